@@ -1,0 +1,36 @@
+# contactfx: `make demo` (the main job) and `make test` (the suite, serial and mpirun -n 2).
+# Each target creates .venv with python3.12 and installs what is missing by itself.
+
+VENV      := .venv
+PY        := $(VENV)/bin/python
+MPIRUN    := $(VENV)/bin/mpirun
+STAMP     := $(VENV)/.installed
+# python3.12 may be a pyenv shim that is not activated: fall back to pyenv's own 3.12.
+PYTHON312 := $(shell python3.12 -c 'import sys' >/dev/null 2>&1 && echo python3.12 || \
+               ls -d $$HOME/.pyenv/versions/3.12*/bin/python3.12 2>/dev/null | tail -n 1)
+export OPENBLAS_NUM_THREADS := 1
+export OMP_NUM_THREADS := 1
+
+.PHONY: demo test lint bench paper clean venv
+
+venv: $(STAMP)
+
+$(STAMP): pyproject.toml
+	@test -n "$(PYTHON312)" || { echo "python3.12 not found" >&2; exit 1; }
+	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[test]"
+	@touch $(STAMP)
+
+demo: $(STAMP)
+	$(PY) demos/demo_blocks.py
+
+test: $(STAMP)
+	$(PY) -m ruff check contactfx meshes tests demos benchmarks
+	$(PY) -m pytest -q tests
+
+bench: $(STAMP)
+	$(PY) benchmarks/run.py
+
+clean:
+	rm -rf results .pytest_cache

@@ -1,0 +1,118 @@
+"""Command line: python -m contactfx solve {blocks,hertz} [options] --json FILE [--out DIR]."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from dataclasses import fields, replace
+from pathlib import Path
+
+import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
+
+from .errors import ContactFxError
+from .methods import Method
+
+BLOCK_KEYS = ("l1", "l2", "h1", "h2", "E1", "E2", "nu1", "nu2", "p", "size1", "size2",
+              "grading1", "grading2")
+HERTZ_KEYS = ("R", "P", "E1", "E2", "nu1", "nu2", "refine", "r_refine", "width", "height")
+
+
+def parser() -> argparse.ArgumentParser:
+    """The argument parser (defaults of scene parameters are the paper's, filled in later)."""
+    ap = argparse.ArgumentParser(prog="python -m contactfx",
+                                 description="2D frictionless two-body contact (units: cm, MPa)")
+    sub = ap.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("solve", help="solve a scene and write a JSON summary")
+    s.add_argument("scene", help="blocks (S1-S4, default S1) or hertz (S5)")
+    s.add_argument("--preset", choices=["S1", "S2", "S3", "S4"],
+                   help="block scene of the paper to start from (other options override it)")
+    for key in sorted(set(BLOCK_KEYS) | set(HERTZ_KEYS)):
+        s.add_argument(f"--{key.replace('_', '-')}", dest=key, type=float, default=None,
+                       help=f"scene parameter {key}")
+    s.add_argument("--method", default="nts", choices=[m.value for m in Method])
+    s.add_argument("--active", type=int, default=2, choices=[1, 2],
+                   help="which body is active (slave, carries the multipliers)")
+    s.add_argument("--solver", default="mumps", help="mumps | fieldsplit | fieldsplit-gamg")
+    s.add_argument("--petsc-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="extra PETSc option for the saddle-point KSP (no leading dash)")
+    s.add_argument("--json", type=Path, required=True, help="where to write the JSON summary")
+    s.add_argument("--out", type=Path, help="directory for XDMF fields and figures")
+    s.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    s.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
+    return ap
+
+
+def scene_params(args: argparse.Namespace):
+    """Scene parameters from the paper's defaults, a preset, and the options given."""
+    from .errors import InputError
+    from .scenes import BLOCK_SCENES, BlockParams, HertzParams
+
+    if args.scene == "blocks":
+        base, keys = BLOCK_SCENES[args.preset or "S1"], BLOCK_KEYS
+    elif args.scene == "hertz":
+        if args.preset:
+            raise InputError("--preset applies to the blocks scene only")
+        base, keys = HertzParams(), HERTZ_KEYS
+    else:
+        raise InputError(f"unknown scene '{args.scene}' (choose blocks or hertz)")
+    given = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    unused = [k for k in set(BLOCK_KEYS) | set(HERTZ_KEYS)
+              if k not in keys and getattr(args, k) is not None]
+    if unused:
+        raise InputError(f"option --{unused[0]} does not apply to the {args.scene} scene")
+    assert {f.name for f in fields(BlockParams)} >= set(BLOCK_KEYS)
+    return replace(base, **given)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run one solve and write its outputs; return the exit code."""
+    from mpi4py import MPI
+
+    from .api import run_case
+    from .errors import InputError
+    from .output import plot_interface, write_fields, write_json
+    from .saddle import SOLVERS
+
+    comm = MPI.COMM_WORLD
+    params = scene_params(args)
+    method = Method(args.method)
+    if args.solver not in SOLVERS:
+        raise InputError(f"unknown solver '{args.solver}' (choose {', '.join(SOLVERS)})")
+    options = dict(SOLVERS[args.solver])
+    for item in args.petsc_option:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise InputError(f"--petsc-option expects KEY=VALUE, got '{item}'")
+        options[key.lstrip("-")] = value
+    sol, data = run_case(args.scene, params, method, args.active, options,
+                         args.max_iterations, comm)
+    data["solver"] = args.solver
+    if args.out is not None:
+        write_fields(sol, args.out)
+    if comm.rank == 0:
+        write_json(args.json, data)
+        log = logging.getLogger("contactfx")
+        log.info("contact force %.10g, %d multipliers, %d dofs, total %.2f s",
+                 data["contact_force"], data["multipliers"], data["dofs"], data["times"]["total"])
+        log.info("wrote %s", args.json)
+        if args.out is not None:
+            fig = plot_interface(data, args.out / "interface.png")
+            log.info("wrote fields (XDMF) and %s to %s", fig.name, args.out)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point: parse, run, and turn contactfx errors into one line on stderr."""
+    args = parser().parse_args(argv)
+    from mpi4py import MPI
+
+    rank = MPI.COMM_WORLD.rank
+    logging.basicConfig(level=logging.WARNING if args.quiet or rank else logging.INFO,
+                        format="%(message)s", stream=sys.stdout)
+    try:
+        return run(args)
+    except ContactFxError as err:
+        if rank == 0:
+            print(f"contactfx: error: {err}", file=sys.stderr)
+        return 2

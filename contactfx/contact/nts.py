@@ -1,0 +1,34 @@
+"""Node-to-surface: the gap collocated at each active node, scaled by its tributary length."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .geometry import Surface, project
+from .mortar import overlap_weights
+from .operator import ContactOperator, assemble, linear_shape
+
+# Active nodes beyond the passive surface's end by more than this (in passive segment lengths)
+# get no constraint.
+TOL = 1e-8
+
+
+def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOperator:
+    """NTS operator: row j = w_j n . (e_j - sum_A N_A(xi_j) e_A), w_j the overlapped int N_j."""
+    seg, xi, found = project(active.x, passive, TOL)
+    # Scaling by int N_j turns the multiplier into a traction comparable with STS and mortar.
+    w = overlap_weights(active, passive)
+    j = np.flatnonzero(found & (w > 0))
+    s = seg[j]
+    return assemble(
+        active,
+        passive,
+        ndofs,
+        rows=j[:, None],
+        row_coef=w[j][:, None],
+        act_nodes=j[:, None],
+        act_coef=np.ones((len(j), 1)),
+        pas_nodes=passive.segments[s],
+        pas_coef=linear_shape(xi[j]),
+        normal=passive.normals[s],
+    )

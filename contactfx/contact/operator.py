@@ -1,0 +1,72 @@
+"""The linearized contact operator and its assembly from point contributions."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .geometry import Surface
+
+
+@dataclass(frozen=True)
+class ContactOperator:
+    """Weighted gap g_tilde(u) = gap + B @ u, one row per active-surface node."""
+
+    B: sp.csr_matrix  # (n_active_nodes, ndofs): row j = active node j
+    gap: np.ndarray  # (n_active_nodes,) weighted gap at u = 0 (reference config)
+    weights: np.ndarray  # (n_active_nodes,) int over the overlapped part of N_j dGamma
+
+    @property
+    def rows(self) -> np.ndarray:
+        """Active nodes with a non-empty constraint (weights > 0); the others are all zero."""
+        return np.flatnonzero(self.weights > 0)
+
+
+def gauss_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n-point Gauss-Legendre points and weights on [0, 1]."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+def linear_shape(xi: np.ndarray) -> np.ndarray:
+    """Values (..., 2) of the two linear shape functions (node 0, node 1) at xi."""
+    return np.stack([1.0 - xi, xi], axis=-1)
+
+
+def assemble(
+    active: Surface,
+    passive: Surface,
+    ndofs: int,
+    rows: np.ndarray,
+    row_coef: np.ndarray,
+    act_nodes: np.ndarray,
+    act_coef: np.ndarray,
+    pas_nodes: np.ndarray,
+    pas_coef: np.ndarray,
+    normal: np.ndarray,
+) -> ContactOperator:
+    """Sum point contributions row_coef * n . (sum act_coef x_act - sum pas_coef x_pas)."""
+    # Point p adds to rows[p, r] (active nodes, weight row_coef[p, r]) the linearized gap
+    # n_p . (x_active(p) - x_passive(p)), both sides written as shape-function sums.
+    na = active.n_nodes
+    if max(active.dofs.max(initial=-1), passive.dofs.max(initial=-1)) >= ndofs:
+        raise ValueError("a surface dof number is >= ndofs")
+    x_act = np.einsum("pk,pkd->pd", act_coef, active.x[act_nodes])
+    x_pas = np.einsum("pk,pkd->pd", pas_coef, passive.x[pas_nodes])
+    g = np.einsum("pd,pd->p", normal, x_act - x_pas)
+    flat_rows = rows.ravel()
+    gap = np.bincount(flat_rows, weights=(row_coef * g[:, None]).ravel(), minlength=na)
+    weights = np.bincount(flat_rows, weights=row_coef.ravel(), minlength=na)
+
+    cols = np.concatenate([active.dofs[act_nodes], passive.dofs[pas_nodes]], axis=1)
+    coef = np.concatenate([act_coef, -pas_coef], axis=1)
+    vals = row_coef[:, :, None, None] * coef[:, None, :, None] * normal[:, None, None, :]
+    shape = vals.shape
+    r = np.broadcast_to(rows[:, :, None, None], shape).ravel()
+    c = np.broadcast_to(cols[:, None, :, :], shape).ravel()
+    B = sp.coo_matrix((vals.ravel(), (r, c)), shape=(na, ndofs)).tocsr()
+    B.sum_duplicates()
+    B.eliminate_zeros()
+    return ContactOperator(B=B, gap=gap, weights=weights)

@@ -1,0 +1,29 @@
+"""Exception types a user of contactfx can catch; the CLI turns each into one line on stderr."""
+
+
+class ContactFxError(Exception):
+    """Base class of every error contactfx raises on purpose."""
+
+
+class InputError(ContactFxError, ValueError):
+    """A scene or method parameter is out of its physical or geometric range."""
+
+
+class MeshError(ContactFxError):
+    """The mesh lacks a required tag, has the wrong cell type, or the surfaces do not overlap."""
+
+
+class GeometryError(ContactFxError):
+    """The contact surfaces do not face each other or already penetrate beyond tolerance."""
+
+
+class SingularSystemError(ContactFxError):
+    """A body is held neither by supports nor by contact, so the system has no unique solution."""
+
+
+class SolverError(ContactFxError):
+    """A linear solve diverged (PETSc's reason is in the message)."""
+
+
+class ActiveSetError(ContactFxError):
+    """The active-set iteration cycled or hit its iteration limit."""

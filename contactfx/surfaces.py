@@ -1,0 +1,103 @@
+"""Gather a body's contact facets into a small 1D Surface known on every rank."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from .contact import Surface
+from .errors import MeshError
+from .scenes import Scene
+
+
+@dataclass(frozen=True)
+class GatheredSurface:
+    """A Surface plus, per node, its owning rank and its global block (node) number."""
+
+    surface: Surface
+    owner: np.ndarray
+    gblock: np.ndarray
+
+
+def vertex_to_block(V: fem.FunctionSpace) -> np.ndarray:
+    """Local dof block of every local vertex (Q1: one block per vertex)."""
+    msh = V.mesh
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim, 0)
+    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
+    ncells = c2v.shape[0]
+    v2b = np.full(msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts,
+                  -1, dtype=np.int32)
+    # For Q1 the dofs of a cell are listed in the order of its vertices.
+    v2b[c2v.ravel()] = V.dofmap.list[:ncells].ravel()
+    return v2b
+
+
+def gather_surface(scene: Scene, V: fem.FunctionSpace, body: int) -> GatheredSurface:
+    """Allgather the contact facets of `body` with coordinates, outward normals and dofs."""
+    msh = V.mesh
+    comm = msh.comm
+    tdim = msh.topology.dim
+    name = f"contact{body}"
+    if name not in scene.tags:
+        raise MeshError(f"the mesh has no physical group '{name}'")
+    msh.topology.create_connectivity(tdim - 1, 0)
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    facets = scene.facet_tags.find(scene.tags[name])
+    facets = facets[facets < msh.topology.index_map(tdim - 1).size_local]
+    f2v = msh.topology.connectivity(tdim - 1, 0)
+    f2c = msh.topology.connectivity(tdim - 1, tdim)
+    c2v = msh.topology.connectivity(tdim, 0)
+    xv = vertex_coordinates(msh)
+    v2b = vertex_to_block(V)
+    imap = V.dofmap.index_map
+    nloc = imap.size_local
+    owners_ghost = imap.owners
+
+    fv = f2v.array.reshape(-1, 2)[facets]
+    cells = f2c.array[f2c.offsets[facets]]
+    cell_mid = xv[c2v.array.reshape(-1, 4)[cells]].mean(axis=1)
+    x0, x1 = xv[fv[:, 0]], xv[fv[:, 1]]
+    t = x1 - x0
+    normal = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
+    flip = np.einsum("ij,ij->i", normal, 0.5 * (x0 + x1) - cell_mid) < 0
+    normal[flip] *= -1
+    blocks = v2b[fv]
+    gblocks = imap.local_to_global(blocks.ravel()).reshape(-1, 2)
+    owner = np.concatenate([np.full(nloc, comm.rank, dtype=np.int64), owners_ghost])[blocks]
+
+    local = np.column_stack([x0, x1, normal, gblocks, owner]).astype(np.float64)
+    rows = comm.allgather(local)
+    allrows = np.concatenate(rows) if rows else np.zeros((0, 10))
+    if allrows.shape[0] == 0:
+        raise MeshError(f"the contact surface '{name}' has no facets")
+    coords = allrows[:, 0:4].reshape(-1, 2)
+    gb = allrows[:, 6:8].astype(np.int64).ravel()
+    own = allrows[:, 8:10].astype(np.int64).ravel()
+    uniq, first, inverse = np.unique(gb, return_index=True, return_inverse=True)
+    segments = inverse.reshape(-1, 2)
+    x = coords[first]
+    surface = Surface(x=x, segments=segments.astype(np.int64), normals=allrows[:, 4:6].copy(),
+                      dofs=np.column_stack([2 * uniq, 2 * uniq + 1]).astype(np.int64))
+    return GatheredSurface(surface, own[first], uniq)
+
+
+def vertex_coordinates(msh) -> np.ndarray:
+    """Coordinates (x, y) of every local vertex."""
+    tdim = msh.topology.dim
+    nv = msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts
+    msh.topology.create_connectivity(tdim, 0)
+    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
+    geo = msh.geometry.dofmaps[0]
+    xv = np.zeros((nv, 2))
+    # Q1 geometry: the cell's geometry nodes are its vertices, in the same order.
+    xv[c2v.ravel()] = msh.geometry.x[geo[: c2v.shape[0]].ravel(), :2]
+    return xv
+
+
+def comm_sum(comm: MPI.Comm, value: float) -> float:
+    """Sum a float over all ranks."""
+    return comm.allreduce(value, op=MPI.SUM)

@@ -1,0 +1,108 @@
+"""Hertz scene (S5): quarter of a cylinder on an elastic block, half model by symmetry."""
+
+import math
+
+import gmsh
+
+from contactfx.errors import InputError, MeshError
+
+# Growth of the element size with distance beyond r_refine (size per unit distance).
+_SLOPE = 0.4
+# Quad element types of gmsh (4-node quadrangle); anything else is a leftover triangle.
+_QUAD4 = 3
+
+
+def build_hertz(
+    R: float,
+    width: float,
+    height: float,
+    h_contact: float,
+    r_refine: float,
+    h_far: float | None = None,
+    contact_extent: float | None = None,
+) -> None:
+    """Add the Hertz half model (quarter disc on a block) to the current gmsh model and mesh it."""
+    h_far = R / 6.0 if h_far is None else h_far
+    extent = min(width, R / 4.0) if contact_extent is None else contact_extent
+    if min(R, width, height, h_contact, r_refine, h_far) <= 0.0:
+        raise InputError("radius, block size, mesh sizes and r_refine must be positive")
+    if not 0.0 < extent < min(width, R):
+        raise InputError(f"contact_extent={extent} must lie in (0, min(width, R))")
+    h_far = max(h_far, h_contact)
+    yc = height + R
+    geo = gmsh.model.geo
+
+    # Block: the top is split at the end of the contact zone.
+    b00 = geo.addPoint(0.0, 0.0, 0.0)
+    b10 = geo.addPoint(width, 0.0, 0.0)
+    b11 = geo.addPoint(width, height, 0.0)
+    bce = geo.addPoint(extent, height, 0.0)
+    b01 = geo.addPoint(0.0, height, 0.0)
+    support = geo.addLine(b00, b10)
+    b_right = geo.addLine(b10, b11)
+    b_top_free = geo.addLine(b11, bce)
+    contact1 = geo.addLine(bce, b01)
+    b_sym = geo.addLine(b01, b00)
+    block = geo.addPlaneSurface([geo.addCurveLoop([support, b_right, b_top_free, contact1, b_sym])])
+
+    # Quarter disc from its own points (same location as b01, distinct tag): the bodies
+    # must not share nodes, contact needs duplicated interface nodes.
+    centre = geo.addPoint(0.0, yc, 0.0)
+    d_bot = geo.addPoint(0.0, height, 0.0)
+    d_ce = geo.addPoint(extent, yc - math.sqrt(R * R - extent * extent), 0.0)
+    d_right = geo.addPoint(R, yc, 0.0)
+    contact2 = geo.addCircleArc(d_bot, centre, d_ce)
+    arc_free = geo.addCircleArc(d_ce, centre, d_right)
+    load = geo.addLine(d_right, centre)
+    d_sym = geo.addLine(centre, d_bot)
+    disc = geo.addPlaneSurface([geo.addCurveLoop([contact2, arc_free, load, d_sym])])
+    geo.synchronize()
+
+    # Size grows linearly from h_contact at r_refine to h_far; distance is measured from
+    # both copies of the contact point, so both bodies are refined alike.
+    dist = gmsh.model.mesh.field.add("Distance")
+    gmsh.model.mesh.field.setNumbers(dist, "PointsList", [b01, d_bot])
+    thr = gmsh.model.mesh.field.add("Threshold")
+    gmsh.model.mesh.field.setNumber(thr, "InField", dist)
+    gmsh.model.mesh.field.setNumber(thr, "SizeMin", h_contact)
+    gmsh.model.mesh.field.setNumber(thr, "SizeMax", h_far)
+    gmsh.model.mesh.field.setNumber(thr, "DistMin", r_refine)
+    gmsh.model.mesh.field.setNumber(thr, "DistMax", r_refine + (h_far - h_contact) / _SLOPE)
+    gmsh.model.mesh.field.setAsBackgroundMesh(thr)
+    # The field alone sets the size: point sizes and curvature would override it.
+    options = {
+        "Mesh.MeshSizeExtendFromBoundary": 0,
+        "Mesh.MeshSizeFromPoints": 0,
+        "Mesh.MeshSizeFromCurvature": 0,
+        # Frontal-Delaunay for quads + Blossom full-quad recombination: no triangle left.
+        "Mesh.Algorithm": 8,
+        "Mesh.RecombinationAlgorithm": 3,
+        "Mesh.RecombineAll": 1,
+    }
+    # Options are global to the gmsh session: restore them so later models are unaffected.
+    saved = {name: gmsh.option.getNumber(name) for name in options}
+    for name, value in options.items():
+        gmsh.option.setNumber(name, value)
+    for surf in (block, disc):
+        gmsh.model.mesh.setRecombine(2, surf)
+
+    groups = [
+        (2, [block], "body1"),
+        (2, [disc], "body2"),
+        (1, [contact1], "contact1"),
+        (1, [contact2], "contact2"),
+        (1, [b_sym, d_sym], "symmetry"),
+        (1, [support], "support"),
+        (1, [load], "load"),
+    ]
+    for dim, tags, name in groups:
+        gmsh.model.addPhysicalGroup(dim, tags, name=name)
+    try:
+        gmsh.model.mesh.generate(2)
+    finally:
+        for name, value in saved.items():
+            gmsh.option.setNumber(name, value)
+
+    types, _, _ = gmsh.model.mesh.getElements(2)
+    if any(t != _QUAD4 for t in types):
+        raise MeshError(f"Hertz mesh has non-quadrilateral elements (gmsh types {list(types)})")
