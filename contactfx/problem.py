@@ -106,6 +106,9 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
     needs_contact = [b for b in (1, 2) if not body_supported(el, scene, b)]
 
     active = g / w <= aso.penetration_tol * h
+    if needs_contact and comm.allreduce(int(active.sum())) == 0 and layout.size:
+        # A body held only by contact needs a first contact point: take the closest node(s).
+        active = g / w <= g_all.min() + aso.penetration_tol * h
     seen: set[bytes] = set()
     history: list[dict[str, float]] = []
     u = fem.Function(V, name="u")
