@@ -1,0 +1,89 @@
+"""Block scenes S1-S4: equilibrium, the contact patch test, and the methods' known errors."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from contactfx.api import run_case
+from contactfx.metrics import patch_errors
+from contactfx.postprocess import body_stress_deviation
+from contactfx.scenes import BLOCK_SCENES
+
+METHODS = ["nts", "sts", "mortar"]
+S4 = BLOCK_SCENES["S4"]
+P = S4.p
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("active", [1, 2])
+def test_patch_test_matching_meshes(method: str, active: int) -> None:
+    """Equal widths and matching uniform meshes: every method gives sigma_yy = -p exactly."""
+    params = replace(S4, size1=0.125, size2=0.125, grading1=1.0, grading2=1.0)
+    sol, data = run_case("blocks", params, method, active=active)
+    dev = body_stress_deviation(sol, -P)
+    assert dev["body1"] < 1e-8 and dev["body2"] < 1e-8
+    assert patch_errors(data["interface"], P)["pressure"] < 1e-8
+
+
+@pytest.mark.parametrize("scene", list(BLOCK_SCENES))
+@pytest.mark.parametrize("method", METHODS)
+def test_contact_force_equals_load(scene: str, method: str) -> None:
+    """The top block is held only by contact, so the contact force is the whole load p*l2/2."""
+    params = BLOCK_SCENES[scene]
+    _, data = run_case("blocks", params, method)
+    assert data["contact_force"] == pytest.approx(params.p * params.l2 / 2, rel=1e-10)
+    assert data["iterations"] == 1
+
+
+@pytest.mark.parametrize("active", [1, 2])
+@pytest.mark.parametrize("graded", [False, True])
+def test_mortar_passes_patch_test_on_nonmatching_meshes(active: int, graded: bool) -> None:
+    """Segment-based mortar reproduces the uniform state to round-off (SPEC S4 bar: 1e-8)."""
+    params = S4 if graded else replace(S4, grading1=1.0, grading2=1.0)
+    sol, data = run_case("blocks", params, "mortar", active=active)
+    dev = body_stress_deviation(sol, -P)
+    assert max(dev.values()) < 1e-8
+    assert patch_errors(data["interface"], P)["pressure"] < 1e-8
+
+
+# Measured on the paper's S4 meshes (0.12 / 0.15 cm, graded): the failures are physics, not bugs.
+# NTS collocates nodal forces, so the fine passive mesh gets point loads; STS integrates across
+# passive nodes with a smooth-integrand rule. A change of behaviour outside these bands shows.
+KNOWN_S4_ERRORS = {
+    # (method, active): (body 1, body 2, pressure), max relative deviations from the exact state
+    ("nts", 2): (8.35e-1, 3.04e-2, 2.36e-2),
+    ("nts", 1): (1.76e-1, 1.62e-2, 1.49e-1),
+    ("sts", 2): (4.88e-2, 1.17e-3, 2.09e-3),
+    ("sts", 1): (2.01e-2, 2.10e-3, 3.37e-2),
+}
+
+
+@pytest.mark.parametrize(("method", "active"), list(KNOWN_S4_ERRORS))
+def test_nts_and_sts_fail_patch_test_by_known_amount(method: str, active: int) -> None:
+    """NTS and STS do not pass the non-matching patch test; their errors keep a known size."""
+    sol, data = run_case("blocks", S4, method, active=active)
+    dev = body_stress_deviation(sol, -P)
+    measured = (dev["body1"], dev["body2"], patch_errors(data["interface"], P)["pressure"])
+    for got, known in zip(measured, KNOWN_S4_ERRORS[(method, active)], strict=True):
+        assert known / 1.5 < got < known * 1.5
+
+
+def test_s1_methods_agree_away_from_corner() -> None:
+    """S1 (matching meshes): the methods agree to 0.1 % away from the corner (paper: ~5th digit).
+
+    The stresses agree to round-off on the outer 90 % of the line. NTS's pressure is a lumped
+    nodal force per tributary length while STS and mortar interpolate a traction field; the two
+    differ by O(h^2 p''), which the corner singularity makes large on its last few elements, so
+    the pressure is compared on the inner two thirds.
+    """
+    params = BLOCK_SCENES["S1"]
+    results = {m: run_case("blocks", params, m)[1]["interface"] for m in METHODS}
+    x = np.asarray(results["nts"]["x"])
+    corner = params.l2 / 2
+    for key, zone in (("sigma_yy_1", 0.9), ("sigma_yy_2", 0.9), ("pressure", 2 / 3)):
+        far = x < zone * corner
+        ref = np.asarray(results["mortar"][key], dtype=float)[far]
+        for m in ("nts", "sts"):
+            other = np.asarray(results[m][key], dtype=float)[far]
+            assert np.max(np.abs(other / ref - 1)) < 1e-3, (key, m)

@@ -1,0 +1,75 @@
+"""The command line as a user runs it: the JSON schema, outputs, and one-line errors."""
+
+import json
+
+import pytest
+
+from conftest import run_cli
+
+KEYS = {"scene", "method", "params", "ranks", "dofs", "multipliers", "elements", "iterations",
+        "times", "contact_force", "interface"}
+
+
+def test_blocks_nts_writes_schema(tmp_path) -> None:
+    """`solve blocks --method nts --json r.json` writes every documented key."""
+    out = tmp_path / "r.json"
+    proc = run_cli("solve", "blocks", "--method", "nts", "--json", str(out), "--out",
+                   str(tmp_path / "fields"))
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(out.read_text())
+    assert KEYS <= data.keys()
+    assert {"mesh", "assemble", "contact", "solve", "total"} <= data["times"].keys()
+    assert {"x", "pressure", "sigma_yy_1", "sigma_yy_2"} <= data["interface"].keys()
+    params = data["params"]
+    assert (params["l1"], params["l2"], params["E1"], params["p"], params["size1"]) == (
+        10.0, 6.0, 70000.0, 50.0, 0.125)
+    n = data["multipliers"]
+    assert all(len(data["interface"][k]) == n for k in ("x", "pressure", "sigma_yy_1"))
+    assert data["contact_force"] == pytest.approx(150.0, rel=1e-10)
+    assert (tmp_path / "fields" / "displacement.xdmf").exists()
+    assert (tmp_path / "fields" / "interface.png").stat().st_size > 10_000
+
+
+def test_mortar_patch_test_from_the_issue(tmp_path) -> None:
+    """The issue's acceptance command: mortar on S4 geometry gives sigma_yy = -p to 1e-8."""
+    out = tmp_path / "r.json"
+    proc = run_cli("solve", "blocks", "--method", "mortar", "--l2", "10", "--E1", "700000",
+                   "--E2", "70000", "--size1", "0.12", "--size2", "0.15", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    itf = json.loads(out.read_text())["interface"]
+    for key in ("sigma_yy_1", "sigma_yy_2"):
+        assert max(abs(v / 50.0 + 1) for v in itf[key]) < 1e-8
+
+
+@pytest.mark.parametrize(("args", "needle"), [
+    (["blocks", "--nu1", "0.5"], "Poisson"),
+    (["blocks", "--nu2", "-1"], "Poisson"),
+    (["blocks", "--E2", "0"], "Young"),
+    (["blocks", "--E1", "-7"], "Young"),
+    (["blocks", "--size1", "0"], "size1"),
+    (["blocks", "--size2", "-0.1"], "size2"),
+    (["cylinder"], "unknown scene"),
+    (["blocks", "--R", "3"], "does not apply"),
+    (["blocks", "--solver", "cg"], "unknown solver"),
+])
+def test_bad_input_one_line_no_traceback(tmp_path, args: list[str], needle: str) -> None:
+    """Bad input: non-zero exit, one line on stderr naming the problem, no JSON written."""
+    out = tmp_path / "r.json"
+    proc = run_cli("solve", *args, "--json", str(out))
+    assert proc.returncode != 0
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], proc.stderr
+    assert "Traceback" not in proc.stderr + proc.stdout
+    assert not out.exists()
+
+
+def test_unbuilt_method_is_refused_clearly(tmp_path) -> None:
+    """A method that is not implemented yet says so, rather than failing later."""
+    from contactfx.methods import IMPLEMENTED, Method
+
+    missing = [m for m in Method if m not in IMPLEMENTED]
+    if not missing:
+        pytest.skip("every method is implemented")
+    proc = run_cli("solve", "blocks", "--method", missing[0].value, "--json",
+                   str(tmp_path / "r.json"))
+    assert proc.returncode == 2 and "not implemented" in proc.stderr
