@@ -12,13 +12,15 @@ from .postprocess import summary
 from .problem import ActiveSetOptions, Solution, solve_contact
 from .saddle import SOLVERS
 from .scenes import BlockParams, HertzParams, build_scene
+from .schwarz import SchwarzOptions, solve_schwarz
 from .timers import Timers
 
 
 def run_case(kind: str, params: BlockParams | HertzParams, method: Method | str,
              active: int = 2, solver: str | dict[str, object] = "mumps",
-             max_iterations: int = 50, comm: MPI.Comm = MPI.COMM_WORLD
-             ) -> tuple[Solution, dict[str, Any]]:
+             max_iterations: int = 50, comm: MPI.Comm = MPI.COMM_WORLD,
+             penalty: float | None = None, schwarz: SchwarzOptions | None = None,
+             reference_timing: bool = False) -> tuple[Solution, dict[str, Any]]:
     """Mesh, assemble and solve one scene; return the solution and its JSON summary."""
     t_start = time.perf_counter()
     method = Method(method)
@@ -26,11 +28,25 @@ def run_case(kind: str, params: BlockParams | HertzParams, method: Method | str,
     timers = Timers()
     with timers("mesh"):
         scene = build_scene(kind, params, active=active, comm=comm)
-    sol = solve_contact(scene, method, options, ActiveSetOptions(max_iterations), timers)
+    if method == Method.PENALTY:
+        from .penalty import penetration, solve_penalty
+
+        sol = solve_penalty(scene, penalty, options, ActiveSetOptions(max_iterations), timers)
+    elif method == Method.SCHWARZ:
+        sol = solve_schwarz(scene, schwarz or SchwarzOptions(max_iterations=max_iterations),
+                            timers)
+    else:
+        sol = solve_contact(scene, method, options, ActiveSetOptions(max_iterations), timers,
+                            reference_timing=reference_timing)
     times = {k: timers.seconds.get(k, 0.0)
              for k in ("mesh", "assemble", "search", "contact", "solve")}
     times["total"] = time.perf_counter() - t_start
+    if "reference_solve" in timers.seconds:
+        times["reference_solve"] = timers.seconds["reference_solve"]
     extra: dict[str, Any] = {"solver": solver if isinstance(solver, str) else "custom"}
+    if method == Method.PENALTY:
+        extra["penalty"] = sol.history[-1]["penalty"]
+        extra["penetration"] = penetration(sol)
     if kind == "hertz":
         from .hertz import hertz_summary
 

@@ -15,7 +15,8 @@ from .methods import Method
 
 BLOCK_KEYS = ("l1", "l2", "h1", "h2", "E1", "E2", "nu1", "nu2", "p", "size1", "size2",
               "grading1", "grading2")
-HERTZ_KEYS = ("R", "P", "E1", "E2", "nu1", "nu2", "refine", "r_refine", "width", "height")
+HERTZ_KEYS = ("R", "P", "E1", "E2", "nu1", "nu2", "refine", "r_refine", "refine_edge", "slope",
+              "width", "height")
 
 
 def parser() -> argparse.ArgumentParser:
@@ -39,6 +40,13 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--json", type=Path, required=True, help="where to write the JSON summary")
     s.add_argument("--out", type=Path, help="directory for XDMF fields and figures")
     s.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    s.add_argument("--penalty", type=float, default=None, metavar="EPS",
+                   help="penalty normal stiffness in MPa/cm (pressure = EPS * penetration) for "
+                   "--method penalty; default 1e3 * max(E1, E2) / h, h the median contact "
+                   "element size")
+    s.add_argument("--reference-timing", action="store_true",
+                   help="also time a fresh solve of the final saddle-point system (the cost "
+                   "floor) and report it as times.reference_solve")
     s.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
     return ap
 
@@ -85,8 +93,11 @@ def run(args: argparse.Namespace) -> int:
         if not sep or not key:
             raise InputError(f"--petsc-option expects KEY=VALUE, got '{item}'")
         options[key.lstrip("-")] = value
+    if args.penalty is not None and method != Method.PENALTY:
+        raise InputError("--penalty applies to --method penalty only")
     sol, data = run_case(args.scene, params, method, args.active, options,
-                         args.max_iterations, comm)
+                         args.max_iterations, comm, penalty=args.penalty,
+                         reference_timing=args.reference_timing)
     data["solver"] = args.solver
     if args.out is not None:
         write_fields(sol, args.out)

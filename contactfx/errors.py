@@ -27,3 +27,7 @@ class SolverError(ContactFxError):
 
 class ActiveSetError(ContactFxError):
     """The active-set iteration cycled or hit its iteration limit."""
+
+
+class ConvergenceError(ContactFxError):
+    """An outer iteration (e.g. the alternating Schwarz method) diverged or hit its limit."""

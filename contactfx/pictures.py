@@ -15,7 +15,6 @@ def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | N
     if sol.scene.mesh.comm.size > 1:
         return None
     import pyvista
-
     from dolfinx import plot
 
     pyvista.OFF_SCREEN = True

@@ -54,8 +54,10 @@ class HertzParams:
     E2: float = 7000.0
     nu1: float = 0.23
     nu2: float = 0.23
-    refine: float = 0.05
-    r_refine: float = 0.0
+    refine: float = 0.02        # element size on the contact zone, x <= r_refine (cm)
+    r_refine: float = 0.0       # end of the refined zone; 0 = 1.4 a (Hertz's half-width)
+    refine_edge: float = 0.005  # element size at x = a, the pressure's sqrt edge; 0 = off
+    slope: float = 0.1          # growth of the element size per unit distance
     width: float = 60.0
     height: float = 60.0
 
@@ -89,7 +91,7 @@ def validate(params: BlockParams | HertzParams) -> None:
     _check_material("body 2", params.E2, params.nu2)
     positive = {
         BlockParams: ("l1", "l2", "h1", "h2", "size1", "size2", "grading1", "grading2"),
-        HertzParams: ("R", "P", "refine", "width", "height"),
+        HertzParams: ("R", "P", "refine", "slope", "width", "height"),
     }[type(params)]
     for key in positive:
         value = getattr(params, key)
@@ -109,6 +111,8 @@ def validate(params: BlockParams | HertzParams) -> None:
             raise InputError(f"refine = {params.refine} is too coarse for R = {params.R}")
         if params.r_refine < 0:
             raise InputError(f"r_refine must be >= 0 (got {params.r_refine})")
+        if not (math.isfinite(params.refine_edge) and params.refine_edge >= 0):
+            raise InputError(f"refine_edge must be >= 0 (got {params.refine_edge})")
 
 
 @dataclass(frozen=True)
@@ -161,8 +165,11 @@ def build_scene(kind: str, params: BlockParams | HertzParams, active: int = 2,
             params = replace(params, r_refine=round(1.4 * exact["a"], 6))
         h = params
 
+        # The edge grading targets the Hertz estimate of a, as a user would plan a mesh.
+        edge = (exact["a"], h.refine_edge) if h.refine_edge > 0 else None
+
         def build() -> None:
-            build_hertz(h.R, h.width, h.height, h.refine, h.r_refine)
+            build_hertz(h.R, h.width, h.height, h.refine, h.r_refine, slope=h.slope, edge=edge)
 
         pressure = h.P / (2 * h.R)
         extra["hertz_exact"] = exact

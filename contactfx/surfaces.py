@@ -8,8 +8,9 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from .contact import Surface
-from .errors import MeshError
+from .contact import ContactOperator, Surface
+from .contact.geometry import nodal_normals, project, segment_lengths
+from .errors import GeometryError, MeshError
 from .scenes import Scene
 
 
@@ -101,3 +102,24 @@ def vertex_coordinates(msh) -> np.ndarray:
 def comm_sum(comm: MPI.Comm, value: float) -> float:
     """Sum a float over all ranks."""
     return comm.allreduce(value, op=MPI.SUM)
+
+
+def check_facing(active: Surface, passive: Surface, op: ContactOperator) -> None:
+    """Raise GeometryError if the active nodes nearest the passive surface do not face it."""
+    tol = 1e-12 * max(float(op.weights.max(initial=0.0)), 1e-300)
+    nodes = np.flatnonzero(op.weights > tol)
+    if nodes.size == 0:
+        return
+    gap = op.gap[nodes] / op.weights[nodes]
+    h = float(np.median(segment_lengths(active)))
+    # Only the nodes that can come into contact matter: a curved body turns away elsewhere.
+    near = nodes[gap <= gap.min() + h]
+    seg, _, _ = project(active.x[near], passive)
+    dot = np.einsum("ij,ij->i", nodal_normals(active)[near], passive.normals[seg])
+    if np.any(dot >= 0.0):
+        j = int(np.argmax(dot))
+        xa = active.x[near[j]]
+        angle = np.degrees(np.arccos(min(dot[j], 1.0)))
+        raise GeometryError(f"the contact surfaces do not face each other: at ({xa[0]:.4g}, "
+                            f"{xa[1]:.4g}) the outward normals of the active and passive "
+                            f"surfaces make an angle of {angle:.0f} degrees (180 expected)")

@@ -6,8 +6,10 @@ import gmsh
 
 from contactfx.errors import InputError, MeshError
 
-# Growth of the element size with distance beyond r_refine (size per unit distance).
-_SLOPE = 0.4
+# Growth of the element size with distance from the refined zone (size per unit distance).
+# The elastic field decays like 1/r in 2D, so every decade of distance adds about the same
+# discretization error: the slope, not the far size, sets the error in the compliance.
+_SLOPE = 0.1
 # Quad element types of gmsh (4-node quadrangle); anything else is a leftover triangle.
 _QUAD4 = 3
 
@@ -20,15 +22,28 @@ def build_hertz(
     r_refine: float,
     h_far: float | None = None,
     contact_extent: float | None = None,
+    slope: float = _SLOPE,
+    edge: tuple[float, float] | None = None,
 ) -> None:
-    """Add the Hertz half model (quarter disc on a block) to the current gmsh model and mesh it."""
+    """Add the Hertz half model (quarter disc on a block) to the current gmsh model and mesh it.
+
+    The size is h_contact along both contact surfaces for x <= r_refine and, if `edge` =
+    (x_edge, h_edge) is given, h_edge at x_edge (the expected edge of the contact zone, where
+    the pressure has its square-root singularity); it grows by `slope` per unit distance.
+    """
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
-    if min(R, width, height, h_contact, r_refine, h_far) <= 0.0:
-        raise InputError("radius, block size, mesh sizes and r_refine must be positive")
+    if min(R, width, height, h_contact, r_refine, h_far, slope) <= 0.0:
+        raise InputError("radius, block size, mesh sizes, r_refine and slope must be positive")
+    if edge is not None and not (0.0 <= edge[0] < width and edge[1] > 0.0):
+        raise InputError(f"edge = {edge}: need 0 <= x_edge < width and h_edge > 0")
     if not 0.0 < extent < min(width, R):
         raise InputError(f"contact_extent={extent} must lie in (0, min(width, R))")
     h_far = max(h_far, h_contact)
+    # Plain floats: numpy scalars would print as np.float64(...) in the gmsh expression.
+    R, height, h_contact, r_refine, h_far, slope = map(
+        float, (R, height, h_contact, r_refine, h_far, slope))
+    edge = None if edge is None else (float(edge[0]), float(edge[1]))
     yc = height + R
     geo = gmsh.model.geo
 
@@ -58,17 +73,21 @@ def build_hertz(
     disc = geo.addPlaneSurface([geo.addCurveLoop([contact2, arc_free, load, d_sym])])
     geo.synchronize()
 
-    # Size grows linearly from h_contact at r_refine to h_far; distance is measured from
-    # both copies of the contact point, so both bodies are refined alike.
-    dist = gmsh.model.mesh.field.add("Distance")
-    gmsh.model.mesh.field.setNumbers(dist, "PointsList", [b01, d_bot])
-    thr = gmsh.model.mesh.field.add("Threshold")
-    gmsh.model.mesh.field.setNumber(thr, "InField", dist)
-    gmsh.model.mesh.field.setNumber(thr, "SizeMin", h_contact)
-    gmsh.model.mesh.field.setNumber(thr, "SizeMax", h_far)
-    gmsh.model.mesh.field.setNumber(thr, "DistMin", r_refine)
-    gmsh.model.mesh.field.setNumber(thr, "DistMax", r_refine + (h_far - h_contact) / _SLOPE)
-    gmsh.model.mesh.field.setAsBackgroundMesh(thr)
+    # The size grows linearly (at `slope`) with the distance from the part of the contact
+    # surfaces with x <= r_refine: fine where the pressure lives, coarse a few elements
+    # deeper. Each body's distance is to its own surface (the line y = height, the arc);
+    # the smaller of the two is the right one on both sides of the interface.
+    d_line = f"Abs(y - {height!r})"
+    d_arc = f"Abs({R!r} - Sqrt(x^2 + (y - {yc!r})^2))"
+    dist = f"Sqrt(Max(x - {r_refine!r}, 0)^2 + Min({d_line}, {d_arc})^2)"
+    field = gmsh.model.mesh.field.add("MathEval")
+    size = f"{h_contact!r} + {slope!r} * {dist}"
+    if edge is not None:
+        xe, he = edge
+        de = f"Sqrt((x - {xe!r})^2 + Min({d_line}, {d_arc})^2)"
+        size = f"Min({size}, {he!r} + {slope!r} * {de})"
+    gmsh.model.mesh.field.setString(field, "F", f"Min({h_far!r}, {size})")
+    gmsh.model.mesh.field.setAsBackgroundMesh(field)
     # The field alone sets the size: point sizes and curvature would override it.
     options = {
         "Mesh.MeshSizeExtendFromBoundary": 0,

@@ -6,7 +6,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from conftest import ENV, MPIRUN, ROOT
 
 DEMOS = sorted((ROOT / "demos").glob("demo_*.py"))

@@ -17,7 +17,7 @@ def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOp
     """NTS operator: row j = w_j n . (e_j - sum_A N_A(xi_j) e_A), w_j the overlapped int N_j."""
     seg, xi, found = project(active.x, passive, TOL)
     # Scaling by int N_j turns the multiplier into a traction comparable with STS and mortar.
-    w = overlap_weights(active, passive)
+    w = overlap_weights(active, passive, seg)
     j = np.flatnonzero(found & (w > 0))
     s = seg[j]
     return assemble(

@@ -46,10 +46,13 @@ def assemble(
     pas_nodes: np.ndarray,
     pas_coef: np.ndarray,
     normal: np.ndarray,
+    group: int = 1,
 ) -> ContactOperator:
     """Sum point contributions row_coef * n . (sum act_coef x_act - sum pas_coef x_pas)."""
     # Point p adds to rows[p, r] (active nodes, weight row_coef[p, r]) the linearized gap
-    # n_p . (x_active(p) - x_passive(p)), both sides written as shape-function sums.
+    # n_p . (x_active(p) - x_passive(p)), both sides written as shape-function sums. Points
+    # come in runs of `group` sharing rows, nodes and normal (the Gauss points of one mortar
+    # sub-segment); their values are summed before the scatter to shrink the COO arrays.
     na = active.n_nodes
     if max(active.dofs.max(initial=-1), passive.dofs.max(initial=-1)) >= ndofs:
         raise ValueError("a surface dof number is >= ndofs")
@@ -63,6 +66,9 @@ def assemble(
     cols = np.concatenate([active.dofs[act_nodes], passive.dofs[pas_nodes]], axis=1)
     coef = np.concatenate([act_coef, -pas_coef], axis=1)
     vals = row_coef[:, :, None, None] * coef[:, None, :, None] * normal[:, None, None, :]
+    if group > 1:
+        vals = vals.reshape(-1, group, *vals.shape[1:]).sum(axis=1)
+        rows, cols = rows[::group], cols[::group]
     shape = vals.shape
     r = np.broadcast_to(rows[:, :, None, None], shape).ravel()
     c = np.broadcast_to(cols[:, None, :, :], shape).ravel()

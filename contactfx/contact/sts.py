@@ -23,7 +23,7 @@ def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOp
     na = linear_shape(xi)
     nodes = active.segments[e]
     points = np.einsum("pk,pkd->pd", na, active.x[nodes])
-    seg, eta, found = project(points, passive, TOL)
+    seg, eta, found = project(points, passive, TOL, group=GAUSS_POINTS)
     # No cutting at passive nodes: a segment straddling a passive node or kink is integrated
     # as if the integrand were smooth (the method's known source of oscillations).
     f = np.flatnonzero(found)

@@ -1,0 +1,253 @@
+"""Bad input and failure modes: a specific exception from the API, one stderr line from the CLI."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import dolfinx_solver  # noqa: F401
+import numpy as np
+import pytest
+from dolfinx import mesh as dmesh
+from mpi4py import MPI
+
+from contactfx.api import run_case
+from contactfx.errors import (
+    ActiveSetError,
+    ContactFxError,
+    GeometryError,
+    InputError,
+    MeshError,
+    SingularSystemError,
+    SolverError,
+)
+from contactfx.methods import Method
+from contactfx.penalty import solve_penalty
+from contactfx.problem import solve_contact
+from contactfx.scenes import BLOCK_SCENES, BlockParams, Scene, build_scene
+
+COARSE = replace(BLOCK_SCENES["S4"], size1=0.5, size2=0.6)
+ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+def solvers():
+    """Both solve entry points: the multiplier methods and the penalty baseline."""
+    return [lambda s: solve_contact(s, Method.MORTAR), lambda s: solve_penalty(s, 1e7)]
+
+
+def coarse_scene(params: BlockParams = COARSE) -> Scene:
+    """A small S4-like scene on COMM_SELF (cheap to build, safe to modify)."""
+    return build_scene("blocks", params, active=2, comm=MPI.COMM_SELF)
+
+
+def shift_body(scene: Scene, body: int, dx: float, dy: float) -> None:
+    """Move every geometry node of `body` rigidly (the bodies share no node)."""
+    cells = scene.cell_tags.find(scene.tags[f"body{body}"])
+    nodes = np.unique(scene.mesh.geometry.dofmaps[0][cells])
+    scene.mesh.geometry.x[nodes, 0] += dx
+    scene.mesh.geometry.x[nodes, 1] += dy
+
+
+def cli(tmp_path: Path, *args: str, mpi: int = 0) -> tuple[int, list[str], Path]:
+    """Run the CLI; return the exit code, the non-empty stderr lines and the JSON path."""
+    out = tmp_path / "run.json"
+    cmd = [sys.executable, "-m", "contactfx", "solve", *args, "--json", str(out), "-q"]
+    if mpi:
+        mpirun = str(Path(sys.executable).parent / "mpirun")
+        # As the README runs it: every rank raises the same (collective) error and exits 2;
+        # under `-m mpi4py` a non-zero exit would become an MPI_Abort with its own message.
+        cmd = [mpirun, "-n", str(mpi), *cmd]
+    res = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+    return res.returncode, [ln for ln in res.stderr.splitlines() if ln.strip()], out
+
+
+def assert_clean_failure(tmp_path: Path, args: list[str], words: str, mpi: int = 0) -> str:
+    """The CLI exits non-zero with exactly one 'contactfx: error:' line and writes no JSON."""
+    rc, err, out = cli(tmp_path, *args, mpi=mpi)
+    assert rc != 0
+    assert len(err) == 1, err
+    assert err[0].startswith("contactfx: error: "), err
+    assert words in err[0], err
+    assert not out.exists()
+    assert not any(tmp_path.iterdir()), list(tmp_path.iterdir())  # no temp file either
+    return err[0]
+
+
+# ---------------------------------------------------------------- parameters (API)
+
+@pytest.mark.parametrize(("change", "words"), [
+    ({"nu1": 0.5}, "Poisson ratio"),
+    ({"nu2": 0.7}, "Poisson ratio"),
+    ({"nu1": -1.0}, "Poisson ratio"),
+    ({"E1": 0.0}, "Young's modulus"),
+    ({"E2": -7e4}, "Young's modulus"),
+    ({"size1": 0.0}, "size1"),
+    ({"size2": -0.1}, "size2"),
+])
+def test_bad_parameters_raise_input_error(change: dict, words: str) -> None:
+    with pytest.raises(InputError, match=words):
+        run_case("blocks", replace(COARSE, **change), "mortar", comm=MPI.COMM_SELF)
+
+
+def test_unknown_scene_raises_input_error() -> None:
+    with pytest.raises(InputError, match="unknown scene 'cube'"):
+        build_scene("cube", COARSE, comm=MPI.COMM_SELF)
+
+
+# ---------------------------------------------------------------- meshes and tags (API)
+
+@pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
+def test_missing_contact_tag(solve) -> None:
+    scene = coarse_scene()
+    tags = {k: v for k, v in scene.tags.items() if k != "contact2"}
+    with pytest.raises(MeshError, match="no physical group 'contact2'"):
+        solve(replace(scene, tags=tags))
+
+
+@pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
+def test_empty_contact_tag(solve) -> None:
+    scene = coarse_scene()
+    with pytest.raises(MeshError, match="'contact1' has no facets"):
+        solve(replace(scene, tags={**scene.tags, "contact1": 9999}))
+
+
+def test_triangle_mesh_is_refused() -> None:
+    msh = dmesh.create_rectangle(MPI.COMM_SELF, [[0.0, 0.0], [1.0, 1.0]], [2, 2],
+                                 dmesh.CellType.triangle)
+    msh.topology.create_connectivity(1, 2)
+    empty = np.zeros(0, dtype=np.int32)
+    ct = dmesh.meshtags(msh, 2, empty, empty)
+    ft = dmesh.meshtags(msh, 1, empty, empty)
+    tags = {name: i + 1 for i, name in enumerate(
+        ("body1", "body2", "contact1", "contact2", "symmetry", "support", "load"))}
+    base = coarse_scene()
+    scene = Scene("blocks", COARSE, msh, ct, ft, tags, base.materials, 50.0, 2)
+    for solve in solvers():
+        with pytest.raises(MeshError, match="all-quadrilateral mesh, got triangle cells"):
+            solve(scene)
+
+
+# ---------------------------------------------------------------- geometry (API)
+
+@pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
+def test_surfaces_not_facing(solve) -> None:
+    # The top (load) face of B2 tagged as its contact face: its normal points away from B1.
+    scene = coarse_scene()
+    with pytest.raises(GeometryError, match="do not face each other.*angle of 0 degrees"):
+        solve(replace(scene, tags={**scene.tags, "contact2": scene.tags["load"]}))
+
+
+@pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
+def test_surfaces_do_not_overlap(solve) -> None:
+    scene = coarse_scene()
+    shift_body(scene, 2, 20.0, 0.0)
+    with pytest.raises(GeometryError, match="does not overlap"):
+        solve(scene)
+
+
+@pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
+def test_initial_penetration(solve) -> None:
+    scene = coarse_scene()
+    shift_body(scene, 2, 0.0, -0.01)
+    with pytest.raises(GeometryError, match=r"initial penetration 1\.000e-02 cm"):
+        solve(scene)
+
+
+def test_penetration_within_tolerance_is_accepted() -> None:
+    # A round-off-sized overlap (1e-9 of the element size) is a touching contact, not an error.
+    scene = coarse_scene()
+    shift_body(scene, 2, 0.0, -1e-9 * 0.5)
+    sol = solve_contact(scene, Method.MORTAR)
+    assert np.all(sol.active)
+
+
+# ---------------------------------------------------------------- singular systems (API)
+
+@pytest.mark.parametrize("method", ["mortar", "nts", "penalty"])
+def test_body_pulled_off_is_singular(method: str) -> None:
+    with pytest.raises(SingularSystemError, match="body 2 has no support"):
+        run_case("blocks", replace(COARSE, p=-50.0), method, comm=MPI.COMM_SELF)
+
+
+@pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
+def test_no_support_at_all(solve) -> None:
+    scene = coarse_scene()
+    with pytest.raises(SingularSystemError, match="cannot hold bodies 1 and 2"):
+        solve(replace(scene, tags={**scene.tags, "support": 9999}))
+
+
+# ---------------------------------------------------------------- solvers (API)
+
+def test_linear_solve_not_converging_reports_reason() -> None:
+    opts = {"ksp_type": "gmres", "pc_type": "none", "ksp_max_it": 5}
+    with pytest.raises(SolverError, match=r"reason -3 \(DIVERGED_MAX_IT\) after 5 iterations"):
+        run_case("blocks", COARSE, "mortar", solver=opts, comm=MPI.COMM_SELF)
+    with pytest.raises(SolverError, match=r"reason -3 \(DIVERGED_MAX_IT\) after 5 iterations"):
+        run_case("blocks", COARSE, "penalty", solver=opts, comm=MPI.COMM_SELF)
+
+
+@pytest.mark.parametrize("method", ["mortar", "penalty"])
+def test_petsc_error_becomes_solver_error(method: str) -> None:
+    with pytest.raises(SolverError, match="PETSc error 86 .*Unable to find requested KSP type"):
+        run_case("blocks", COARSE, method, solver={"ksp_type": "bogus"}, comm=MPI.COMM_SELF)
+
+
+def test_penalty_refuses_fieldsplit() -> None:
+    with pytest.raises(InputError, match="no multiplier block"):
+        run_case("blocks", COARSE, "penalty", solver="fieldsplit", comm=MPI.COMM_SELF)
+
+
+@pytest.mark.parametrize("method", ["mortar", "penalty"])
+def test_active_set_iteration_limit(method: str) -> None:
+    from contactfx.scenes import HertzParams
+
+    with pytest.raises(ActiveSetError, match="did not converge in 2 iterations"):
+        run_case("hertz", HertzParams(refine=0.1), method, max_iterations=2,
+                 comm=MPI.COMM_SELF)
+
+
+def test_every_error_is_a_contactfx_error() -> None:
+    for err in (InputError, MeshError, GeometryError, SingularSystemError, SolverError,
+                ActiveSetError):
+        assert issubclass(err, ContactFxError)
+
+
+# ---------------------------------------------------------------- the CLI
+
+S4 = ["blocks", "--preset", "S4", "--size1", "0.5", "--size2", "0.6"]
+
+
+@pytest.mark.parametrize(("args", "words"), [
+    (S4 + ["--nu1", "0.5"], "Poisson ratio must lie in (-1, 0.5) (got nu = 0.5)"),
+    (S4 + ["--nu2", "-1"], "Poisson ratio"),
+    (S4 + ["--E2", "0"], "Young's modulus must be > 0"),
+    (S4 + ["--size1", "0"], "size1 must be a positive number"),
+    (["cube"], "unknown scene 'cube'"),
+    (S4 + ["--p", "-50"], "body 2 has no support"),
+    (S4 + ["--method", "penalty", "--p", "-50"], "body 2 has no support"),
+    (S4 + ["--petsc-option", "ksp_type=gmres", "--petsc-option", "pc_type=none",
+           "--petsc-option", "ksp_max_it=5"], "PETSc reason -3 (DIVERGED_MAX_IT)"),
+    (S4 + ["--solver", "fieldsplit", "--petsc-option", "ksp_max_it=1",
+           "--petsc-option", "fieldsplit_lambda_ksp_max_it=1"], "did not converge: PETSc reason"),
+    (S4 + ["--petsc-option", "pc_type=bogus"], "PETSc error 86"),
+    (S4 + ["--method", "penalty", "--penalty", "-1"], "penalty parameter must be a positive"),
+    (S4 + ["--penalty", "1e6"], "--penalty applies to --method penalty only"),
+    (["hertz", "--refine", "0.1", "--max-iterations", "2"], "did not converge in 2 iterations"),
+])
+def test_cli_one_line_no_json(tmp_path: Path, args: list[str], words: str) -> None:
+    assert_clean_failure(tmp_path, args, words)
+
+
+def test_cli_failure_under_mpi(tmp_path: Path) -> None:
+    line = assert_clean_failure(tmp_path, S4 + ["--p", "-50"], "body 2 has no support", mpi=2)
+    assert "SingularSystemError" not in line
+
+
+def test_cli_success_writes_json(tmp_path: Path) -> None:
+    # The counterpart: the same command line with a valid pressure writes its JSON.
+    rc, err, out = cli(tmp_path, *S4, "--method", "penalty")
+    assert rc == 0, err
+    assert out.exists()

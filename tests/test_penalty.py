@@ -1,0 +1,102 @@
+"""The penalty baseline on the mortar gap: exact patch test, O(1/eps) consistency, CLI output."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import dolfinx_solver  # noqa: F401
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from contactfx.api import run_case
+from contactfx.metrics import patch_errors
+from contactfx.penalty import DEFAULT_FACTOR, penetration
+from contactfx.postprocess import body_stress_deviation
+from contactfx.scenes import BLOCK_SCENES, HertzParams
+
+S4 = replace(BLOCK_SCENES["S4"], size1=0.3, size2=0.4)
+HERTZ = HertzParams(refine=0.1)
+ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+@pytest.mark.parametrize("active", [1, 2])
+def test_patch_test_uniform_penetration(active: int) -> None:
+    # Exact solution: sigma_yy = -p everywhere, pressure p, and a uniform penetration p / eps.
+    eps = 1e7
+    sol, data = run_case("blocks", S4, "penalty", active=active, penalty=eps,
+                         comm=MPI.COMM_SELF)
+    p = S4.p
+    err = patch_errors(data["interface"], p)
+    dev = body_stress_deviation(sol, -p)
+    assert err["pressure"] < 1e-9, err
+    assert max(dev.values()) < 1e-8, dev
+    assert np.allclose(sol.gap, -p / eps, rtol=1e-8, atol=0)
+    assert data["penetration"] == pytest.approx(p / eps, rel=1e-8)
+    assert data["contact_force"] == pytest.approx(p * S4.l2 / 2, rel=1e-12)
+
+
+def test_hertz_converges_to_mortar_like_one_over_eps() -> None:
+    # The penalty solution differs from the Lagrange (mortar) one on the same mesh by O(1/eps)
+    # once the contact zone is settled: ten times eps, a tenth of the difference.
+    ref, _ = run_case("hertz", HERTZ, "mortar", comm=MPI.COMM_SELF)
+    diffs = []
+    for eps in (1e7, 1e8, 1e9):  # about 70, 700, 7000 E / h on this mesh
+        sol, data = run_case("hertz", HERTZ, "penalty", penalty=eps, comm=MPI.COMM_SELF)
+        assert data["contact_force"] == pytest.approx(HERTZ.P / 2, rel=1e-9)
+        assert np.array_equal(sol.layout.x, ref.layout.x)
+        assert np.array_equal(sol.active, ref.active)
+        diffs.append(np.max(np.abs(sol.pressure - ref.pressure)) / np.max(ref.pressure))
+        # The reported traction is the penalty force: eps times the penetration.
+        assert np.max(sol.pressure) == pytest.approx(eps * data["penetration"], rel=1e-12)
+    assert diffs[0] < 2e-2  # measured 6.3e-3 at eps = 1e7 MPa/cm
+    for coarse, fine in zip(diffs, diffs[1:], strict=False):
+        assert 8.0 < coarse / fine < 12.0, diffs
+
+
+def test_small_penalty_spreads_the_contact() -> None:
+    # A soft penalty lets the cylinder sink in: more nodes carry load, the peak drops.
+    stiff, d_stiff = run_case("hertz", HERTZ, "penalty", penalty=1e8, comm=MPI.COMM_SELF)
+    soft, d_soft = run_case("hertz", HERTZ, "penalty", penalty=1e3, comm=MPI.COMM_SELF)
+    assert soft.active.sum() > stiff.active.sum()
+    assert d_soft["hertz"]["p0"] < 0.8 * d_stiff["hertz"]["p0"]
+    assert d_soft["penetration"] > 100 * d_stiff["penetration"]
+
+
+def test_cli_json_has_penalty_and_penetration(tmp_path: Path) -> None:
+    out = tmp_path / "p.json"
+    cmd = [sys.executable, "-m", "contactfx", "solve", "blocks", "--preset", "S4", "--size1",
+           "0.3", "--size2", "0.4", "--method", "penalty", "--json", str(out), "-q"]
+    subprocess.run(cmd, check=True, env=ENV, timeout=120)
+    data = json.loads(out.read_text())
+    h = np.median(np.diff(np.sort(data["interface"]["x"])))
+    assert data["method"] == "penalty"
+    # Default: DEFAULT_FACTOR * E_max / h with h the median contact weight (= element size).
+    assert data["penalty"] == pytest.approx(DEFAULT_FACTOR * S4.E1 / h, rel=0.05)
+    assert data["penetration"] == pytest.approx(S4.p / data["penalty"], rel=1e-8)
+
+
+def test_penalty_mpi_matches_serial(tmp_path: Path) -> None:
+    args = ["-m", "contactfx", "solve", "hertz", "--refine", "0.1", "--method", "penalty",
+            "--penalty", "1e6", "-q", "--json"]
+    mpirun = str(Path(sys.executable).parent / "mpirun")
+    subprocess.run([sys.executable, *args, str(tmp_path / "s.json")], check=True, env=ENV,
+                   timeout=120)
+    subprocess.run([mpirun, "-n", "2", sys.executable, *args, str(tmp_path / "m.json")],
+                   check=True, env=ENV, timeout=300)
+    s, m = (json.loads((tmp_path / f"{k}.json").read_text()) for k in "sm")
+    assert m["ranks"] == 2
+    assert m["iterations"] == s["iterations"]
+    ps, pm = np.array(s["interface"]["pressure"]), np.array(m["interface"]["pressure"])
+    assert np.max(np.abs(ps - pm)) < 1e-8 * np.max(ps)
+    assert m["penetration"] == pytest.approx(s["penetration"], rel=1e-8)
+
+
+def test_penalty_of_default_matches_penetration_helper() -> None:
+    sol, data = run_case("blocks", S4, "penalty", comm=MPI.COMM_SELF)
+    assert penetration(sol) == data["penetration"] > 0

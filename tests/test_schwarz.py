@@ -1,0 +1,187 @@
+"""The alternating Schwarz (Dirichlet-Neumann) reference solver on the block scenes."""
+
+from __future__ import annotations
+
+import json
+import logging
+import textwrap
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from conftest import run_cli
+
+from contactfx.api import run_case
+from contactfx.errors import ConvergenceError, InputError
+from contactfx.postprocess import body_stress_deviation, u_at_points
+from contactfx.scenes import BLOCK_SCENES, build_scene
+from contactfx.schwarz import SchwarzOptions, solve_schwarz
+
+
+def _arr(data: dict, key: str) -> np.ndarray:
+    return np.array([np.nan if v is None else v for v in data["interface"][key]], dtype=float)
+
+
+@pytest.fixture(scope="module")
+def s1_pair() -> tuple[dict, dict]:
+    """S1 solved by the mortar multipliers and by Schwarz (default: Aitken from 0.5)."""
+    _, mortar = run_case("blocks", BLOCK_SCENES["S1"], "mortar")
+    _, schwarz = run_case("blocks", BLOCK_SCENES["S1"], "schwarz")
+    return mortar, schwarz
+
+
+def test_s1_agrees_with_mortar_away_from_corner(s1_pair) -> None:
+    """The paper's check: sigma_yy and pressure of Schwarz and mortar agree to 0.1 %."""
+    mortar, schwarz = s1_pair
+    x = _arr(schwarz, "x")
+    np.testing.assert_array_equal(x, _arr(mortar, "x"))
+    far = x < 0.9 * BLOCK_SCENES["S1"].l2 / 2
+    assert far.sum() >= 20
+    for key in ("pressure", "sigma_yy_1", "sigma_yy_2"):
+        a, m = _arr(schwarz, key)[far], _arr(mortar, key)[far]
+        assert np.max(np.abs(a / m - 1)) < 1e-3, key
+    # Stronger, because the Schwarz fixed point solves the mortar equations: the two agree to
+    # the iteration tolerance everywhere, the singular corner included (measured 6e-10 p).
+    p = BLOCK_SCENES["S1"].p
+    for key in ("pressure", "sigma_yy_1", "sigma_yy_2"):
+        assert np.nanmax(np.abs(_arr(schwarz, key) - _arr(mortar, key))) < 1e-7 * p, key
+
+
+def test_s1_summary_reports_iterations_and_force(s1_pair) -> None:
+    """The JSON has the Schwarz iteration count, its history and the applied load."""
+    _, schwarz = s1_pair
+    hist = schwarz["active_set"]
+    assert schwarz["method"] == "schwarz"
+    assert schwarz["iterations"] == len(hist) == 14
+    assert hist[-1]["residual"] < 1e-8 and hist[-1]["traction_change"] < 1e-8
+    assert hist[0]["relaxation"] == 0.5 and hist[0]["traction_change"] is None
+    p = BLOCK_SCENES["S1"]
+    assert schwarz["contact_force"] == pytest.approx(p.p * p.l2 / 2, rel=1e-10)
+    json.dumps(schwarz, allow_nan=False)
+
+
+@pytest.mark.parametrize("active", [2, 1])
+def test_s2_nonmatching_equals_mortar_with_b2_slave(active: int) -> None:
+    """Non-matching S2: displacements equal those of mortar with B2 active, either report."""
+    params = BLOCK_SCENES["S2"]
+    m_sol, mortar = run_case("blocks", params, "mortar", active=active)
+    ref_sol, _ = run_case("blocks", params, "mortar", active=2)
+    s_sol, schwarz = run_case("blocks", params, "schwarz", active=active)
+    u_ref, u = u_at_points(ref_sol), u_at_points(s_sol)
+    scale = np.abs(u_ref[:, 2:]).max()
+    assert np.abs(u[:, 2:] - u_ref[:, 2:]).max() < 1e-7 * scale
+    # The multipliers are reported on the scene's active body, like the other methods.
+    np.testing.assert_array_equal(_arr(schwarz, "x"), _arr(mortar, "x"))
+    assert schwarz["contact_force"] == pytest.approx(params.p * params.l2 / 2, rel=1e-10)
+    if active == 2:
+        assert np.max(np.abs(_arr(schwarz, "pressure") - _arr(mortar, "pressure"))) < 1e-6
+
+
+def test_s4_patch_test() -> None:
+    """S4 (non-matching, graded): sigma_yy = -p in every cell and pressure = p."""
+    params = BLOCK_SCENES["S4"]
+    sol, data = run_case("blocks", params, "schwarz")
+    dev = body_stress_deviation(sol, -params.p)
+    # Measured 1.3e-11 in both bodies; the iteration tolerance is 1e-8.
+    assert dev["body1"] < 1e-8 and dev["body2"] < 1e-8, dev
+    assert np.max(np.abs(_arr(data, "pressure") / params.p - 1)) < 1e-8
+    assert data["iterations"] <= 5
+
+
+def test_aitken_needs_fewer_iterations_than_fixed_relaxation() -> None:
+    """Same material (S1): Aitken 14 iterations, fixed 0.5 needs 28 (measured)."""
+    params = BLOCK_SCENES["S1"]
+    _, fixed = run_case("blocks", params, "schwarz",
+                        schwarz=SchwarzOptions(relaxation=0.5, aitken=False))
+    _, aitken = run_case("blocks", params, "schwarz")
+    assert aitken["iterations"] < 0.75 * fixed["iterations"]
+
+
+def test_no_relaxation_converges_with_the_stiffer_body_neumann() -> None:
+    """S3: B1 (Neumann side) 10x stiffer, so omega = 1 contracts (8 iterations measured)."""
+    _, data = run_case("blocks", BLOCK_SCENES["S3"], "schwarz",
+                       schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=15))
+    assert data["iterations"] <= 10
+
+
+def test_no_relaxation_same_material_fails_at_the_limit() -> None:
+    """S1 with omega = 1 stalls (eigenvalue near -1): ConvergenceError at the limit."""
+    with pytest.raises(ConvergenceError, match="did not converge in 30 iterations") as err:
+        run_case("blocks", BLOCK_SCENES["S1"], "schwarz",
+                 schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=30))
+    last = err.value.history[-1]["residual"]
+    # Measured: the relative residual stays near 3e-3 instead of falling below 1e-8.
+    assert 1e-4 < last < 1e-1
+
+
+def test_stiff_top_on_soft_base_diverges() -> None:
+    """S3 with the stiffnesses swapped (Dirichlet body 10x stiffer), omega = 1: it blows up."""
+    params = replace(BLOCK_SCENES["S3"], E1=70000.0, E2=700000.0)
+    with pytest.raises(ConvergenceError, match="diverged at iteration"):
+        run_case("blocks", params, "schwarz",
+                 schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=50))
+
+
+def test_logs_every_iteration(caplog) -> None:
+    """One INFO line per iteration with the residual and the relaxation factor."""
+    with caplog.at_level(logging.INFO, logger="contactfx"):
+        _, data = run_case("blocks", BLOCK_SCENES["S4"], "schwarz")
+    lines = [r.getMessage() for r in caplog.records if r.getMessage().startswith("schwarz ")]
+    its = [m for m in lines if "interface residual" in m and "relaxation" in m]
+    assert len(its) == data["iterations"]
+
+
+def test_hertz_is_rejected() -> None:
+    """The contact zone of Hertz is unknown: Schwarz refuses it with an InputError."""
+    scene = build_scene("blocks", BLOCK_SCENES["S1"])
+    with pytest.raises(InputError, match="full-contact block scenes only"):
+        solve_schwarz(replace(scene, name="hertz"))
+    with pytest.raises(InputError, match="relaxation"):
+        solve_schwarz(scene, SchwarzOptions(relaxation=0.0))
+
+
+def test_cli_writes_the_usual_schema(tmp_path) -> None:
+    """python -m contactfx solve blocks --method schwarz --json r.json."""
+    out = tmp_path / "r.json"
+    proc = run_cli("solve", "blocks", "--method", "schwarz", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(out.read_text())
+    for key in ("scene", "method", "params", "ranks", "dofs", "multipliers", "iterations",
+                "times", "contact_force", "interface"):
+        assert key in data
+    assert data["method"] == "schwarz" and data["iterations"] == 14
+    assert set(data["interface"]) == {"x", "pressure", "sigma_yy_1", "sigma_yy_2"}
+
+
+SCRIPT = textwrap.dedent("""
+    import sys
+    import numpy as np
+    from mpi4py import MPI
+    from contactfx.api import run_case
+    from contactfx.postprocess import u_at_points
+    from contactfx.scenes import BLOCK_SCENES
+
+    scene, active, out = sys.argv[1:4]
+    sol, data = run_case("blocks", BLOCK_SCENES[scene], "schwarz", active=int(active))
+    u = u_at_points(sol)
+    if MPI.COMM_WORLD.rank == 0:
+        np.savez(out, u=u, p=np.asarray(data["interface"]["pressure"]), ranks=data["ranks"],
+                 its=data["iterations"])
+""")
+
+
+def test_two_ranks_equal_serial(tmp_path, mpi_script) -> None:
+    """mpirun -n 2 gives the serial displacement, multipliers and iteration count."""
+    script = tmp_path / "run.py"
+    script.write_text(SCRIPT)
+    res = {}
+    for ranks in (1, 2):
+        out = tmp_path / f"r{ranks}.npz"
+        mpi_script(script, "S2", "1", str(out), ranks=ranks)
+        res[ranks] = np.load(out)
+    assert int(res[2]["ranks"]) == 2
+    assert int(res[1]["its"]) == int(res[2]["its"])
+    u1, u2 = res[1]["u"], res[2]["u"]
+    np.testing.assert_allclose(u2[:, :2], u1[:, :2], atol=1e-12)
+    assert np.abs(u2[:, 2:] - u1[:, 2:]).max() < 1e-8 * np.abs(u1[:, 2:]).max()
+    assert np.abs(res[2]["p"] - res[1]["p"]).max() < 1e-8 * np.abs(res[1]["p"]).max()
