@@ -19,15 +19,12 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from .contact import contact_operator
-from .coupling import global_dirichlet_dofs, multiplier_layout, petsc_constraint
-from .elasticity import assemble_elasticity
-from .errors import ActiveSetError, GeometryError, InputError, SingularSystemError, SolverError
+from .coupling import global_dirichlet_dofs, petsc_constraint
+from .errors import ActiveSetError, InputError, SolverError
 from .methods import Method
-from .problem import ActiveSetOptions, Solution, body_supported
+from .problem import ActiveSetOptions, Solution, _gather, prepare_contact
 from .saddle import SOLVERS, _reason_name, petsc_error_message, petsc_options, uses_augmentation
 from .scenes import Scene
-from .surfaces import check_facing, gather_surface
 from .timers import Timers
 
 log = logging.getLogger("contactfx")
@@ -39,10 +36,6 @@ DEFAULT_FACTOR = 1e3
 def default_penalty(scene: Scene, h: float) -> float:
     """The default normal stiffness eps (MPa/cm): 1e3 times the stiffer body's E over h."""
     return DEFAULT_FACTOR * max(m.E for m in scene.materials) / h
-
-
-def _gather(comm: MPI.Comm, local: np.ndarray) -> np.ndarray:
-    return np.concatenate(comm.allgather(np.asarray(local)))
 
 
 def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.ndarray,
@@ -106,43 +99,15 @@ def solve_penalty(scene: Scene, penalty: float | None = None,
                          "single-field PETSc options, not a fieldsplit")
     timers = timers or Timers()
     comm = scene.mesh.comm
-    with timers("assemble"):
-        el = assemble_elasticity(scene)
+    setup = prepare_contact(scene, Method.PENALTY.operator, aso, timers)
+    el, B, g, w, h = setup.elasticity, setup.B, setup.g, setup.w, setup.h
     V = el.V
-    ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-    with timers("search"):
-        surf_a = gather_surface(scene, V, scene.active)
-        surf_p = gather_surface(scene, V, scene.passive)
-    with timers("contact"):
-        op = contact_operator(Method.PENALTY.operator, surf_a.surface, surf_p.surface, ndofs)
-        layout, order = multiplier_layout(comm, surf_a, op)
-        if layout.size == 0:
-            raise GeometryError(f"the active surface contact{scene.active} does not overlap the "
-                                f"passive surface contact{scene.passive}")
-        check_facing(surf_a.surface, surf_p.surface, op)
-        B = petsc_constraint(V, op, order, layout, global_dirichlet_dofs(V, el.bc_dofs))
-    w_all = layout.weights
-    g_all = op.gap[order] / w_all
-    h = float(np.median(w_all))
-    if g_all.min() < -aso.penetration_tol * h:
-        j = int(np.argmin(g_all))
-        raise GeometryError(f"initial penetration {-g_all[j]:.3e} cm at x = {layout.x[j, 0]:.4g} "
-                            f"exceeds the tolerance {aso.penetration_tol * h:.1e} cm")
     eps = default_penalty(scene, h) if penalty is None else float(penalty)
     if not (np.isfinite(eps) and eps > 0):
         raise InputError(f"the penalty parameter must be a positive number (got {eps})")
-    mine = layout.mine
-    w, g = w_all[mine], op.gap[order][mine]
-    needs_contact = [b for b in (1, 2) if not body_supported(el, scene, b)]
-    if len(needs_contact) == 2:
-        raise SingularSystemError("neither body has supports in both directions: contact alone "
-                                  "cannot hold bodies 1 and 2")
-    # Start from the touching nodes; a penalty enforces g >= 0 only approximately, so a node
-    # is in contact when its gap is negative (penetration), with the same round-off margin.
-    tol = aso.penetration_tol * h
-    active = g / w <= tol
-    if needs_contact and comm.allreduce(int(active.sum())) == 0:
-        active = g / w <= g_all.min() + tol
+    # A penalty enforces g >= 0 only approximately: a node is in contact when its gap is
+    # negative (penetration), with the same round-off margin as the multiplier methods.
+    active = setup.initial_active(aso.penetration_tol * h)
     seen: set[bytes] = set()
     history: list[dict[str, float]] = []
     u = fem.Function(V, name="u")
@@ -150,10 +115,7 @@ def solve_penalty(scene: Scene, penalty: float | None = None,
     entered = left = 0
     for it in range(1, aso.max_iterations + 1):
         n_active = comm.allreduce(int(active.sum()))
-        if n_active == 0 and needs_contact:
-            raise SingularSystemError(
-                f"body {needs_contact[0]} has no support in the load direction and no node in "
-                "contact (empty active set): the load pulls the bodies apart")
+        setup.check_not_floating(n_active)
         key = _gather(comm, active).tobytes()
         if key in seen:
             raise ActiveSetError(f"active set cycles at iteration {it} ({n_active} active nodes)")
@@ -165,12 +127,7 @@ def solve_penalty(scene: Scene, penalty: float | None = None,
         t_solve = time.perf_counter() - t0
         u.x.petsc_vec.array[:] = x
         u.x.scatter_forward()
-        ub = u.x.petsc_vec.copy()
-        y = B.createVecLeft()
-        B.mult(ub, y)
-        gap_u = (g + y.array_r) / w
-        ub.destroy()
-        y.destroy()
+        gap_u = setup.normalized_gap(u)
         new_active = gap_u < 0.0
         entered = comm.allreduce(int(np.sum(new_active & ~active)))
         left = comm.allreduce(int(np.sum(active & ~new_active)))
@@ -188,12 +145,7 @@ def solve_penalty(scene: Scene, penalty: float | None = None,
     else:
         raise ActiveSetError(f"active set did not converge in {aso.max_iterations} iterations "
                              f"(last change: +{entered} -{left})")
-    B.destroy()
-    pressure = np.where(active, -eps * gap_u, 0.0)
-    return Solution(scene, Method.PENALTY, el, u, layout, pressure=_gather(comm, pressure),
-                    gap=_gather(comm, gap_u), active=_gather(comm, active), operator=op,
-                    order=order, surfaces=(surf_a, surf_p) if scene.active == 1 else
-                    (surf_p, surf_a), iterations=len(history), history=history, timers=timers)
+    return setup.solution(Method.PENALTY, u, -eps * gap_u, gap_u, active, history, timers)
 
 
 def penetration(sol: Solution) -> float:

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from .contact import ContactOperator, contact_operator
 from .coupling import Multipliers, global_dirichlet_dofs, multiplier_layout, petsc_constraint
@@ -152,18 +153,65 @@ def _gather(comm: MPI.Comm, local: np.ndarray) -> np.ndarray:
     return np.concatenate(comm.allgather(np.asarray(local)))
 
 
-def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] = "mumps",
-                  aso: ActiveSetOptions = ActiveSetOptions(),
-                  timers: Timers | None = None, reference_timing: bool = False) -> Solution:
-    """Solve the frictionless unilateral contact problem of `scene` with `method`."""
-    if method not in IMPLEMENTED:
-        raise InputError(f"method '{method.value}' is not implemented yet "
-                         f"(available: {', '.join(sorted(m.value for m in IMPLEMENTED))})")
-    if method == Method.PENALTY:
-        raise InputError("the penalty method has no multipliers: call penalty.solve_penalty "
-                         "(api.run_case does)")
-    options = SOLVERS[solver] if isinstance(solver, str) else solver
-    timers = timers or Timers()
+@dataclass
+class ContactSetup:
+    """What every contact solver needs before its first solve: K, f, B, gaps, the layout."""
+
+    scene: Scene
+    elasticity: Elasticity
+    surfaces: tuple[GatheredSurface, GatheredSurface]  # (active, passive)
+    operator: ContactOperator
+    layout: Multipliers
+    order: np.ndarray
+    B: PETSc.Mat
+    g: np.ndarray              # weighted gaps of the rows owned here
+    w: np.ndarray              # weights of the rows owned here
+    h: float                   # median contact element size (cm)
+    needs_contact: list[int]   # bodies held in the load direction only by contact
+
+    def normalized_gap(self, u: fem.Function) -> np.ndarray:
+        """Nodal gap (weighted gap / weight, cm) of the owned rows at displacement u."""
+        y = self.B.createVecLeft()
+        self.B.mult(u.x.petsc_vec, y)
+        gap = (self.g + y.array_r) / self.w
+        y.destroy()
+        return gap
+
+    def initial_active(self, tol: float) -> np.ndarray:
+        """Touching nodes; if none and a body floats, the closest node(s) as a first contact."""
+        comm = self.scene.mesh.comm
+        gap = self.g / self.w
+        active = gap <= tol
+        if self.needs_contact and comm.allreduce(int(active.sum())) == 0:
+            gmin = comm.allreduce(float(gap.min(initial=np.inf)), op=MPI.MIN)
+            active = gap <= gmin + tol
+        return active
+
+    def check_not_floating(self, n_active: int) -> None:
+        """Raise SingularSystemError if a body held only by contact has lost every contact."""
+        if n_active == 0 and self.needs_contact:
+            raise SingularSystemError(
+                f"body {self.needs_contact[0]} has no support in the load direction and no node "
+                "in contact (empty active set): the load pulls the bodies apart")
+
+    def solution(self, method: Method, u: fem.Function, pressure: np.ndarray, gap: np.ndarray,
+                 active: np.ndarray, history: list[dict[str, float]], timers: Timers
+                 ) -> Solution:
+        """Gather the owned rows into a Solution (and free B)."""
+        comm = self.scene.mesh.comm
+        self.B.destroy()
+        surf_a, surf_p = self.surfaces
+        bodies = (surf_a, surf_p) if self.scene.active == 1 else (surf_p, surf_a)
+        return Solution(self.scene, method, self.elasticity, u, self.layout,
+                        pressure=_gather(comm, np.where(active, pressure, 0.0)),
+                        gap=_gather(comm, gap), active=_gather(comm, active),
+                        operator=self.operator, order=self.order, surfaces=bodies,
+                        iterations=len(history), history=history, timers=timers)
+
+
+def prepare_contact(scene: Scene, operator: str, aso: ActiveSetOptions,
+                    timers: Timers) -> ContactSetup:
+    """Assemble K and f, gather the surfaces, build B and check the geometry."""
     comm = scene.mesh.comm
     with timers("assemble"):
         el = assemble_elasticity(scene)
@@ -173,7 +221,7 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
         surf_a = gather_surface(scene, V, scene.active)
         surf_p = gather_surface(scene, V, scene.passive)
     with timers("contact"):
-        op = contact_operator(method.operator, surf_a.surface, surf_p.surface, ndofs)
+        op = contact_operator(operator, surf_a.surface, surf_p.surface, ndofs)
         layout, order = multiplier_layout(comm, surf_a, op)
         if layout.size == 0:
             raise GeometryError(f"the active surface contact{scene.active} does not overlap the "
@@ -187,20 +235,35 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
         j = int(np.argmin(g_all))
         raise GeometryError(f"initial penetration {-g_all[j]:.3e} cm at x = {layout.x[j, 0]:.4g} "
                             f"exceeds the tolerance {aso.penetration_tol * h:.1e} cm")
-    mine = layout.mine
-    w, g = w_all[mine], op.gap[order][mine]
-    e_max = max(m.E for m in scene.materials)
-    c = e_max / h
-    gamma = e_max / h**2 if uses_augmentation(options) else 0.0
     needs_contact = [b for b in (1, 2) if not body_supported(el, scene, b)]
     if len(needs_contact) == 2:
         raise SingularSystemError("neither body has supports in both directions: contact alone "
                                   "cannot hold bodies 1 and 2")
+    mine = layout.mine
+    return ContactSetup(scene, el, (surf_a, surf_p), op, layout, order, B,
+                        op.gap[order][mine], w_all[mine], h, needs_contact)
 
-    active = g / w <= aso.penetration_tol * h
-    if needs_contact and comm.allreduce(int(active.sum())) == 0 and layout.size:
-        # A body held only by contact needs a first contact point: take the closest node(s).
-        active = g / w <= g_all.min() + aso.penetration_tol * h
+
+def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] = "mumps",
+                  aso: ActiveSetOptions = ActiveSetOptions(),
+                  timers: Timers | None = None, reference_timing: bool = False) -> Solution:
+    """Solve the frictionless unilateral contact problem of `scene` with `method`."""
+    if method not in IMPLEMENTED:
+        raise InputError(f"method '{method.value}' is not implemented yet "
+                         f"(available: {', '.join(sorted(m.value for m in IMPLEMENTED))})")
+    if method == Method.PENALTY:
+        raise InputError("the penalty method has no multipliers: call penalty.solve_penalty "
+                         "(api.run_case does)")
+    options = SOLVERS[solver] if isinstance(solver, str) else solver
+    timers = timers or Timers()
+    comm = scene.mesh.comm
+    setup = prepare_contact(scene, method.operator, aso, timers)
+    el, B, g, w, h = setup.elasticity, setup.B, setup.g, setup.w, setup.h
+    V, layout, mine = el.V, setup.layout, setup.layout.mine
+    e_max = max(m.E for m in scene.materials)
+    c = e_max / h
+    gamma = e_max / h**2 if uses_augmentation(options) else 0.0
+    active = setup.initial_active(aso.penetration_tol * h)
     direct = options.get("ksp_type") == "preonly"
     state = _ActiveSet(comm, mine, layout.size)
     history: list[dict[str, float]] = []
@@ -212,10 +275,7 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
     converged = False
     for it in range(1, aso.max_iterations + 1):
         n_active = comm.allreduce(int(active.sum()))
-        if n_active == 0 and needs_contact:
-            raise SingularSystemError(
-                f"body {needs_contact[0]} has no support in the load direction and no node in "
-                "contact (empty active set): the load pulls the bodies apart")
+        setup.check_not_floating(n_active)
         state.visit(active, it, n_active, probe is not None)
         probes = None if probe is None else state.probe_rhs(probe)
         t0 = time.perf_counter()
@@ -225,12 +285,7 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
         u.x.petsc_vec.array[:] = res.u
         u.x.scatter_forward()
         lam = -res.mu
-        ub = u.x.petsc_vec.copy()
-        y = B.createVecLeft()
-        B.mult(ub, y)
-        gap_u = (g + y.array_r) / w
-        ub.destroy()
-        y.destroy()
+        gap_u = setup.normalized_gap(u)
         # Semi-smooth Newton on min(lambda, c g): with the active gaps solved exactly, c only
         # scales the test, so the update is lambda > 0 on active, penetration on inactive.
         new_active = lam - c * gap_u > 0
@@ -283,9 +338,4 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
         # The cost floor: one fresh solve of the final system by the same solver.
         _, timers.seconds["reference_solve"] = reference_solve(el.K, B, el.f, g, active,
                                                               options, gamma, nullspace)
-    B.destroy()
-    return Solution(scene, method, el, u, layout,
-                    pressure=_gather(comm, np.where(active, lam, 0.0)),
-                    gap=_gather(comm, gap_u), active=_gather(comm, active), operator=op,
-                    order=order, surfaces=(surf_a, surf_p) if scene.active == 1 else
-                    (surf_p, surf_a), iterations=len(history), history=history, timers=timers)
+    return setup.solution(method, u, lam, gap_u, active, history, timers)
