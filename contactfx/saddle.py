@@ -24,11 +24,15 @@ from petsc4py import PETSc
 from .errors import SolverError
 
 SOLVERS: dict[str, dict[str, object]] = {
-    # MUMPS LU directly on the MatNest (PETSc converts it): the robust reference.
+    # MUMPS LU directly on the MatNest (PETSc converts it): the robust reference. PORD
+    # ordering: MUMPS' METIS analysis (sequential) took half of a 1M-dof solve, 4.0 of 7.5 s;
+    # PORD's took 1.3 s for the same factorization time (4.7 s in all; 13.8 s instead of
+    # 18.7 s at 2M dofs, 10.0 s instead of 16.5 s on 2 ranks). benchmarks/README.md.
     "mumps": {
         "ksp_type": "preonly",
         "pc_type": "lu",
         "pc_factor_mat_solver_type": "mumps",
+        "mat_mumps_icntl_7": 4,
     },
     # Schur-complement fieldsplit, A00 = K + gamma B^T B factorized by MUMPS, S by Jacobi-GMRES.
     "fieldsplit": {
@@ -43,6 +47,7 @@ SOLVERS: dict[str, dict[str, object]] = {
         "fieldsplit_u_ksp_type": "preonly",
         "fieldsplit_u_pc_type": "lu",
         "fieldsplit_u_pc_factor_mat_solver_type": "mumps",
+        "fieldsplit_u_mat_mumps_icntl_7": 4,
         "fieldsplit_lambda_ksp_type": "gmres",
         "fieldsplit_lambda_ksp_rtol": 1e-12,
         "fieldsplit_lambda_ksp_max_it": 500,
@@ -64,7 +69,9 @@ SOLVERS: dict[str, dict[str, object]] = {
         "fieldsplit_u_pc_type": "gamg",
         "fieldsplit_u_pc_gamg_threshold": 0.01,
         "fieldsplit_u_pc_gamg_reuse_interpolation": True,
-        "fieldsplit_u_mg_levels_ksp_max_it": 2,
+        # SOR smoothing: stretched cells of graded meshes defeat Chebyshev/Jacobi (measured on
+        # the structured Hertz mesh, 115k dofs: 236 outer iterations with it, 50 with SOR).
+        "fieldsplit_u_mg_levels_pc_type": "sor",
         "fieldsplit_lambda_ksp_type": "preonly",
         "fieldsplit_lambda_pc_type": "jacobi",
     },
@@ -73,6 +80,8 @@ SOLVERS: dict[str, dict[str, object]] = {
 _counter = itertools.count()
 # Largest set of released rows solved by a capacitance system instead of a refactorization.
 _MAX_RELEASED = 2000
+# Entries per rank of one dense block of probe right-hand sides (8 bytes each).
+_PROBE_ENTRIES = 64_000_000
 
 
 @contextmanager
@@ -121,14 +130,14 @@ def _diagonal_matrix(comm, values: np.ndarray, offset: int) -> PETSc.Mat:
     return C
 
 
-def schur_al_diagonal(active: np.ndarray, gamma: float) -> np.ndarray:
-    """Diagonal of the Schur preconditioner: -1/gamma on active rows, 1 on the others.
+def schur_al_diagonal(active: np.ndarray, gamma: float, inactive: float = 1.0) -> np.ndarray:
+    """Diagonal of the Schur preconditioner: -1/gamma on active rows, C's entry on the others.
 
     With A00 = K + gamma B^T B the exact identity S^-1 = -(gamma I + (B K^-1 B^T)^-1) holds on
     the active rows; gamma = E/h^2 bounds the second term by gamma times a constant of order
     one at every mesh size, so -I/gamma preconditions S with mesh-independent quality.
     """
-    return np.where(active, -1.0 / gamma, 1.0)
+    return np.where(active, -1.0 / gamma, inactive)
 
 
 class SaddleSolver:
@@ -154,7 +163,8 @@ class SaddleSolver:
         B.transpose(self._BT)
         self._BA = B.copy()
         self._BAT = self._BT.copy()
-        self._C = _diagonal_matrix(comm, np.ones(m), r0)
+        self._c_inactive = _inactive_scale(K, B)
+        self._C = _diagonal_matrix(comm, np.full(m, self._c_inactive), r0)
         self._owned: list[PETSc.Object] = [self._act, self._BT, self._BA, self._BAT, self._C]
         self._A00 = K
         if gamma > 0.0:
@@ -184,7 +194,15 @@ class SaddleSolver:
             self._is_u.compose("nearnullspace", nullspace)
         self._prefix = f"contactfx_{next(_counter)}_"
         self._db = PETSc.Options()
-        for key, value in self.options.items():
+        self._db_keys = dict(self.options)
+        if self.reuse:
+            # GMRES around the LU: one iteration with a fresh factorization, a few with a
+            # lagged one (the change is low-rank); right preconditioning tests the true
+            # residual, modified Gram-Schmidt keeps the basis orthogonal down to round-off.
+            self._db_keys.update({"ksp_type": "gmres", "ksp_pc_side": "right", "ksp_rtol": 1e-13,
+                                  "ksp_atol": 0.0, "ksp_max_it": 120, "ksp_gmres_restart": 120,
+                                  "ksp_gmres_modifiedgramschmidt": True})
+        for key, value in self._db_keys.items():
             self._db[self._prefix + key] = value
         self._ksp = PETSc.KSP().create(comm)
         self._ksp.setOptionsPrefix(self._prefix)
@@ -205,7 +223,7 @@ class SaddleSolver:
 
     def destroy(self) -> None:
         """Free the PETSc objects and remove this solver's options from the database."""
-        for key in self.options:
+        for key in self._db_keys:
             self._db.delValue(self._prefix + key)
         self._ksp.destroy()
         for obj in self._owned:
@@ -221,7 +239,7 @@ class SaddleSolver:
         self._BT.copy(self._BAT, structure=same)
         self._BAT.diagonalScale(R=self._act)
         diag = self._act.duplicate()
-        diag.array[:] = np.where(active, 0.0, 1.0)
+        diag.array[:] = np.where(active, 0.0, self._c_inactive)
         self._C.setDiagonal(diag)
         self._f.copy(self._rhs_u)
         if self.gamma > 0.0:
@@ -237,7 +255,8 @@ class SaddleSolver:
             self._rhs_u.axpy(1.0, tmp)
             tmp.destroy()
         if self._Sp is not None:
-            diag.array[:] = schur_al_diagonal(active, self.gamma) if self.gamma > 0 else 1.0
+            diag.array[:] = (schur_al_diagonal(active, self.gamma, self._c_inactive)
+                             if self.gamma > 0 else self._c_inactive)
             self._Sp.setDiagonal(diag)
         diag.destroy()
         self._A.assemble()
@@ -258,14 +277,7 @@ class SaddleSolver:
         ksp.setFromOptions()
         if self._Sp is not None:
             pc.setFieldSplitSchurPreType(PETSc.PC.FieldSplitSchurPreType.USER, self._Sp)
-        if self.reuse:
-            # GMRES around the LU: one iteration with a fresh factorization, a few with a
-            # lagged one; right preconditioning tests the true residual.
-            ksp.setType("gmres")
-            ksp.setPCSide(PETSc.PC.Side.RIGHT)
-            ksp.setTolerances(rtol=1e-13, atol=0.0, max_it=120)
-            ksp.setGMRESRestart(120)
-        else:
+        if not self.reuse:
             ksp.setInitialGuessNonzero(not self.direct)
         self._ready = True
 
@@ -423,28 +435,23 @@ class SaddleSolver:
         rows_u = self._is_u.getIndices() - start
         rows_l = self._is_l.getIndices() - start
         nloc = self._b.getLocalSize()
-        rhs = np.zeros((nloc, k))
-        rhs[rows_l] = gp
-        if self.gamma > 0.0:
-            tmp_l, tmp_u = self._act.duplicate(), self._rhs_u.duplicate()
-            for j in range(k):
-                tmp_l.array[:] = self.gamma * gp[:, j]
-                self._BAT.mult(tmp_l, tmp_u)
-                rhs[rows_u, j] = tmp_u.array_r
-            tmp_l.destroy()
-            tmp_u.destroy()
+        # Dense blocks of at most ~_PROBE_ENTRIES entries per rank: the right-hand sides and
+        # solutions are (dofs x columns), gigabytes for a million dofs and 400 probes at once.
+        chunk = max(1, min(k, _PROBE_ENTRIES // max(self._mpi.allreduce(nloc, op=MPI.MAX), 1)))
+        tmp_l, tmp_u = self._act.duplicate(), self._rhs_u.duplicate()
+        for lo in range(0, k, chunk):
+            cols = range(lo, min(lo + chunk, k))
+            rhs = np.zeros((nloc, len(cols)))
+            rhs[rows_l] = gp[:, cols]
+            if self.gamma > 0.0:
+                for c, j in enumerate(cols):
+                    tmp_l.array[:] = self.gamma * gp[:, j]
+                    self._BAT.mult(tmp_l, tmp_u)
+                    rhs[rows_u, c] = tmp_u.array_r
+            out[:, cols] = self._apply_inverse(rhs)[rows_l]
+        tmp_l.destroy()
+        tmp_u.destroy()
         if self.direct:
-            # The factorization is exact here: one multi-right-hand-side MUMPS solve.
-            size = ((nloc, PETSc.DETERMINE), (PETSc.DECIDE, k))
-            Bd = PETSc.Mat().createDense(size, comm=self._comm)
-            Bd.setUp()
-            Bd.getDenseArray()[:] = rhs
-            Bd.assemble()
-            Xd = Bd.duplicate()
-            self._ksp.getPC().matApply(Bd, Xd)
-            out[:] = Xd.getDenseArray()[rows_l]
-            Bd.destroy()
-            Xd.destroy()
             # Keep the responses: a later subset of this set is then solved without refactoring.
             r0 = self._B.getOwnershipRange()[0]
             nz = gp != 0.0
@@ -453,16 +460,51 @@ class SaddleSolver:
             self._mpi.Allreduce(MPI.IN_PLACE, col_row, op=MPI.MAX)
             order = np.argsort(col_row)
             self._cache = (self.stats["factorizations"], col_row[order], out[:, order])
-            return out
+        return out
+
+    def _apply_inverse(self, rhs: np.ndarray) -> np.ndarray:
+        """Solutions (local rows x columns) for dense right-hand sides, current operator."""
+        if self.direct:
+            # The factorization is exact here: one multi-right-hand-side MUMPS solve.
+            size = ((rhs.shape[0], PETSc.DETERMINE), (PETSc.DECIDE, rhs.shape[1]))
+            Bd = PETSc.Mat().createDense(size, comm=self._comm)
+            Bd.setUp()
+            Bd.getDenseArray()[:] = rhs
+            Bd.assemble()
+            Xd = Bd.duplicate()
+            self._ksp.getPC().matApply(Bd, Xd)
+            sol = Xd.getDenseArray().copy()
+            Bd.destroy()
+            Xd.destroy()
+            return sol
+        sol = np.zeros_like(rhs)
         b, x = self._b.duplicate(), self._x.duplicate()
-        for j in range(k):
+        for j in range(rhs.shape[1]):
             b.array[:] = rhs[:, j]
             x.set(0.0)
             self._ksp.solve(b, x)
-            out[:, j] = x.array_r[rows_l]
+            sol[:, j] = x.array_r
         b.destroy()
         x.destroy()
-        return out
+        return sol
+
+
+def _inactive_scale(K: PETSc.Mat, B: PETSc.Mat) -> float:
+    """C's entry on inactive rows (which only say mu = 0): the scale of B K^-1 B^T, negative.
+
+    Any nonzero value gives the same solution, but 1 next to Schur entries of order
+    |B_j|^2 / K_jj (1e-8 and less) leaves eigenvalues that far apart, and GMRES on a lagged
+    factorization then stagnates at the factorization's round-off.
+    """
+    comm = K.getComm().tompi4py()
+    _, _, vals = B.getValuesCSR()
+    indptr = B.getValuesCSR()[0]
+    rows = np.add.reduceat(vals**2, indptr[:-1]) if len(vals) else np.zeros(0)
+    rows = rows[np.diff(indptr) > 0]
+    diag = np.abs(K.getDiagonal().array_r)
+    b2 = comm.allreduce(float(rows.sum())) / max(comm.allreduce(len(rows)), 1)
+    kd = comm.allreduce(float(diag.sum())) / max(comm.allreduce(len(diag)), 1)
+    return -b2 / kd if b2 > 0.0 and kd > 0.0 else 1.0
 
 
 def solve_saddle(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, active: np.ndarray,

@@ -7,12 +7,9 @@ import json
 import math
 import textwrap
 
-import dolfinx.fem.petsc
 import numpy as np
 import pytest
-import ufl
 from conftest import run_cli
-from dolfinx import fem
 from mpi4py import MPI
 
 from contactfx.contact import contact_operator
@@ -46,15 +43,20 @@ def hertz_system():
 
 
 def _close(res, ref) -> None:
-    """u and mu of two saddle-point solves agree to a 1e-9 relative round-off bound."""
-    assert np.abs(res.u - ref.u).max() <= 1e-9 * np.abs(ref.u).max()
-    assert np.abs(res.mu - ref.mu).max() <= 1e-9 * np.abs(ref.mu).max()
+    """u and mu of two saddle-point solves agree to 1e-8 relative.
+
+    GMRES on a lagged factorization stops at a relative residual of 1e-13; the saddle-point
+    matrix amplifies that by its condition number (about 1e5 here) in the multipliers.
+    """
+    du = np.abs(res.u - ref.u).max() / np.abs(ref.u).max()
+    dmu = np.abs(res.mu - ref.mu).max() / np.abs(ref.mu).max()
+    assert du <= 1e-8 and dmu <= 1e-8, (du, dmu)
 
 
 def test_persistent_solver_equals_fresh_solves(hertz_system) -> None:
     """Every reuse path (refactor, lagged LU + GMRES, released-row capacitance) is exact."""
     el, B, g, x = hertz_system
-    sets = [x < 1.0, x < 2.0, x < 1.5, (x < 1.5) | ((x > 1.7) & (x < 1.9)), x < 1.45]
+    sets = [x < 1.0, x < 1.3, x < 1.2, (x < 1.1) | ((x > 1.4) & (x < 1.5)), x < 0.9]
     with SaddleSolver(el.K, B, el.f, {"ksp_type": "preonly", "pc_type": "lu",
                                        "pc_factor_mat_solver_type": "mumps"}) as solver:
         solver.policy = "reuse"
@@ -66,9 +68,9 @@ def test_persistent_solver_equals_fresh_solves(hertz_system) -> None:
             paths.append("released" if "released" in res.info else
                          "factorized" if res.info["refactored"] else "lagged")
         assert solver.stats["factorizations"] == 1
-    # The factorized set stays x < 1: every later set adds rows to it, so GMRES runs on the
-    # lagged factorization (a low-rank change) and must still reach the fresh answer.
-    assert paths == ["factorized"] + ["lagged"] * (len(sets) - 1)
+    # The factorized set stays x < 1: the next three add rows to it, so GMRES runs on the
+    # lagged factorization (a low-rank change); the last only releases rows (capacitance).
+    assert paths == ["factorized", "lagged", "lagged", "lagged", "released"]
 
 
 def test_released_rows_use_capacitance(hertz_system) -> None:
@@ -86,6 +88,10 @@ def test_released_rows_use_capacitance(hertz_system) -> None:
 
 def test_near_nullspace_is_the_kernel_of_free_bodies() -> None:
     """The six rigid-body modes are orthonormal and K v = 0 without Dirichlet rows."""
+    import dolfinx.fem.petsc  # after contactfx, which loads MPI first
+    import ufl
+    from dolfinx import fem
+
     scene = build_scene("blocks", BLOCK_SCENES["S1"])
     V = fem.functionspace(scene.mesh, ("Lagrange", 1, (2,)))
     E, nu = material_fields(scene)
@@ -144,10 +150,14 @@ def test_graded_points_follow_the_size_law() -> None:
     s = graded_points(10.0, 0.01, 1.0, 0.2, 0.5)
     h = np.diff(s)
     assert s[0] == 0.0 and s[-1] == 10.0 and np.all(h > 0)
-    assert np.allclose(h[s[1:] <= 1.0], 0.01, rtol=1e-6)
-    assert h.max() <= 0.5 * (1 + 1e-6)
+    # Rounding the cell count to an integer scales every size by at most 1 +- 1/(2 n).
+    slack = 0.5 / len(h)
+    fine = h[s[1:] <= 1.0]
+    assert np.ptp(fine) < 1e-12 and abs(fine[0] / 0.01 - 1.0) <= slack
+    assert h.max() <= 0.5 * (1 + slack)
     grow = h[1:] / h[:-1]
-    assert grow.max() < 1.0 + 0.2 * 1.01
+    # dh/ds = slope with ds = h per cell: neighbouring sizes grow by exp(slope) at most.
+    assert grow.min() > 1.0 - 1e-9 and grow.max() <= np.exp(0.2) * (1 + 1e-9)
 
 
 def test_structured_hertz_geometry_and_contact() -> None:
