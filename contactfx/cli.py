@@ -31,6 +31,9 @@ def parser() -> argparse.ArgumentParser:
     for key in sorted(set(BLOCK_KEYS) | set(HERTZ_KEYS)):
         s.add_argument(f"--{key.replace('_', '-')}", dest=key, type=float, default=None,
                        help=f"scene parameter {key}")
+    s.add_argument("--mesh", choices=["gmsh", "structured"], default=None,
+                   help="hertz only: gmsh graded quads (default) or a structured graded mesh "
+                        "built in DOLFINx (fast to make for millions of DOFs)")
     s.add_argument("--method", default="nts", choices=[m.value for m in Method])
     s.add_argument("--active", type=int, default=2, choices=[1, 2],
                    help="which body is active (slave, carries the multipliers)")
@@ -65,6 +68,10 @@ def scene_params(args: argparse.Namespace):
     else:
         raise InputError(f"unknown scene '{args.scene}' (choose blocks or hertz)")
     given = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    if args.mesh is not None:
+        if args.scene != "hertz":
+            raise InputError("option --mesh applies to the hertz scene only")
+        given["mesh"] = args.mesh
     unused = [k for k in set(BLOCK_KEYS) | set(HERTZ_KEYS)
               if k not in keys and getattr(args, k) is not None]
     if unused:

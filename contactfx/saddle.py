@@ -455,7 +455,9 @@ class SaddleSolver:
             # Keep the responses: a later subset of this set is then solved without refactoring.
             r0 = self._B.getOwnershipRange()[0]
             nz = gp != 0.0
-            col_row = np.where(nz.any(axis=0), r0 + np.argmax(nz, axis=0), -1)
+            # A rank may own no multiplier row: argmax of an empty axis is undefined there.
+            first = np.argmax(nz, axis=0) if nz.shape[0] else np.zeros(k, dtype=np.int64)
+            col_row = np.where(nz.any(axis=0), r0 + first, -1)
             col_row = col_row.astype(np.int64)
             self._mpi.Allreduce(MPI.IN_PLACE, col_row, op=MPI.MAX)
             order = np.argsort(col_row)

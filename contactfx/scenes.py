@@ -60,7 +60,10 @@ class HertzParams:
     slope: float = 0.1          # growth of the element size per unit distance
     width: float = 60.0
     height: float = 60.0
+    mesh: str = "gmsh"          # "gmsh" (graded unstructured quads) or "structured" (large runs)
 
+
+MESHERS = ("gmsh", "structured")
 
 BLOCK_SCENES: dict[str, BlockParams] = {
     "S1": BlockParams(),
@@ -109,6 +112,8 @@ def validate(params: BlockParams | HertzParams) -> None:
     else:
         if params.refine > params.R / 10:
             raise InputError(f"refine = {params.refine} is too coarse for R = {params.R}")
+        if params.mesh not in MESHERS:
+            raise InputError(f"unknown mesh '{params.mesh}' (choose {' or '.join(MESHERS)})")
         if params.r_refine < 0:
             raise InputError(f"r_refine must be >= 0 (got {params.r_refine})")
         if not (math.isfinite(params.refine_edge) and params.refine_edge >= 0):
@@ -157,6 +162,11 @@ def build_scene(kind: str, params: BlockParams | HertzParams, active: int = 2,
             build_blocks(p.l1, p.l2, p.h1, p.h2, p.size1, p.size2, p.grading1, p.grading2)
 
         pressure = p.p
+    elif kind == "hertz" and isinstance(params, HertzParams) and params.mesh == "structured":
+        # Built directly in DOLFINx: gmsh's quad mesher is too slow for millions of DOFs.
+        from meshes.hertz_structured import hertz_structured_scene
+
+        return hertz_structured_scene(params, comm, slope=params.slope, active=active)
     elif kind == "hertz":
         assert isinstance(params, HertzParams)
         exact = hertz_exact(params)

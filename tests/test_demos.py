@@ -20,7 +20,7 @@ def test_demo(demo: Path, ranks: int, tmp_path: Path) -> None:
     cmd = [sys.executable, str(demo)]
     if ranks > 1:
         cmd = [MPIRUN, "-n", str(ranks), sys.executable, "-m", "mpi4py", str(demo)]
-    proc = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=180)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
 
 
