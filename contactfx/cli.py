@@ -19,6 +19,31 @@ HERTZ_KEYS = ("R", "P", "E1", "E2", "nu1", "nu2", "refine", "r_refine", "refine_
               "width", "height")
 
 
+PARAM_HELP = {
+    "l1": "blocks: full width of the base B1 (cm, default 10)",
+    "l2": "blocks: full width of the top block B2 (cm, default 6)",
+    "h1": "blocks: height of B1 (cm, default 3)",
+    "h2": "blocks: height of B2 (cm, default 3)",
+    "E1": "Young's modulus of body 1 (MPa; blocks 70000, hertz 7000)",
+    "E2": "Young's modulus of body 2 (MPa; blocks 70000, hertz 7000)",
+    "nu1": "Poisson ratio of body 1 (blocks 0.3, hertz 0.23)",
+    "nu2": "Poisson ratio of body 2 (blocks 0.3, hertz 0.23)",
+    "p": "blocks: pressure on the top of B2 (MPa, default 50)",
+    "size1": "blocks: element size in B1 (cm, default 0.125)",
+    "size2": "blocks: element size in B2 (cm, default 0.125)",
+    "grading1": "blocks: element-size ratio of neighbours along x in B1 (1 = uniform)",
+    "grading2": "blocks: element-size ratio of neighbours along x in B2 (1 = uniform)",
+    "R": "hertz: cylinder radius (cm, default 60)",
+    "P": "hertz: load per unit thickness, full model (MPa*cm, default 100)",
+    "refine": "hertz: element size on the contact zone (cm, default 0.02)",
+    "r_refine": "hertz: extent of the refined zone (cm; default 1.4 x Hertz's a)",
+    "refine_edge": "hertz, gmsh mesh: element size at the edge of contact (cm, 0 = off)",
+    "slope": "hertz: growth of the element size per cm of distance (default 0.1)",
+    "width": "hertz: half width of the block (cm, default 60)",
+    "height": "hertz: height of the block (cm, default 60)",
+}
+
+
 def parser() -> argparse.ArgumentParser:
     """The argument parser (defaults of scene parameters are the paper's, filled in later)."""
     ap = argparse.ArgumentParser(prog="python -m contactfx",
@@ -30,7 +55,7 @@ def parser() -> argparse.ArgumentParser:
                    help="block scene of the paper to start from (other options override it)")
     for key in sorted(set(BLOCK_KEYS) | set(HERTZ_KEYS)):
         s.add_argument(f"--{key.replace('_', '-')}", dest=key, type=float, default=None,
-                       help=f"scene parameter {key}")
+                       help=PARAM_HELP.get(key, key))
     s.add_argument("--mesh", choices=["gmsh", "structured"], default=None,
                    help="hertz only: gmsh graded quads (default) or a structured graded mesh "
                         "built in DOLFINx (fast to make for millions of DOFs)")
