@@ -62,13 +62,20 @@ def test_bad_input_one_line_no_traceback(tmp_path, args: list[str], needle: str)
     assert not out.exists()
 
 
-def test_unbuilt_method_is_refused_clearly(tmp_path) -> None:
-    """A method that is not implemented yet says so, rather than failing later."""
-    from contactfx.methods import IMPLEMENTED, Method
+def test_hertz_structured_mesh_from_the_cli(tmp_path) -> None:
+    """`--mesh structured` builds the Hertz scene in DOLFINx and lands near the exact a."""
+    out = tmp_path / "h.json"
+    proc = run_cli("solve", "hertz", "--mesh", "structured", "--refine", "0.04", "--method",
+                   "mortar", "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(out.read_text())
+    assert data["params"]["mesh"] == "structured"
+    hz = data["hertz"]
+    assert abs(hz["a"] / hz["a_exact"] - 1) < 0.03
+    assert data["contact_force"] == pytest.approx(50.0, rel=1e-9)
 
-    missing = [m for m in Method if m not in IMPLEMENTED]
-    if not missing:
-        pytest.skip("every method is implemented")
-    proc = run_cli("solve", "blocks", "--method", missing[0].value, "--json",
-                   str(tmp_path / "r.json"))
-    assert proc.returncode == 2 and "not implemented" in proc.stderr
+
+def test_mesh_option_is_hertz_only(tmp_path) -> None:
+    """--mesh on the blocks scene is refused with one line."""
+    proc = run_cli("solve", "blocks", "--mesh", "structured", "--json", str(tmp_path / "r.json"))
+    assert proc.returncode == 2 and "hertz scene only" in proc.stderr
