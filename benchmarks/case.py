@@ -14,6 +14,7 @@ import time
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 from mpi4py import MPI
 
+from contactfx.api import COARSE_FACTOR, coarse_params, coarse_prediction, use_coarse
 from contactfx.methods import Method
 from contactfx.problem import ActiveSetOptions, solve_contact
 from contactfx.saddle import SOLVERS
@@ -43,6 +44,9 @@ def main() -> None:
     ap.add_argument("--h-far", type=float, required=True, help="largest element size (cm)")
     ap.add_argument("--option", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--no-reference", action="store_true")
+    ap.add_argument("--predictor", default="auto", choices=("auto", "coarse", "none"),
+                    help="first active set from a solve with 4x coarser sizes (timed as "
+                    "'predictor', part of the contact solve); auto: above 200k dofs, direct")
     ap.add_argument("--fixed-set", action="store_true",
                     help="no active-set loop: one fresh solve with the Hertz zone x < a active "
                     "(the iterative path's scaling of linear iterations)")
@@ -68,8 +72,14 @@ def main() -> None:
         if comm.rank == 0:
             print("RESULT " + json.dumps(record), flush=True)
         return
+    init = None
+    if use_coarse(args.predictor, scene, options):
+        with timers("predictor"):
+            coarse = hertz_structured_scene(coarse_params(scene.params), comm,
+                                            h_far=COARSE_FACTOR * args.h_far)
+            init = coarse_prediction(coarse, Method(args.method), options)
     sol = solve_contact(scene, Method(args.method), options, ActiveSetOptions(), timers,
-                        reference_timing=not args.no_reference)
+                        reference_timing=not args.no_reference, initial_active=init)
     comm.Barrier()
     total = time.perf_counter() - t0
     V = sol.elasticity.V
@@ -78,7 +88,7 @@ def main() -> None:
     times["total"] = total
     record = {
         "method": args.method, "solver": args.solver, "ranks": comm.size,
-        "refine": args.refine, "h_far": args.h_far,
+        "refine": args.refine, "h_far": args.h_far, "predictor": "predictor" in times,
         "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
         "multipliers": int(sol.layout.size), "active_nodes": int(sol.active.sum()),
         "iterations": sol.iterations, "times": times, "peak_rss_mb": rss,

@@ -72,6 +72,9 @@ def parser() -> argparse.ArgumentParser:
                    help="penalty normal stiffness in MPa/cm (pressure = EPS * penetration) for "
                    "--method penalty; default 1e3 * max(E1, E2) / h, h the median contact "
                    "element size")
+    s.add_argument("--predictor", choices=["auto", "coarse", "none"], default="auto",
+                   help="first active set from a coarser solve of the same scene: auto = hertz "
+                        "with a direct solver above 200k DOFs (the answer does not depend on it)")
     s.add_argument("--reference-timing", action="store_true",
                    help="also time a fresh solve of the final saddle-point system (the cost "
                    "floor) and report it as times.reference_solve")
@@ -129,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--penalty applies to --method penalty only")
     sol, data = run_case(args.scene, params, method, args.active, options,
                          args.max_iterations, comm, penalty=args.penalty,
-                         reference_timing=args.reference_timing)
+                         reference_timing=args.reference_timing, predictor=args.predictor)
     data["solver"] = args.solver
     if args.out is not None:
         write_fields(sol, args.out)

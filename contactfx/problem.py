@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -56,6 +57,47 @@ class ActiveSetOptions:
     max_probes: int = 2000         # largest candidate set probed
 
 
+@dataclass(frozen=True)
+class InitialSet:
+    """A first active set by position: `active(x)` in contact, `uncertain(x)` worth probing.
+
+    Both map (n, 2) node coordinates to (n,) bools. A superset of the converged set makes the
+    loop factorize once and then only release rows (solved without refactoring); probing only
+    the uncertain band keeps the multi-right-hand-side solve small.
+    """
+
+    active: Callable[[np.ndarray], np.ndarray]
+    uncertain: Callable[[np.ndarray], np.ndarray] | None = None
+
+
+def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0
+                       ) -> InitialSet:
+    """An InitialSet from the solution of the same scene on a coarser mesh.
+
+    In contact: nodes within `margin` coarse elements of a coarse active node; uncertain:
+    those within `band` coarse elements of a coarse inactive node (the zone's edge, wider
+    inwards: a coarse node-to-segment zone overshoots the fine one by up to two elements).
+    The coarse element size is the largest node spacing in the coarse contact zone.
+    """
+    from scipy.spatial import cKDTree
+
+    x = np.asarray(coarse.layout.x)[:, :2]
+    act = np.asarray(coarse.active, dtype=bool)
+    if not act.any():
+        return InitialSet(lambda p: np.zeros(len(p), dtype=bool))
+    spacing = cKDTree(x).query(x[act], k=2)[0][:, 1] if len(x) > 1 else np.zeros(1)
+    r = margin * float(spacing.max())
+    tree_a = cKDTree(x[act])
+    tree_i = cKDTree(x[~act]) if (~act).any() else None
+
+    def near(tree: cKDTree | None, p: np.ndarray, d: float) -> np.ndarray:
+        if tree is None or len(p) == 0:
+            return np.zeros(len(p), dtype=bool)
+        return tree.query(np.asarray(p)[:, :2], distance_upper_bound=d * (1 + 1e-9))[0] <= d
+
+    return InitialSet(lambda p: near(tree_a, p, r), lambda p: near(tree_i, p, r * band / margin))
+
+
 def body_supported(el: Elasticity, scene: Scene, body: int) -> bool:
     """True if `body` has Dirichlet conditions on both displacement components."""
     msh = el.V.mesh
@@ -103,8 +145,12 @@ class _ActiveSet:
         rhs[rows, np.searchsorted(probe, self.mine[rows])] = 1.0
         return rhs
 
-    def predict(self, probe: np.ndarray, lam: np.ndarray, dmu: np.ndarray) -> np.ndarray | None:
-        """Active set (local mask) solving the complementarity problem restricted to `probe`."""
+    def predict(self, probe: np.ndarray, lam: np.ndarray, dmu: np.ndarray,
+                active: np.ndarray) -> np.ndarray | None:
+        """Active set (local mask) solving the complementarity problem restricted to `probe`.
+
+        Rows of `active` (local mask) outside `probe` stay as they are.
+        """
         lam0 = self.to_global(lam)[probe]
         # Column j: change of the tractions when the weighted gap of candidate j opens by 1.
         kq = -self.to_global(dmu)[probe]
@@ -112,7 +158,8 @@ class _ActiveSet:
         act = lcp_active_set(kq, lam0)
         if act is None:
             return None
-        mask = np.zeros(self.size, dtype=bool)
+        mask = self.to_global(np.asarray(active, dtype=bool))
+        mask[probe] = False
         mask[probe[act]] = True
         return mask[self.mine]
 
@@ -246,8 +293,14 @@ def prepare_contact(scene: Scene, operator: str, aso: ActiveSetOptions,
 
 def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] = "mumps",
                   aso: ActiveSetOptions = ActiveSetOptions(),
-                  timers: Timers | None = None, reference_timing: bool = False) -> Solution:
-    """Solve the frictionless unilateral contact problem of `scene` with `method`."""
+                  timers: Timers | None = None, reference_timing: bool = False,
+                  initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None
+                  ) -> Solution:
+    """Solve the frictionless unilateral contact problem of `scene` with `method`.
+
+    `initial_active` (node coordinates -> bool, or an InitialSet) adds nodes to the first
+    active set; only the loop's cost depends on it, never the converged solution.
+    """
     if method not in IMPLEMENTED:
         raise InputError(f"method '{method.value}' is not implemented yet "
                          f"(available: {', '.join(sorted(m.value for m in IMPLEMENTED))})")
@@ -269,6 +322,17 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
     history: list[dict[str, float]] = []
     u = fem.Function(V, name="u")
     probe: np.ndarray | None = None   # global indices of the candidate set being probed
+    band = np.zeros(len(mine), dtype=bool)  # rows whose status the initial set is unsure of
+    if initial_active is not None:
+        guess = (initial_active if isinstance(initial_active, InitialSet)
+                 else InitialSet(initial_active))
+        x_mine = layout.x[mine]
+        active = active | np.asarray(guess.active(x_mine), dtype=bool)
+        if guess.uncertain is not None and aso.predictor and direct:
+            # Probe only the band where the guess is unsure: the rest of it stays in contact.
+            band = np.asarray(guess.uncertain(x_mine), dtype=bool)
+            if 0 < comm.allreduce(int((active & band).sum())) <= aso.max_probes:
+                probe = state.global_indices(active & band)
     # One solver for the whole loop: fixed matrix pattern, reused analysis and factorization.
     nullspace = near_nullspace(V, scene) if uses_augmentation(options) else None
     solver = SaddleSolver(el.K, B, el.f, options, gamma, nullspace)
@@ -311,22 +375,26 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
             converged = True
             break
         if probe is not None:
-            # The set probed holds every candidate: the small complementarity problem on it
-            # predicts the converged set; the next solve checks it like any other iterate.
-            predicted = state.predict(probe, lam, res.info["probes"])
+            # The set probed holds every candidate (rows outside it keep their status): the
+            # small complementarity problem on it predicts the converged set; the next solve
+            # checks it like any other iterate.
+            predicted = state.predict(probe, lam, res.info["probes"], active)
             probe = None
             if predicted is not None and not np.array_equal(predicted, active):
                 active = predicted
                 continue
-        elif aso.predictor and direct:
+        elif aso.predictor and direct and not (entered == 0 and initial_active is not None):
             # Probe the union of the current and the updated set: on the Hertz scene the plain
             # update adds every penetrating node and then drops one or two edge nodes per
             # iteration; one multi-right-hand-side solve replaces those iterations. If nodes
-            # only leave, the union is the current set, solved again with probes.
+            # only leave, the union is the current set, solved again with probes. (Not after
+            # a given first set, a superset: releasing rows costs two back-substitutions.)
             union = active | new_active
+            # After a given first set only its uncertain band and the rows that change.
+            cand = union if initial_active is None else union & (band | (new_active != active))
             n_new = comm.allreduce(int(new_active.sum()))
-            if 0 < n_new and comm.allreduce(int(union.sum())) <= aso.max_probes:
-                probe = state.global_indices(union)
+            if 0 < n_new and comm.allreduce(int(cand.sum())) <= aso.max_probes:
+                probe = state.global_indices(cand)
                 active = union
                 continue
         active = new_active

@@ -212,3 +212,64 @@ def test_structured_hertz_two_ranks_equal_serial(tmp_path, mpi_script, solver) -
     np.testing.assert_allclose(r2["x"], r1["x"], atol=1e-12)
     tol = 1e-8 if solver == "mumps" else 1e-5
     assert np.abs(r2["p"] - r1["p"]).max() <= tol * np.abs(r1["p"]).max()
+
+
+@pytest.fixture(scope="module")
+def structured_pair():
+    """A structured Hertz scene (70k dofs, 58 active nodes) and the same scene 8x coarser."""
+    fine = hertz_structured_scene(HertzParams(refine=0.025), h_far=1.0)
+    coarse = hertz_structured_scene(HertzParams(refine=0.2), h_far=8.0)
+    return fine, coarse
+
+
+@pytest.mark.parametrize("method", [Method.MORTAR, Method.NTS, Method.STS])
+def test_coarse_predictor_same_answer_one_factorization(structured_pair, method) -> None:
+    """A coarse solve's zone as the first set: the same converged set and fields, one LU."""
+    from contactfx.problem import coarse_initial_set
+
+    fine, coarse = structured_pair
+    plain = solve_contact(fine, method, "mumps")
+    init = coarse_initial_set(solve_contact(coarse, method, "mumps"))
+    sol = solve_contact(fine, method, "mumps", initial_active=init)
+    assert np.array_equal(sol.active, plain.active)
+    p_max = np.abs(plain.pressure).max()
+    assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max
+    du = np.abs(sol.u.x.array - plain.u.x.array).max()
+    assert du <= 1e-8 * np.abs(plain.u.x.array).max()
+    # The cost: one factorization (plain: two), band probes only, at most two solves.
+    assert sum(h["factorized"] for h in sol.history) == 1
+    assert sum(h["factorized"] for h in plain.history) >= 2
+    assert sol.iterations <= 2
+    probes = sum(h["probes"] for h in sol.history)
+    assert 0 < probes < int(sol.active.sum()) / 2, probes
+
+
+@pytest.mark.parametrize("guess", ["inside", "far", "nothing"])
+def test_any_initial_set_converges_to_the_same_answer(structured_pair, guess) -> None:
+    """A wrong first set (a subset, a wide superset, empty) costs iterations, not accuracy."""
+    fine, _ = structured_pair
+    a = fine.extra["hertz_exact"]["a"]
+    radius = {"inside": 0.5 * a, "far": 3.0 * a, "nothing": -1.0}[guess]
+    plain = solve_contact(fine, Method.MORTAR, "mumps")
+    sol = solve_contact(fine, Method.MORTAR, "mumps",
+                        initial_active=lambda x: x[:, 0] <= radius)
+    assert np.array_equal(sol.active, plain.active)
+    p_max = np.abs(plain.pressure).max()
+    assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max
+
+
+def test_run_case_coarse_predictor() -> None:
+    """run_case's coarse predictor: timed apart, same contact zone and force as without it."""
+    from contactfx.api import run_case, use_coarse
+
+    params = HertzParams(refine=0.025, mesh="structured")
+    base, s_base = run_case("hertz", params, "mortar", predictor="none")
+    sol, s = run_case("hertz", params, "mortar", predictor="coarse")
+    assert "predictor" in s["times"] and "predictor" not in s_base["times"]
+    assert np.array_equal(sol.active, base.active)
+    assert np.abs(sol.pressure - base.pressure).max() <= 1e-8 * np.abs(base.pressure).max()
+    assert sum(h["factorized"] for h in sol.history) == 1
+    # "auto" leaves small meshes and iterative solvers alone.
+    assert not use_coarse("auto", sol.scene, {"ksp_type": "preonly", "pc_type": "lu"})
+    with pytest.raises(ValueError):
+        use_coarse("sometimes", sol.scene, {})
