@@ -45,7 +45,7 @@ def main() -> None:
     ap.add_argument("--option", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--no-reference", action="store_true")
     ap.add_argument("--predictor", default="auto", choices=("auto", "coarse", "none"),
-                    help="first active set from a solve with 4x coarser sizes (timed as "
+                    help="first active set from a solve with 8x coarser sizes (timed as "
                     "'predictor', part of the contact solve); auto: above 200k dofs, direct")
     ap.add_argument("--fixed-set", action="store_true",
                     help="no active-set loop: one fresh solve with the Hertz zone x < a active "
@@ -103,35 +103,23 @@ def main() -> None:
 
 def fixed_set_solve(scene, method: Method, options: dict, timers: Timers) -> dict:
     """Assemble, search, build B, then one fresh solve with x < a (Hertz) active."""
-    import numpy as np
-
-    from contactfx.contact import contact_operator
-    from contactfx.coupling import global_dirichlet_dofs, multiplier_layout, petsc_constraint
-    from contactfx.elasticity import assemble_elasticity
     from contactfx.nullspace import near_nullspace
+    from contactfx.problem import ActiveSetOptions, prepare_contact
     from contactfx.saddle import reference_solve, uses_augmentation
-    from contactfx.surfaces import gather_surface
 
     comm = scene.mesh.comm
-    with timers("assemble"):
-        el = assemble_elasticity(scene)
+    setup = prepare_contact(scene, method.operator, ActiveSetOptions(), timers)
+    el, layout = setup.elasticity, setup.layout
     V = el.V
-    ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-    with timers("search"):
-        sa = gather_surface(scene, V, scene.active)
-        sp = gather_surface(scene, V, scene.passive)
-    with timers("contact"):
-        op = contact_operator(method.operator, sa.surface, sp.surface, ndofs)
-        layout, order = multiplier_layout(comm, sa, op)
-        B = petsc_constraint(V, op, order, layout, global_dirichlet_dofs(V, el.bc_dofs))
-    h = float(np.median(layout.weights))
-    gamma = max(m.E for m in scene.materials) / h**2 if uses_augmentation(options) else 0.0
+    gamma = (max(m.E for m in scene.materials) / setup.h**2 if uses_augmentation(options)
+             else 0.0)
     active = layout.x[layout.mine, 0] < scene.extra["hertz_exact"]["a"]
     nsp = near_nullspace(V, scene) if uses_augmentation(options) else None
-    res, seconds = reference_solve(el.K, B, el.f, op.gap[order][layout.mine], active, options,
-                                   gamma, nsp)
+    res, seconds = reference_solve(el.K, setup.B, el.f, setup.g, active, options, gamma, nsp)
+    setup.B.destroy()
     timers.seconds["reference_solve"] = seconds
-    return {"dofs": ndofs, "multipliers": int(layout.size),
+    return {"dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+            "multipliers": int(layout.size),
             "active_nodes": comm.allreduce(int(active.sum())), "iterations": 1,
             "linear_iterations": res.iterations}
 
