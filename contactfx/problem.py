@@ -256,17 +256,24 @@ class ContactSetup:
                         iterations=len(history), history=history, timers=timers)
 
 
-def prepare_contact(scene: Scene, operator: str, aso: ActiveSetOptions,
-                    timers: Timers) -> ContactSetup:
-    """Assemble K and f, gather the surfaces, build B and check the geometry."""
-    comm = scene.mesh.comm
+def assemble_and_gather(scene: Scene, bodies: tuple[int, int], timers: Timers
+                        ) -> tuple[Elasticity, int, GatheredSurface, GatheredSurface]:
+    """Assemble K and f, and gather the contact surfaces of `bodies` (in that order)."""
     with timers("assemble"):
         el = assemble_elasticity(scene)
     V = el.V
     ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
     with timers("search"):
-        surf_a = gather_surface(scene, V, scene.active)
-        surf_p = gather_surface(scene, V, scene.passive)
+        first, second = (gather_surface(scene, V, body) for body in bodies)
+    return el, ndofs, first, second
+
+
+def prepare_contact(scene: Scene, operator: str, aso: ActiveSetOptions,
+                    timers: Timers) -> ContactSetup:
+    """Assemble K and f, gather the surfaces, build B and check the geometry."""
+    comm = scene.mesh.comm
+    el, ndofs, surf_a, surf_p = assemble_and_gather(scene, (scene.active, scene.passive), timers)
+    V = el.V
     with timers("contact"):
         op = contact_operator(operator, surf_a.surface, surf_p.surface, ndofs)
         layout, order = multiplier_layout(comm, surf_a, op)

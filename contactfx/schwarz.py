@@ -26,12 +26,12 @@ from petsc4py import PETSc
 from .contact import contact_operator
 from .contact.mortar import mortar_matrices
 from .coupling import multiplier_layout
-from .elasticity import Elasticity, assemble_elasticity
+from .elasticity import Elasticity
 from .errors import ConvergenceError, GeometryError, InputError, MeshError, SolverError
 from .methods import Method
-from .problem import Solution
+from .problem import Solution, assemble_and_gather
 from .scenes import Scene
-from .surfaces import GatheredSurface, gather_surface
+from .surfaces import GatheredSurface
 from .timers import Timers
 
 log = logging.getLogger("contactfx")
@@ -159,13 +159,8 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         raise InputError(f"relaxation must lie in (0, 2] (got {options.relaxation})")
     timers = timers or Timers()
     comm = scene.mesh.comm
-    with timers("assemble"):
-        el = assemble_elasticity(scene)
+    el, ndofs, surf1, surf2 = assemble_and_gather(scene, (1, 2), timers)
     V = el.V
-    ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-    with timers("search"):
-        surf1 = gather_surface(scene, V, 1)
-        surf2 = gather_surface(scene, V, 2)
     _check_flat(surf1, surf2)
     with timers("contact"):
         # Transfer pair: B2 (the Dirichlet body) is the mortar slave, whatever scene.active is.
