@@ -55,6 +55,13 @@ def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
         vals = np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
         ax.plot(x, vals, style, label=label)
     ax.plot(x, -np.asarray(itf["pressure"]), ":", label="-pressure (multipliers)")
+    if "hertz" in data:
+        # Zoom on the contact zone and show the exact plane-strain Hertz profile.
+        a, p0 = data["hertz"]["a_exact"], data["hertz"]["p0_exact"]
+        xs = np.linspace(0.0, 2.0 * a, 400)
+        ax.plot(xs, -p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0.0, None)), "k-", lw=0.8,
+                alpha=0.6, label="-pressure, exact 2D Hertz")
+        ax.set_xlim(0.0, 2.0 * a)
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("MPa")
     ax.set_title(title or f"{data['scene']} / {data['method']}: contact line")
