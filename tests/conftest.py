@@ -7,7 +7,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from contactfx.contact import Surface
 
 ROOT = Path(__file__).resolve().parents[1]
 MPIRUN = str(Path(sys.executable).parent / "mpirun")
@@ -38,3 +41,15 @@ def run_mpi_script(script: Path, *args: str, ranks: int = 2,
 def mpi_script():
     """The run_mpi_script helper as a fixture."""
     return run_mpi_script
+
+
+def polyline(x: np.ndarray, y: np.ndarray, normal_up: bool, dof0: int) -> Surface:
+    """Surface through (x, y) in order; normals point to +y (lower body) or -y (upper body)."""
+    pts = np.column_stack([x, y]).astype(float)
+    n = len(pts)
+    seg = np.column_stack([np.arange(n - 1), np.arange(1, n)])
+    t = pts[seg[:, 1]] - pts[seg[:, 0]]
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    nrm = np.column_stack([-t[:, 1], t[:, 0]])
+    nrm *= (np.sign(nrm[:, 1]) * (1.0 if normal_up else -1.0))[:, None]
+    return Surface(pts, seg, nrm, dof0 + 2 * np.arange(n)[:, None] + np.arange(2))

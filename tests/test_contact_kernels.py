@@ -2,24 +2,12 @@
 
 import numpy as np
 import pytest
+from conftest import polyline
 
 from contactfx.contact import OPERATORS, ContactOperator, Surface, contact_operator
 from contactfx.contact.mortar import mortar_matrices, subsegments
 
 METHODS = sorted(OPERATORS)
-
-
-def polyline(x: np.ndarray, y: np.ndarray, normal_up: bool, dof0: int) -> Surface:
-    """Surface through (x, y) in order; normals point to +y (lower body) or -y (upper body)."""
-    pts = np.column_stack([x, y]).astype(float)
-    n = len(pts)
-    seg = np.column_stack([np.arange(n - 1), np.arange(1, n)])
-    t = pts[seg[:, 1]] - pts[seg[:, 0]]
-    t /= np.linalg.norm(t, axis=1)[:, None]
-    nrm = np.column_stack([-t[:, 1], t[:, 0]])
-    nrm *= (np.sign(nrm[:, 1]) * (1.0 if normal_up else -1.0))[:, None]
-    dofs = dof0 + 2 * np.arange(n)[:, None] + np.arange(2)
-    return Surface(pts, seg, nrm, dofs)
 
 
 def pair(xp, yp, xa, ya) -> tuple[Surface, Surface, int]:

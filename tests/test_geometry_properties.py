@@ -1,6 +1,7 @@
 """Property tests of the contact geometry and operators on random polylines (hypothesis)."""
 
 import numpy as np
+from conftest import polyline
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -9,18 +10,6 @@ from contactfx.contact.geometry import nodal_normals, project
 from contactfx.contact.mortar import mortar_matrices, subsegments
 
 FAST = settings(max_examples=40, deadline=None)
-
-
-def polyline(x: np.ndarray, y: np.ndarray, normal_up: bool, dof0: int) -> Surface:
-    """Surface through (x, y) in order; normals point to +y (lower body) or -y (upper body)."""
-    pts = np.column_stack([x, y])
-    n = len(pts)
-    seg = np.column_stack([np.arange(n - 1), np.arange(1, n)])
-    t = pts[seg[:, 1]] - pts[seg[:, 0]]
-    t /= np.linalg.norm(t, axis=1)[:, None]
-    nrm = np.column_stack([-t[:, 1], t[:, 0]])
-    nrm *= (np.sign(nrm[:, 1]) * (1.0 if normal_up else -1.0))[:, None]
-    return Surface(pts, seg, nrm, dof0 + 2 * np.arange(n)[:, None] + np.arange(2))
 
 
 def random_line(rng: np.random.Generator, n: int, x0: float, wiggle: float) -> tuple:
