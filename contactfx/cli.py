@@ -12,6 +12,7 @@ import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 
 from .errors import ContactFxError
 from .methods import Method
+from .scenes import BlockParams, HertzParams
 
 BLOCK_KEYS = ("l1", "l2", "h1", "h2", "E1", "E2", "nu1", "nu2", "p", "size1", "size2",
               "grading1", "grading2")
@@ -82,10 +83,10 @@ def parser() -> argparse.ArgumentParser:
     return ap
 
 
-def scene_params(args: argparse.Namespace):
+def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
     """Scene parameters from the paper's defaults, a preset, and the options given."""
     from .errors import InputError
-    from .scenes import BLOCK_SCENES, BlockParams, HertzParams
+    from .scenes import BLOCK_SCENES
 
     if args.scene == "blocks":
         base, keys = BLOCK_SCENES[args.preset or "S1"], BLOCK_KEYS

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import dolfinx.mesh
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
@@ -86,7 +87,7 @@ def gather_surface(scene: Scene, V: fem.FunctionSpace, body: int) -> GatheredSur
     return GatheredSurface(surface, own[first], uniq)
 
 
-def vertex_coordinates(msh) -> np.ndarray:
+def vertex_coordinates(msh: dolfinx.mesh.Mesh) -> np.ndarray:
     """Coordinates (x, y) of every local vertex."""
     tdim = msh.topology.dim
     nv = msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts

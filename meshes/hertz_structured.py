@@ -13,7 +13,9 @@ scaling study needs. Far from the contact the cells are stretched (up to h_far/h
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import basix.ufl
 import numpy as np
@@ -22,6 +24,9 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from contactfx.errors import InputError
+
+if TYPE_CHECKING:
+    from contactfx.scenes import HertzParams, Scene
 
 # Physical groups, numbered like the gmsh scene's names (the numbers themselves are free).
 TAGS = {"body1": 1, "body2": 2, "contact1": 3, "contact2": 4, "symmetry": 5, "support": 6,
@@ -141,7 +146,7 @@ def hertz_grid(R: float, width: float, height: float, h_contact: float, r_refine
 def build_hertz_structured(comm: MPI.Comm, R: float, width: float, height: float,
                            h_contact: float, r_refine: float, h_far: float | None = None,
                            slope: float = 0.1, contact_extent: float | None = None,
-                           partitioner=None) -> StructuredMesh:
+                           partitioner: Callable | None = None) -> StructuredMesh:
     """The Hertz half model (quarter disc on a block) as a distributed structured quad mesh."""
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
@@ -191,8 +196,9 @@ def build_hertz_structured(comm: MPI.Comm, R: float, width: float, height: float
     return StructuredMesh(msh, cell_tags, facet_tags, dict(TAGS))
 
 
-def hertz_structured_scene(params, comm: MPI.Comm = MPI.COMM_WORLD, h_far: float | None = None,
-                           slope: float = 0.1, active: int = 2):
+def hertz_structured_scene(params: HertzParams, comm: MPI.Comm = MPI.COMM_WORLD,
+                           h_far: float | None = None, slope: float = 0.1,
+                           active: int = 2) -> Scene:
     """A contactfx Scene of `params` (HertzParams) on the structured mesh (refine = h_contact)."""
     from dataclasses import replace
 
