@@ -46,7 +46,7 @@ def main() -> None:
     ap.add_argument("--no-reference", action="store_true")
     ap.add_argument("--predictor", default="auto", choices=("auto", "coarse", "none"),
                     help="first active set from a solve with 8x coarser sizes (timed as "
-                    "'predictor', part of the contact solve); auto: above 200k dofs, direct")
+                    "'predictor', part of the contact solve); auto: above 200k dofs")
     ap.add_argument("--fixed-set", action="store_true",
                     help="no active-set loop: one fresh solve with the Hertz zone x < a active "
                     "(the iterative path's scaling of linear iterations)")

@@ -75,7 +75,7 @@ def parser() -> argparse.ArgumentParser:
                    "element size")
     s.add_argument("--predictor", choices=["auto", "coarse", "none"], default="auto",
                    help="first active set from a coarser solve of the same scene: auto = hertz "
-                        "with a direct solver above 200k DOFs (the answer does not depend on it)")
+                        "above 200k DOFs (the answer does not depend on it)")
     s.add_argument("--reference-timing", action="store_true",
                    help="also time a fresh solve of the final saddle-point system (the cost "
                    "floor) and report it as times.reference_solve")

@@ -269,7 +269,7 @@ def test_run_case_coarse_predictor() -> None:
     assert np.array_equal(sol.active, base.active)
     assert np.abs(sol.pressure - base.pressure).max() <= 1e-8 * np.abs(base.pressure).max()
     assert sum(h["factorized"] for h in sol.history) == 1
-    # "auto" leaves small meshes and iterative solvers alone.
+    # "auto" leaves small meshes alone.
     assert not use_coarse("auto", sol.scene, {"ksp_type": "preonly", "pc_type": "lu"})
     with pytest.raises(ValueError):
         use_coarse("sometimes", sol.scene, {})
