@@ -19,11 +19,6 @@ class Material:
     E: float
     nu: float
 
-    def lame(self) -> tuple[float, float]:
-        """Return the Lame parameters (lambda, mu) in plane strain."""
-        lmbda = self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
-        return lmbda, self.E / (2 * (1 + self.nu))
-
 
 @dataclass(frozen=True)
 class BlockParams:

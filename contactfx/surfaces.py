@@ -7,7 +7,6 @@ from dataclasses import dataclass
 import dolfinx.mesh
 import numpy as np
 from dolfinx import fem
-from mpi4py import MPI
 
 from .contact import ContactOperator, Surface
 from .contact.geometry import nodal_normals, project, segment_lengths
@@ -98,11 +97,6 @@ def vertex_coordinates(msh: dolfinx.mesh.Mesh) -> np.ndarray:
     # Q1 geometry: the cell's geometry nodes are its vertices, in the same order.
     xv[c2v.ravel()] = msh.geometry.x[geo[: c2v.shape[0]].ravel(), :2]
     return xv
-
-
-def comm_sum(comm: MPI.Comm, value: float) -> float:
-    """Sum a float over all ranks."""
-    return comm.allreduce(value, op=MPI.SUM)
 
 
 def check_facing(active: Surface, passive: Surface, op: ContactOperator) -> None:
