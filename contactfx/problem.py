@@ -18,7 +18,7 @@ from .elasticity import Elasticity, assemble_elasticity
 from .errors import ActiveSetError, GeometryError, InputError, SingularSystemError
 from .methods import IMPLEMENTED, Method
 from .nullspace import near_nullspace
-from .saddle import SOLVERS, SaddleSolver, reference_solve, uses_augmentation
+from .saddle import SOLVERS, SaddleSolver, is_direct, reference_solve, uses_augmentation
 from .scenes import Scene
 from .surfaces import GatheredSurface, check_facing, gather_surface
 from .timers import Timers
@@ -324,7 +324,8 @@ def solve_contact(scene: Scene, method: Method, solver: str | dict[str, object] 
     c = e_max / h
     gamma = e_max / h**2 if uses_augmentation(options) else 0.0
     active = setup.initial_active(aso.penetration_tol * h)
-    direct = options.get("ksp_type") == "preonly"
+    # Probes need the exact inverse: only a factorization of the whole saddle point gives it.
+    direct = is_direct(options)
     state = _ActiveSet(comm, mine, layout.size)
     history: list[dict[str, float]] = []
     u = fem.Function(V, name="u")

@@ -438,19 +438,14 @@ class SaddleSolver:
         # Dense blocks of at most ~_PROBE_ENTRIES entries per rank: the right-hand sides and
         # solutions are (dofs x columns), gigabytes for a million dofs and 400 probes at once.
         chunk = max(1, min(k, _PROBE_ENTRIES // max(self._mpi.allreduce(nloc, op=MPI.MAX), 1)))
-        tmp_l, tmp_u = self._act.duplicate(), self._rhs_u.duplicate()
         for lo in range(0, k, chunk):
-            cols = range(lo, min(lo + chunk, k))
-            rhs = np.zeros((nloc, len(cols)))
+            cols = slice(lo, min(lo + chunk, k))
+            rhs = np.zeros((nloc, cols.stop - lo))
             rhs[rows_l] = gp[:, cols]
             if self.gamma > 0.0:
-                for c, j in enumerate(cols):
-                    tmp_l.array[:] = self.gamma * gp[:, j]
-                    self._BAT.mult(tmp_l, tmp_u)
-                    rhs[rows_u, c] = tmp_u.array_r
+                # The augmented block's right-hand side gamma B^T g, all columns in one product.
+                rhs[rows_u] = self._dense_product(self._BAT, self.gamma * gp[:, cols])
             out[:, cols] = self._apply_inverse(rhs)[rows_l]
-        tmp_l.destroy()
-        tmp_u.destroy()
         if self.direct:
             # Keep the responses: a later subset of this set is then solved without refactoring.
             r0 = self._B.getOwnershipRange()[0]
@@ -462,6 +457,19 @@ class SaddleSolver:
             self._mpi.Allreduce(MPI.IN_PLACE, col_row, op=MPI.MAX)
             order = np.argsort(col_row)
             self._cache = (self.stats["factorizations"], col_row[order], out[:, order])
+        return out
+
+    def _dense_product(self, A: PETSc.Mat, local: np.ndarray) -> np.ndarray:
+        """Local rows of A @ X for a dense X given by its local rows (one sparse-dense product)."""
+        size = ((local.shape[0], PETSc.DETERMINE), (PETSc.DECIDE, local.shape[1]))
+        X = PETSc.Mat().createDense(size, comm=self._comm)
+        X.setUp()
+        X.getDenseArray()[:] = local
+        X.assemble()
+        Y = A.matMult(X)
+        out = Y.getDenseArray().copy()
+        X.destroy()
+        Y.destroy()
         return out
 
     def _apply_inverse(self, rhs: np.ndarray) -> np.ndarray:

@@ -12,15 +12,13 @@ import pytest
 from conftest import run_cli
 from mpi4py import MPI
 
-from contactfx.contact import contact_operator
-from contactfx.coupling import global_dirichlet_dofs, multiplier_layout, petsc_constraint
-from contactfx.elasticity import assemble_elasticity, material_fields, sigma
+from contactfx.elasticity import material_fields, sigma
 from contactfx.methods import Method
 from contactfx.nullspace import rigid_body_modes
-from contactfx.problem import solve_contact
+from contactfx.problem import ActiveSetOptions, prepare_contact, solve_contact
 from contactfx.saddle import SaddleSolver, solve_saddle
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene
-from contactfx.surfaces import gather_surface
+from contactfx.timers import Timers
 from meshes.hertz_structured import graded_points, hertz_grid, hertz_structured_scene
 
 
@@ -28,18 +26,9 @@ from meshes.hertz_structured import graded_points, hertz_grid, hertz_structured_
 def hertz_system():
     """K, B, f and the weighted gaps of the default Hertz scene with mortar (small)."""
     scene = build_scene("hertz", HertzParams())
-    el = assemble_elasticity(scene)
-    V = el.V
-    ndofs = V.dofmap.index_map.size_global * 2
-    surf_a = gather_surface(scene, V, scene.active)
-    surf_p = gather_surface(scene, V, scene.passive)
-    op = contact_operator("mortar", surf_a.surface, surf_p.surface, ndofs)
-    layout, order = multiplier_layout(MPI.COMM_WORLD, surf_a, op)
-    B = petsc_constraint(V, op, order, layout, global_dirichlet_dofs(V, el.bc_dofs))
-    g = op.gap[order][layout.mine]
-    x = layout.x[layout.mine, 0]
-    yield el, B, g, x
-    B.destroy()
+    setup = prepare_contact(scene, "mortar", ActiveSetOptions(), Timers())
+    yield setup.elasticity, setup.B, setup.g, setup.layout.x[setup.layout.mine, 0]
+    setup.B.destroy()
 
 
 def _close(res, ref) -> None:
@@ -51,6 +40,22 @@ def _close(res, ref) -> None:
     du = np.abs(res.u - ref.u).max() / np.abs(ref.u).max()
     dmu = np.abs(res.mu - ref.mu).max() / np.abs(ref.mu).max()
     assert du <= 1e-8 and dmu <= 1e-8, (du, dmu)
+
+
+def test_probe_responses_do_not_depend_on_augmentation(hertz_system) -> None:
+    """Probe responses with A00 = K + gamma B^T B equal those of the plain saddle point."""
+    el, B, g, x = hertz_system
+    active = x < 1.2
+    probes = np.zeros((len(x), 3))
+    rows = np.flatnonzero(active)[:3]
+    probes[rows, np.arange(len(rows))] = 1.0
+    mumps = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+    out = []
+    for gamma in (0.0, 7000.0 / 0.02**2):
+        with SaddleSolver(el.K, B, el.f, mumps, gamma) as solver:
+            out.append(solver.solve(g, active, probes).info["probes"])
+    scale = np.abs(out[0]).max()
+    assert scale > 0 and np.abs(out[1] - out[0]).max() <= 1e-8 * scale
 
 
 def test_persistent_solver_equals_fresh_solves(hertz_system) -> None:
