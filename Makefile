@@ -27,6 +27,8 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m ruff check contactfx meshes tests demos benchmarks
+	$(PY) -m ruff format --check contactfx meshes tests demos benchmarks
+	$(PY) -m mypy
 	$(PY) -m pytest -q tests
 
 bench: $(STAMP)

@@ -14,13 +14,12 @@ import time
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 from mpi4py import MPI
 
-from contactfx.api import COARSE_FACTOR, coarse_params, coarse_prediction, use_coarse
+from contactfx.api import COARSE_FACTOR, coarse_prediction, use_coarse
 from contactfx.methods import Method
 from contactfx.problem import ActiveSetOptions, solve_contact
-from contactfx.saddle import SOLVERS
-from contactfx.scenes import HertzParams
+from contactfx.scenes import HertzParams, hertz
+from contactfx.solvers import SOLVERS
 from contactfx.timers import Timers
-from meshes.hertz_structured import hertz_structured_scene
 
 
 def peak_rss_mb() -> float:
@@ -60,7 +59,8 @@ def main() -> None:
     comm.Barrier()
     t0 = time.perf_counter()
     with timers("mesh"):
-        scene = hertz_structured_scene(HertzParams(refine=args.refine), comm, h_far=args.h_far)
+        scene = hertz(HertzParams(refine=args.refine, h_far=args.h_far, mesh="structured"),
+                      comm=comm)
     if args.fixed_set:
         record = fixed_set_solve(scene, Method(args.method), options, timers)
         comm.Barrier()
@@ -75,8 +75,7 @@ def main() -> None:
     init = None
     if use_coarse(args.predictor, scene, options):
         with timers("predictor"):
-            coarse = hertz_structured_scene(coarse_params(scene.params), comm,
-                                            h_far=COARSE_FACTOR * args.h_far)
+            coarse = scene.resize(COARSE_FACTOR)
             init = coarse_prediction(coarse, Method(args.method), options)
     sol = solve_contact(scene, Method(args.method), options, ActiveSetOptions(), timers,
                         reference_timing=not args.no_reference, initial_active=init)
@@ -95,7 +94,7 @@ def main() -> None:
         "history": [{k: (float(v) if not isinstance(v, int) else v) for k, v in h.items()}
                     for h in sol.history],
         "contact_force_error": abs(float((sol.pressure * sol.layout.weights).sum())
-                                   - scene.params.P / 2) / (scene.params.P / 2),
+                                   - scene.params["P"] / 2) / (scene.params["P"] / 2),
     }
     if comm.rank == 0:
         print("RESULT " + json.dumps(record), flush=True)
@@ -104,16 +103,18 @@ def main() -> None:
 def fixed_set_solve(scene, method: Method, options: dict, timers: Timers) -> dict:
     """Assemble, search, build B, then one fresh solve with x < a (Hertz) active."""
     from contactfx.nullspace import near_nullspace
-    from contactfx.problem import ActiveSetOptions, prepare_contact
-    from contactfx.saddle import reference_solve, uses_augmentation
+    from contactfx.prepare import prepare_contact
+    from contactfx.problem import ActiveSetOptions
+    from contactfx.saddle import reference_solve
+    from contactfx.solvers import uses_augmentation
 
     comm = scene.mesh.comm
-    setup = prepare_contact(scene, method.operator, ActiveSetOptions(), timers)
+    setup = prepare_contact(scene, method.operator, ActiveSetOptions().penetration_tol, timers)
     el, layout = setup.elasticity, setup.layout
     V = el.V
-    gamma = (max(m.E for m in scene.materials) / setup.h**2 if uses_augmentation(options)
+    gamma = (max(b.material.E for b in scene.bodies) / setup.h**2 if uses_augmentation(options)
              else 0.0)
-    active = layout.x[layout.mine, 0] < scene.extra["hertz_exact"]["a"]
+    active = layout.x[layout.mine, 0] < scene.params["hertz_exact"]["a"]
     nsp = near_nullspace(V, scene) if uses_augmentation(options) else None
     res, seconds = reference_solve(el.K, setup.B, el.f, setup.g, active, options, gamma, nsp)
     setup.B.destroy()

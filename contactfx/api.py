@@ -1,19 +1,23 @@
-"""One call from parameters to a solved scene and its summary, shared by the CLI, demos, tests."""
+"""The Python API: solve(scene, method) -> Solution, and run_case for the built-in scenes.
+
+The CLI, the demos, the benchmarks and the tests are thin layers over these calls.
+"""
 
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from collections.abc import Mapping
 from typing import Any
 
 from mpi4py import MPI
 
 from .methods import Method
-from .postprocess import summary
-from .problem import ActiveSetOptions, InitialSet, Solution, coarse_initial_set, solve_contact
-from .saddle import SOLVERS
+from .problem import ActiveSetOptions, InitialSet, coarse_initial_set, solve_contact
+from .report import summary
 from .scenes import BlockParams, HertzParams, Scene, build_scene
 from .schwarz import SchwarzOptions, solve_schwarz
+from .solution import Solution
+from .solvers import SOLVERS
 from .timers import Timers
 
 # Above this many dofs, "auto" starts the active set from a coarser solve of the same scene:
@@ -29,16 +33,7 @@ def scene_dofs(scene: Scene) -> int:
     return 2 * scene.mesh.topology.index_map(0).size_global
 
 
-def coarse_params(params: BlockParams | HertzParams, factor: float = COARSE_FACTOR
-                  ) -> HertzParams | None:
-    """The same Hertz scene with mesh sizes times `factor`; None for scenes without one."""
-    if not isinstance(params, HertzParams):
-        return None  # block scenes are in contact everywhere: the gap already says it all
-    return replace(params, refine=params.refine * factor,
-                   refine_edge=params.refine_edge * factor)
-
-
-def use_coarse(predictor: str, scene: Scene, options: dict[str, object]) -> bool:
+def use_coarse(predictor: str, scene: Scene, options: Mapping[str, object]) -> bool:
     """Whether `predictor` ("auto", "coarse" or "none") asks for a coarse solve here."""
     if predictor not in ("auto", "coarse", "none"):
         raise ValueError(f"predictor must be auto, coarse or none (got {predictor!r})")
@@ -49,60 +44,73 @@ def use_coarse(predictor: str, scene: Scene, options: dict[str, object]) -> bool
     return predictor == "coarse"
 
 
-def coarse_prediction(coarse: Scene, method: Method, options: dict[str, object],
+def coarse_prediction(coarse: Scene, method: Method, options: Mapping[str, object],
                       max_iterations: int = 50) -> InitialSet:
     """Solve `coarse` (the same scene, coarser) and turn its contact zone into an InitialSet."""
     sol = solve_contact(coarse, method, options, ActiveSetOptions(max_iterations))
     return coarse_initial_set(sol)
 
 
+def solve(scene: Scene, method: Method | str = Method.MORTAR, *,
+          solver: str | Mapping[str, object] = "mumps", max_iterations: int = 50,
+          penalty: float | None = None, schwarz: SchwarzOptions | None = None,
+          reference_timing: bool = False, predictor: str = "auto",
+          timers: Timers | None = None) -> Solution:
+    """Solve the frictionless contact problem of `scene` with `method`.
+
+    `predictor` "coarse" starts the active-set loop from a solve of the same scene with mesh
+    sizes times COARSE_FACTOR (scenes that can be remeshed), "auto" does so above
+    COARSE_PREDICTOR_DOFS; the converged solution does not depend on it.
+    """
+    method = Method(method)
+    options = SOLVERS[solver] if isinstance(solver, str) else solver
+    timers = timers or Timers()
+    aso = ActiveSetOptions(max_iterations)
+    if method == Method.PENALTY:
+        from .penalty import penetration, solve_penalty
+
+        sol = solve_penalty(scene, penalty, options, aso, timers)
+        sol.info.update({"penalty": sol.history[-1]["penalty"], "penetration": penetration(sol)})
+        return sol
+    if method == Method.SCHWARZ:
+        return solve_schwarz(scene, schwarz or SchwarzOptions(max_iterations=max_iterations),
+                             timers)
+    init = None
+    if scene.resize is not None and use_coarse(predictor, scene, options):
+        with timers("predictor"):
+            coarse = scene.resize(COARSE_FACTOR)
+            init = coarse_prediction(coarse, method, options, max_iterations)
+    return solve_contact(scene, method, options, aso, timers,
+                         reference_timing=reference_timing, initial_active=init)
+
+
+def run_scene(scene: Scene, method: Method | str = Method.MORTAR, *,
+              solver: str | Mapping[str, object] = "mumps", t_start: float | None = None,
+              timers: Timers | None = None, **options: Any) -> tuple[Solution, dict[str, Any]]:
+    """Solve `scene` and return the solution with its JSON summary (times from `t_start`)."""
+    t_start = time.perf_counter() if t_start is None else t_start
+    timers = timers or Timers()
+    sol = solve(scene, method, solver=solver, timers=timers, **options)
+    times = {k: timers.seconds.get(k, 0.0)
+             for k in ("mesh", "assemble", "search", "contact", "solve")}
+    for key in ("predictor", "reference_solve"):
+        if key in timers.seconds:
+            times[key] = timers.seconds[key]
+    times["total"] = time.perf_counter() - t_start
+    return sol, summary(sol, times, {"solver": solver if isinstance(solver, str) else "custom"})
+
+
 def run_case(kind: str, params: BlockParams | HertzParams, method: Method | str,
-             active: int = 2, solver: str | dict[str, object] = "mumps",
+             active: int = 2, solver: str | Mapping[str, object] = "mumps",
              max_iterations: int = 50, comm: MPI.Comm = MPI.COMM_WORLD,
              penalty: float | None = None, schwarz: SchwarzOptions | None = None,
              reference_timing: bool = False, predictor: str = "auto"
              ) -> tuple[Solution, dict[str, Any]]:
-    """Mesh, assemble and solve one scene; return the solution and its JSON summary.
-
-    `predictor` "coarse" starts the active-set loop from a solve of the same scene with
-    coarser meshes (Hertz only), "auto" does so above COARSE_PREDICTOR_DOFS; the converged
-    solution does not depend on it.
-    """
+    """Mesh, assemble and solve a built-in scene; return the solution and its JSON summary."""
     t_start = time.perf_counter()
-    method = Method(method)
-    options = SOLVERS[solver] if isinstance(solver, str) else solver
     timers = Timers()
     with timers("mesh"):
         scene = build_scene(kind, params, active=active, comm=comm)
-    if method == Method.PENALTY:
-        from .penalty import penetration, solve_penalty
-
-        sol = solve_penalty(scene, penalty, options, ActiveSetOptions(max_iterations), timers)
-    elif method == Method.SCHWARZ:
-        sol = solve_schwarz(scene, schwarz or SchwarzOptions(max_iterations=max_iterations),
-                            timers)
-    else:
-        init = None
-        cparams = coarse_params(params)
-        if cparams is not None and use_coarse(predictor, scene, options):
-            with timers("predictor"):
-                coarse = build_scene(kind, cparams, active=active, comm=comm)
-                init = coarse_prediction(coarse, method, options, max_iterations)
-        sol = solve_contact(scene, method, options, ActiveSetOptions(max_iterations), timers,
-                            reference_timing=reference_timing, initial_active=init)
-    times = {k: timers.seconds.get(k, 0.0)
-             for k in ("mesh", "assemble", "search", "contact", "solve")}
-    if "predictor" in timers.seconds:
-        times["predictor"] = timers.seconds["predictor"]
-    times["total"] = time.perf_counter() - t_start
-    if "reference_solve" in timers.seconds:
-        times["reference_solve"] = timers.seconds["reference_solve"]
-    extra: dict[str, Any] = {"solver": solver if isinstance(solver, str) else "custom"}
-    if method == Method.PENALTY:
-        extra["penalty"] = sol.history[-1]["penalty"]
-        extra["penetration"] = penetration(sol)
-    if kind == "hertz":
-        from .hertz import hertz_summary
-
-        extra["hertz"] = hertz_summary(sol)
-    return sol, summary(sol, times, extra)
+    return run_scene(scene, method, solver=solver, t_start=t_start, timers=timers,
+                     max_iterations=max_iterations, penalty=penalty, schwarz=schwarz,
+                     reference_timing=reference_timing, predictor=predictor)

@@ -1,4 +1,4 @@
-"""Command line: python -m contactfx solve {blocks,hertz} [options] --json FILE [--out DIR]."""
+"""Command line: contactfx solve {blocks,hertz,SCENE.toml} [options] [--json FILE] [--out DIR]."""
 
 from __future__ import annotations
 
@@ -7,18 +7,18 @@ import logging
 import sys
 from dataclasses import fields, replace
 from pathlib import Path
+from typing import Any
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 
-from .errors import ContactFxError
+from .errors import ContactFxError, InputError
 from .methods import Method
 from .scenes import BlockParams, HertzParams
 
 BLOCK_KEYS = ("l1", "l2", "h1", "h2", "E1", "E2", "nu1", "nu2", "p", "size1", "size2",
               "grading1", "grading2")
 HERTZ_KEYS = ("R", "P", "E1", "E2", "nu1", "nu2", "refine", "r_refine", "refine_edge", "slope",
-              "width", "height")
-
+              "width", "height", "h_far")
 
 PARAM_HELP = {
     "l1": "blocks: full width of the base B1 (cm, default 10)",
@@ -42,50 +42,106 @@ PARAM_HELP = {
     "slope": "hertz: growth of the element size per cm of distance (default 0.1)",
     "width": "hertz: half width of the block (cm, default 60)",
     "height": "hertz: height of the block (cm, default 60)",
+    "h_far": "hertz: largest element size, far from the contact (cm; default R / 6)",
 }
+
+
+def _builtin_scene_options(p: argparse.ArgumentParser) -> None:
+    """The options of the built-in scenes (blocks, hertz), shared by solve and study."""
+    g = p.add_argument_group("built-in scenes (blocks, hertz)")
+    g.add_argument("--preset", choices=["S1", "S2", "S3", "S4"],
+                   help="block scene of the paper to start from (other options override it)")
+    for key in sorted(set(BLOCK_KEYS) | set(HERTZ_KEYS)):
+        g.add_argument(f"--{key.replace('_', '-')}", dest=key, type=float, default=None,
+                       help=PARAM_HELP.get(key, key))
+    g.add_argument("--mesh", choices=["gmsh", "structured"], default=None,
+                   help="hertz only: gmsh graded quads (default) or a structured graded mesh "
+                        "built in DOLFINx (fast to make for millions of DOFs)")
+    g.add_argument("--active", type=int, default=None, choices=[1, 2],
+                   help="which body is active (slave, carries the multipliers; default 2)")
+
+
+def _study_parser(sub: Any) -> None:
+    s = sub.add_parser("study", help="convergence study: every method on refined meshes, "
+                       "errors, rates, charts",
+                       description="Run a convergence study of one scene: every method on "
+                       "LEVELS meshes, each with all mesh sizes 1/RATIO of the previous one, "
+                       "against the exact solution where the scene has one, else against the "
+                       "finest level of mortar. Writes study.json, study.csv, "
+                       "convergence.png and accuracy_vs_time.png to --out (docs/study.md).")
+    s.add_argument("scene", help="blocks, hertz or a scene .toml file whose mesh is a .geo")
+    _builtin_scene_options(s)
+    st = s.add_argument_group("study")
+    st.add_argument("--methods", default="nts,sts,mortar",
+                    help="comma-separated methods (default nts,sts,mortar)")
+    st.add_argument("--levels", type=int, default=4, help="number of meshes (default 4)")
+    st.add_argument("--ratio", type=float, default=2.0,
+                    help="mesh-size ratio of consecutive levels (default 2)")
+    st.add_argument("--size-factor", type=float, default=1.0, metavar="F",
+                    help="mesh sizes of the first (coarsest) level relative to the scene's "
+                    "(default 1: the scene as given; e.g. 8 to start coarser)")
+    st.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    v = s.add_argument_group("linear solver")
+    v.add_argument("--solver", default="mumps", help="mumps | fieldsplit | fieldsplit-gamg")
+    v.add_argument("--petsc-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="extra PETSc option for the saddle-point KSP (no leading dash)")
+    o = s.add_argument_group("output")
+    o.add_argument("--out", type=Path, required=True,
+                   help="directory for study.json, study.csv and the two charts")
+    o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
+    o.add_argument("-v", "--verbose", action="store_true",
+                   help="also log every active-set iteration (default: one line per run)")
+
+
+def _solve_parser(sub: Any) -> None:
+    s = sub.add_parser("solve", help="solve a scene, print a summary, optionally write JSON",
+                       description="Solve one contact scene. SCENE is blocks (the paper's S1-S4), "
+                       "hertz (S5) or a scene file SCENE.toml (see README, 'Your own scene').")
+    s.add_argument("scene", help="blocks, hertz or a path to a scene .toml file")
+    _builtin_scene_options(s)
+    m = s.add_argument_group("method")
+    m.add_argument("--method", default=Method.MORTAR.value, choices=[m.value for m in Method],
+                   help="contact discretization (default mortar: the only one that passes the "
+                        "patch test on non-matching meshes)")
+    m.add_argument("--penalty", type=float, default=None, metavar="EPS",
+                   help="penalty normal stiffness (pressure = EPS * penetration) for --method "
+                   "penalty; default 1e3 * max E / h, h the median contact element size")
+    m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    m.add_argument("--predictor", choices=["auto", "coarse", "none"], default="auto",
+                   help="first active set from a coarser solve of the same scene: auto = above "
+                        "200k DOFs, for scenes that can be remeshed (the answer does not "
+                        "depend on it)")
+    v = s.add_argument_group("linear solver")
+    v.add_argument("--solver", default="mumps", help="mumps | fieldsplit | fieldsplit-gamg")
+    v.add_argument("--petsc-option", action="append", default=[], metavar="KEY=VALUE",
+                   help="extra PETSc option for the saddle-point KSP (no leading dash)")
+    v.add_argument("--reference-timing", action="store_true",
+                   help="also time a fresh solve of the final saddle-point system (the cost "
+                   "floor) and report it as times.reference_solve")
+    o = s.add_argument_group("output")
+    o.add_argument("--json", type=Path, help="write the JSON summary here")
+    o.add_argument("--out", type=Path, help="directory for XDMF fields, contact surfaces (VTK) "
+                   "and one interface figure per contact pair")
+    o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
 
 
 def parser() -> argparse.ArgumentParser:
     """The argument parser (defaults of scene parameters are the paper's, filled in later)."""
-    ap = argparse.ArgumentParser(prog="python -m contactfx",
-                                 description="2D frictionless two-body contact (units: cm, MPa)")
+    ap = argparse.ArgumentParser(prog="contactfx",
+                                 description="2D frictionless contact of elastic bodies")
     sub = ap.add_subparsers(dest="command", required=True)
-    s = sub.add_parser("solve", help="solve a scene and write a JSON summary")
-    s.add_argument("scene", help="blocks (S1-S4, default S1) or hertz (S5)")
-    s.add_argument("--preset", choices=["S1", "S2", "S3", "S4"],
-                   help="block scene of the paper to start from (other options override it)")
-    for key in sorted(set(BLOCK_KEYS) | set(HERTZ_KEYS)):
-        s.add_argument(f"--{key.replace('_', '-')}", dest=key, type=float, default=None,
-                       help=PARAM_HELP.get(key, key))
-    s.add_argument("--mesh", choices=["gmsh", "structured"], default=None,
-                   help="hertz only: gmsh graded quads (default) or a structured graded mesh "
-                        "built in DOLFINx (fast to make for millions of DOFs)")
-    s.add_argument("--method", default="nts", choices=[m.value for m in Method])
-    s.add_argument("--active", type=int, default=2, choices=[1, 2],
-                   help="which body is active (slave, carries the multipliers)")
-    s.add_argument("--solver", default="mumps", help="mumps | fieldsplit | fieldsplit-gamg")
-    s.add_argument("--petsc-option", action="append", default=[], metavar="KEY=VALUE",
-                   help="extra PETSc option for the saddle-point KSP (no leading dash)")
-    s.add_argument("--json", type=Path, required=True, help="where to write the JSON summary")
-    s.add_argument("--out", type=Path, help="directory for XDMF fields and figures")
-    s.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
-    s.add_argument("--penalty", type=float, default=None, metavar="EPS",
-                   help="penalty normal stiffness in MPa/cm (pressure = EPS * penetration) for "
-                   "--method penalty; default 1e3 * max(E1, E2) / h, h the median contact "
-                   "element size")
-    s.add_argument("--predictor", choices=["auto", "coarse", "none"], default="auto",
-                   help="first active set from a coarser solve of the same scene: auto = hertz "
-                        "above 200k DOFs (the answer does not depend on it)")
-    s.add_argument("--reference-timing", action="store_true",
-                   help="also time a fresh solve of the final saddle-point system (the cost "
-                   "floor) and report it as times.reference_solve")
-    s.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
+    _solve_parser(sub)
+    _study_parser(sub)
     return ap
+
+
+def is_scene_file(scene: str) -> bool:
+    """Whether the SCENE argument names a scene file rather than a built-in scene."""
+    return scene.endswith(".toml")
 
 
 def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
     """Scene parameters from the paper's defaults, a preset, and the options given."""
-    from .errors import InputError
     from .scenes import BLOCK_SCENES
 
     if args.scene == "blocks":
@@ -95,7 +151,8 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
             raise InputError("--preset applies to the blocks scene only")
         base, keys = HertzParams(), HERTZ_KEYS
     else:
-        raise InputError(f"unknown scene '{args.scene}' (choose blocks or hertz)")
+        raise InputError(f"unknown scene '{args.scene}' (choose blocks, hertz or a .toml "
+                         "scene file)")
     given = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
     if args.mesh is not None:
         if args.scene != "hertz":
@@ -109,18 +166,10 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
     return replace(base, **given)
 
 
-def run(args: argparse.Namespace) -> int:
-    """Run one solve and write its outputs; return the exit code."""
-    from mpi4py import MPI
+def solver_options(args: argparse.Namespace) -> dict[str, object]:
+    """The PETSc options of --solver with every --petsc-option applied."""
+    from .solvers import SOLVERS
 
-    from .api import run_case
-    from .errors import InputError
-    from .output import plot_interface, write_fields, write_json
-    from .saddle import SOLVERS
-
-    comm = MPI.COMM_WORLD
-    params = scene_params(args)
-    method = Method(args.method)
     if args.solver not in SOLVERS:
         raise InputError(f"unknown solver '{args.solver}' (choose {', '.join(SOLVERS)})")
     options = dict(SOLVERS[args.solver])
@@ -129,23 +178,94 @@ def run(args: argparse.Namespace) -> int:
         if not sep or not key:
             raise InputError(f"--petsc-option expects KEY=VALUE, got '{item}'")
         options[key.lstrip("-")] = value
+    return options
+
+
+def build_from_args(args: argparse.Namespace) -> Any:
+    """The Scene the arguments describe (a built-in scene or a scene file)."""
+    from mpi4py import MPI
+
+    from .scenes import build_scene, load_scene_file
+
+    comm = MPI.COMM_WORLD
+    if is_scene_file(args.scene):
+        given = [k for k in set(BLOCK_KEYS) | set(HERTZ_KEYS) if getattr(args, k) is not None]
+        for flag, value in (("preset", args.preset), ("mesh", args.mesh),
+                            ("active", args.active)):
+            if value is not None:
+                given.append(flag)
+        if given:
+            raise InputError(f"option --{given[0].replace('_', '-')} applies to the built-in "
+                             "scenes only (a scene file sets everything itself)")
+        return load_scene_file(Path(args.scene), comm)
+    return build_scene(args.scene, scene_params(args), active=args.active or 2, comm=comm)
+
+
+def terminal_summary(data: dict[str, Any]) -> list[str]:
+    """What a user came for, last: each pair's force, and the errors against references."""
+    lines = [f"{data['scene']} / {data['method']}: {data['dofs']} dofs, "
+             f"{data['multipliers']} multipliers, {data['iterations']} iterations, "
+             f"total {data['times']['total']:.2f} s"]
+    for k, c in enumerate(data["contacts"]):
+        f = c["force"]
+        lines.append(f"pair {k} ({c['active']} on {c['passive']}): force ({f[0]:.6g}, "
+                     f"{f[1]:.6g}), balance {c['balance']:.1e}, {c['active_nodes']} active nodes")
+    if "patch" in data:
+        lines.append(f"patch test: max stress/pressure error {data['patch']['max']:.2e} "
+                     "(relative to the exact uniform stress)")
+    for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else []):
+        a = h["a"]
+        a_err = f"{100 * (a / h['a_exact'] - 1):+.2f} %" if a else "n/a"
+        lines.append(f"Hertz, pair {h['pair']}: a = {a or float('nan'):.4g} (exact "
+                     f"{h['a_exact']:.4g}, {a_err}), p0 = {h['p0']:.4g} (exact "
+                     f"{h['p0_exact']:.4g}, {100 * (h['p0'] / h['p0_exact'] - 1):+.2f} %), "
+                     f"L2 error {100 * h['l2_error']:.2f} %")
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run one solve and write its outputs; return the exit code."""
+    import time
+
+    from mpi4py import MPI
+
+    from .api import run_scene
+    from .output import plot_interface, plot_pair, write_contact_surfaces, write_fields, write_json
+    from .timers import Timers
+
+    comm = MPI.COMM_WORLD
+    method = Method(args.method)
+    options = solver_options(args)
     if args.penalty is not None and method != Method.PENALTY:
         raise InputError("--penalty applies to --method penalty only")
-    sol, data = run_case(args.scene, params, method, args.active, options,
-                         args.max_iterations, comm, penalty=args.penalty,
-                         reference_timing=args.reference_timing, predictor=args.predictor)
-    data["solver"] = args.solver
+    if method == Method.SCHWARZ and (args.solver != "mumps" or args.petsc_option):
+        raise InputError("schwarz factorizes each body with MUMPS: --solver and --petsc-option "
+                         "do not apply to it")
+    t_start = time.perf_counter()
+    timers = Timers()
+    with timers("mesh"):
+        scene = build_from_args(args)
+    sol, data = run_scene(scene, method, solver=options, t_start=t_start, timers=timers,
+                          max_iterations=args.max_iterations, penalty=args.penalty,
+                          reference_timing=args.reference_timing, predictor=args.predictor)
+    data["solver"] = "mumps (each body)" if method == Method.SCHWARZ else args.solver
     if args.out is not None:
         write_fields(sol, args.out)
+    log = logging.getLogger("contactfx")
     if comm.rank == 0:
-        write_json(args.json, data)
-        log = logging.getLogger("contactfx")
-        log.info("contact force %.10g, %d multipliers, %d dofs, total %.2f s",
-                 data["contact_force"], data["multipliers"], data["dofs"], data["times"]["total"])
-        log.info("wrote %s", args.json)
+        if args.json is not None:
+            write_json(args.json, data)
+            log.info("wrote %s", args.json)
         if args.out is not None:
-            fig = plot_interface(data, args.out / "interface.png")
-            log.info("wrote fields (XDMF) and %s to %s", fig.name, args.out)
+            written = write_contact_surfaces(data, args.out)
+            written += [plot_pair(data, k, args.out / f"interface_pair{k}.png")
+                        for k in range(len(data["contacts"]))]
+            if "interface" in data:
+                written.append(plot_interface(data, args.out / "interface.png"))
+            log.info("wrote fields (XDMF), %s to %s", ", ".join(p.name for p in written),
+                     args.out)
+        for line in terminal_summary(data):
+            print(line)
     return 0
 
 
@@ -158,6 +278,10 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING if args.quiet or rank else logging.INFO,
                         format="%(message)s", stream=sys.stdout)
     try:
+        if args.command == "study":
+            from .study.command import run_command
+
+            return run_command(args)
         return run(args)
     except ContactFxError as err:
         if rank == 0:

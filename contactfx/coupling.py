@@ -22,6 +22,7 @@ class Multipliers:
     mine: np.ndarray     # indices (into the global order) of the rows owned here
     offset: int          # global index of this rank's first row
     gblock: np.ndarray   # (n,) global dof block of each node
+    pair: np.ndarray     # (n,) contact pair of each multiplier
 
     @property
     def size(self) -> int:
@@ -42,17 +43,39 @@ def global_dirichlet_dofs(V: fem.FunctionSpace, bc_dofs: np.ndarray) -> np.ndarr
     return np.unique(np.concatenate(V.mesh.comm.allgather(mine)))
 
 
-def multiplier_layout(comm: MPI.Comm, active: GatheredSurface,
-                      op: ContactOperator) -> tuple[Multipliers, np.ndarray]:
-    """Order constrained nodes by (owner rank, global node) so each rank's rows are contiguous."""
+def constrained_rows(op: ContactOperator, dirichlet: np.ndarray) -> np.ndarray:
+    """Rows of `op` that constrain a free dof.
+
+    A row on prescribed dofs only is data, not a constraint (its multiplier would make the
+    saddle point singular).
+    """
+    cols = np.zeros(op.B.shape[1], dtype=bool)
+    cols[dirichlet[dirichlet < op.B.shape[1]]] = True
+    B = op.B.tocoo()
+    free = (~cols[B.col]) & (B.data != 0.0)
+    return np.bincount(B.row[free], minlength=op.B.shape[0]) > 0
+
+
+def multiplier_layout(comm: MPI.Comm, active: GatheredSurface, op: ContactOperator,
+                      pair: np.ndarray | None = None, usable: np.ndarray | None = None
+                      ) -> tuple[Multipliers, np.ndarray]:
+    """Order constrained nodes by (owner rank, pair, global node): each rank's rows contiguous.
+
+    `pair` (one entry per row of `op`) tells which contact pair a row belongs to when the
+    operator stacks several pairs; weights below round-off of the largest mark no overlap;
+    rows outside `usable` (if given) are left out.
+    """
+    pair = np.zeros(len(op.weights), dtype=np.int64) if pair is None else pair
     tol = 1e-12 * max(float(op.weights.max(initial=0.0)), 1e-300)
-    keep = np.flatnonzero(op.weights > tol)
-    order = keep[np.lexsort((active.gblock[keep], active.owner[keep]))]
+    ok = op.weights > tol
+    keep = np.flatnonzero(ok if usable is None else ok & usable)
+    order = keep[np.lexsort((active.gblock[keep], pair[keep], active.owner[keep]))]
     owner = active.owner[order]
     mine = np.flatnonzero(owner == comm.rank)
     offset = int(np.count_nonzero(owner < comm.rank))
     x = active.surface.x[order]
-    return Multipliers(x, op.weights[order], mine, offset, active.gblock[order]), order
+    return Multipliers(x, op.weights[order], mine, offset, active.gblock[order],
+                       pair[order]), order
 
 
 def petsc_constraint(V: fem.FunctionSpace, op: ContactOperator, order: np.ndarray,

@@ -1,8 +1,9 @@
-"""Plane-strain linear elasticity of both bodies: space, materials, forms, Dirichlet conditions."""
+"""Plane-strain linear elasticity of every body: space, materials, loads, Dirichlet conditions."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import dolfinx.fem.petsc
 import numpy as np
@@ -11,12 +12,12 @@ from dolfinx import fem, mesh
 from petsc4py import PETSc
 
 from .errors import MeshError
-from .scenes import Scene
+from .scenes import Pressure, Scene
 
 
 @dataclass(frozen=True)
 class Elasticity:
-    """The assembled elastic problem of both bodies (K has identity rows at Dirichlet dofs)."""
+    """The assembled elastic problem of all bodies (K has identity rows at Dirichlet dofs)."""
 
     V: fem.FunctionSpace
     K: PETSc.Mat
@@ -31,11 +32,11 @@ def material_fields(scene: Scene) -> tuple[fem.Function, fem.Function]:
     """DG0 fields of E and nu from the body cell tags."""
     Q = fem.functionspace(scene.mesh, ("DG", 0))
     E, nu = fem.Function(Q, name="E"), fem.Function(Q, name="nu")
-    for body, mat in zip((1, 2), scene.materials, strict=True):
-        cells = scene.cell_tags.find(scene.tags[f"body{body}"])
+    for body in scene.bodies:
+        cells = scene.cell_tags.find(scene.body_tag(body))
         dofs = Q.dofmap.list[cells].ravel()
-        E.x.array[dofs] = mat.E
-        nu.x.array[dofs] = mat.nu
+        E.x.array[dofs] = body.material.E
+        nu.x.array[dofs] = body.material.nu
     E.x.scatter_forward()
     nu.x.scatter_forward()
     return E, nu
@@ -56,36 +57,61 @@ def check_quadrilateral(msh: mesh.Mesh) -> None:
         raise MeshError(f"contactfx needs an all-quadrilateral mesh, got {name} cells")
 
 
+def dirichlet_conditions(scene: Scene, V: fem.FunctionSpace) -> list[fem.DirichletBC]:
+    """One DirichletBC per prescribed component of every [[dirichlet]] group (curve or point)."""
+    msh = V.mesh
+    bcs = []
+    for bc in scene.dirichlet:
+        dim, tag = scene.groups.by_name[bc.group]
+        tags = scene.facet_tags if dim == msh.topology.dim - 1 else scene.point_tags
+        if tags is None:
+            raise MeshError(f"dirichlet: the mesh carries no entities of group '{bc.group}'")
+        if dim == 0:
+            msh.topology.create_connectivity(0, msh.topology.dim)
+        entities = tags.find(tag)
+        for comp, value in bc.components():
+            dofs = fem.locate_dofs_topological(V.sub(comp), dim, entities)
+            # The stub types ScalarType as a dtype instance; it is the scalar class.
+            bcs.append(fem.dirichletbc(PETSc.ScalarType(value), dofs, V.sub(comp)))  # type: ignore[operator]
+    return bcs
+
+
+def load_form(scene: Scene, v: ufl.Argument) -> ufl.Form:
+    """The external work of the scene's pressures and tractions (zero if there are none)."""
+    msh = scene.mesh
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=scene.facet_tags)
+    n = ufl.FacetNormal(msh)
+    zero = fem.Constant(msh, np.zeros(2, dtype=PETSc.ScalarType))
+    L = ufl.inner(zero, v) * ufl.dx
+    for load in scene.loads:
+        dsg = ds(scene.curve_tag(load.group, "load"))
+        if isinstance(load, Pressure):
+            L += -fem.Constant(msh, PETSc.ScalarType(load.p)) * ufl.dot(n, v) * dsg  # type: ignore[operator]
+        else:
+            t = fem.Constant(msh, np.asarray(load.t, dtype=PETSc.ScalarType))
+            L += ufl.dot(t, v) * dsg
+    return L
+
+
 def assemble_elasticity(scene: Scene) -> Elasticity:
-    """Assemble K and f with roller supports, symmetry and the pressure load of the scene."""
+    """Assemble K and f of every body with the scene's supports and loads."""
     msh = scene.mesh
     check_quadrilateral(msh)
-    for name in ("body1", "body2", "symmetry", "support", "load", "contact1", "contact2"):
-        if name not in scene.tags:
-            raise MeshError(f"the mesh has no physical group '{name}'")
     V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
     E, nu = material_fields(scene)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    ds = ufl.Measure("ds", domain=msh, subdomain_data=scene.facet_tags)
-    p = fem.Constant(msh, PETSc.ScalarType(scene.pressure))
-    n = ufl.FacetNormal(msh)
     a = fem.form(ufl.inner(sigma(u, E, nu), ufl.sym(ufl.grad(v))) * ufl.dx)
-    L = fem.form(-p * ufl.dot(n, v) * ds(scene.tags["load"]))
-
-    fdim = msh.topology.dim - 1
-    sym_facets = scene.facet_tags.find(scene.tags["symmetry"])
-    sup_facets = scene.facet_tags.find(scene.tags["support"])
-    # Rollers, as in the paper: u_x = 0 on the symmetry axis, u_y = 0 on the base only.
-    sym_dofs = fem.locate_dofs_topological(V.sub(0), fdim, sym_facets)
-    sup_dofs = fem.locate_dofs_topological(V.sub(1), fdim, sup_facets)
-    zero = PETSc.ScalarType(0)
-    bcs = [fem.dirichletbc(zero, sym_dofs, V.sub(0)), fem.dirichletbc(zero, sup_dofs, V.sub(1))]
+    L = fem.form(load_form(scene, v))
+    bcs = dirichlet_conditions(scene, V)
 
     K = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs)
     K.assemble()
     f = dolfinx.fem.petsc.assemble_vector(L)
     dolfinx.fem.petsc.apply_lifting(f, [a], bcs=[bcs])
-    f.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    # The stub types the mode values as int but the parameters as the enum classes.
+    f.ghostUpdate(addv=cast(PETSc.InsertMode, PETSc.InsertMode.ADD),
+                  mode=cast(PETSc.ScatterMode, PETSc.ScatterMode.REVERSE))
     dolfinx.fem.petsc.set_bc(f, bcs)
-    bc_dofs = np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs]))
+    bc_dofs = (np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs])) if bcs
+               else np.zeros(0, dtype=np.int32))
     return Elasticity(V, K, f, bcs, bc_dofs, E, nu)

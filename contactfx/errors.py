@@ -30,4 +30,10 @@ class ActiveSetError(ContactFxError):
 
 
 class ConvergenceError(ContactFxError):
-    """An outer iteration (e.g. the alternating Schwarz method) diverged or hit its limit."""
+    """An outer iteration (e.g. the alternating Schwarz method) diverged or hit its limit.
+
+    Attributes:
+        history: The iteration records up to the failure (set by the raiser, e.g. schwarz).
+    """
+
+    history: list[dict[str, float | None]]

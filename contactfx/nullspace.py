@@ -7,12 +7,13 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from .scenes import Scene
+from .supports import body_blocks
 
 
 def rigid_body_modes(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Vec]:
     """Three modes per body (x and y translation, rotation), each zero outside its body.
 
-    The six vectors are orthonormalized: they span the kernel of each body's unconstrained
+    The vectors are orthonormalized: they span the kernel of each body's unconstrained
     stiffness matrix separately, which is what aggregation multigrid must interpolate exactly.
     """
     imap = V.dofmap.index_map
@@ -21,9 +22,8 @@ def rigid_body_modes(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Vec]:
     comm = V.mesh.comm
     x = V.tabulate_dof_coordinates()[:nloc, :2]
     modes: list[PETSc.Vec] = []
-    for body in (1, 2):
-        cells = scene.cell_tags.find(scene.tags[f"body{body}"])
-        blocks = np.unique(V.dofmap.list[cells].ravel())
+    for body in scene.bodies:
+        blocks = body_blocks(scene, V, body)
         blocks = blocks[blocks < nloc]
         # Rotate about the body's centroid: keeps the rotation mode well scaled against the
         # translations before orthonormalization.
@@ -54,7 +54,7 @@ def _orthonormalize(vectors: list[PETSc.Vec]) -> None:
 
 
 def near_nullspace(V: fem.FunctionSpace, scene: Scene) -> PETSc.NullSpace:
-    """The rigid-body modes of both bodies as a PETSc near-nullspace (for GAMG)."""
+    """The rigid-body modes of every body as a PETSc near-nullspace (for GAMG)."""
     modes = rigid_body_modes(V, scene)
     nsp = PETSc.NullSpace().create(vectors=modes, comm=V.mesh.comm)
     for v in modes:

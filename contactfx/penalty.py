@@ -11,35 +11,35 @@ same semi-smooth Newton (active-set) loop on the sign of the gap as the multipli
 
 from __future__ import annotations
 
-import logging
-import time
+from collections.abc import Mapping
+from typing import cast
 
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from .active_set import ActiveSetOptions, Step, run_active_set
 from .coupling import global_dirichlet_dofs, petsc_constraint
-from .errors import ActiveSetError, InputError, SolverError
+from .errors import InputError, SolverError
 from .methods import Method
-from .problem import ActiveSetOptions, Solution, _gather, prepare_contact
-from .saddle import SOLVERS, _reason_name, petsc_error_message, petsc_options, uses_augmentation
+from .prepare import ContactSetup, prepare_contact
 from .scenes import Scene
+from .solution import Solution
+from .solvers import SOLVERS, petsc_error_message, petsc_options, reason_name, uses_augmentation
 from .timers import Timers
 
-log = logging.getLogger("contactfx")
-
 DEFAULT_FACTOR = 1e3
-"""Default eps = DEFAULT_FACTOR * max(E1, E2) / h, h the median active-surface element size."""
+"""Default eps = DEFAULT_FACTOR * max E / h, h the median active-surface element size."""
 
 
 def default_penalty(scene: Scene, h: float) -> float:
     """The default normal stiffness eps (MPa/cm): 1e3 times the stiffer body's E over h."""
-    return DEFAULT_FACTOR * max(m.E for m in scene.materials) / h
+    return DEFAULT_FACTOR * max(b.material.E for b in scene.bodies) / h
 
 
 def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.ndarray,
-           options: dict[str, object], condition: bool, check: bool = True
+           options: Mapping[str, object], condition: bool, check: bool = True
            ) -> tuple[np.ndarray, dict[str, float]]:
     """Solve (K + B^T diag(coef) B) u = f - B^T diag(coef) g; coef = eps / w on active rows."""
     d = B.createVecLeft()
@@ -49,7 +49,9 @@ def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.nda
     BAT = PETSc.Mat()
     BA.transpose(BAT)
     A = BAT.matMult(BA)
-    A.axpy(1.0, K, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    # The stub types the Structure values as int but the parameter as Structure.
+    A.axpy(1.0, K, structure=cast(PETSc.Mat.Structure,
+                                  PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN))
     rhs = f.copy()
     d.array[:] = -coef * g
     tmp = rhs.duplicate()
@@ -67,7 +69,8 @@ def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.nda
                 ksp.setComputeSingularValues(True)
             ksp.setUp()
             ksp.solve(rhs, x)
-        reason, its = ksp.getConvergedReason(), ksp.getIterationNumber()
+        # getConvergedReason() returns an int; the stub says the enum class.
+        reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
         if condition and its > 0:
             smax, smin = ksp.computeExtremeSingularValues()
             info["condition"] = float(smax / smin) if smin > 0 else float("inf")
@@ -82,70 +85,63 @@ def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.nda
     info["converged"] = float(ok)
     if check and not ok:
         raise SolverError(f"linear solve ({ksp_type}) did not converge: PETSc reason {reason} "
-                          f"({_reason_name(reason)}) after {its} iterations")
+                          f"({reason_name(reason)}) after {its} iterations")
     info["linear_iterations"] = its
     return u, info
 
 
+class PenaltyIteration:
+    """Solves of K + eps B_A^T W^-1 B_A on a set A; the update is the penetrating nodes."""
+
+    label = "penalty active set"
+    probing = False
+
+    def __init__(self, setup: ContactSetup, eps: float, options: Mapping[str, object],
+                 condition: bool) -> None:
+        self.setup, self.eps, self.options, self.condition = setup, eps, options, condition
+        self.u = fem.Function(setup.elasticity.V, name="u")
+
+    def solve(self, active: np.ndarray, it: int) -> Step:
+        """One penalty solve with `active` penalized."""
+        setup, el = self.setup, self.setup.elasticity
+        comm = setup.scene.comm
+        x, info = _solve(el.K, setup.B, el.f, setup.g,
+                         np.where(active, self.eps / setup.w, 0.0), self.options, self.condition)
+        self.u.x.petsc_vec.array[:] = x
+        self.u.x.scatter_forward()
+        gap = setup.normalized_gap(self.u)
+        pen = max(comm.allreduce(float(np.max(-gap, initial=0.0)), op=MPI.MAX), 0.0)
+        text = (f"max penetration {pen:.3e}, {int(info['linear_iterations'])} linear its, ")
+        # A penalty enforces g >= 0 only approximately: a node is in contact when its gap is
+        # negative (penetration); there is no complementarity residual to check.
+        return Step(-self.eps * gap, gap, gap < 0.0, 0.0,
+                    {"penetration": pen, "penalty": self.eps, **info}, text)
+
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
+        """Always the plain update."""
+        return None
+
+
 def solve_penalty(scene: Scene, penalty: float | None = None,
-                  solver: str | dict[str, object] = "mumps",
+                  solver: str | Mapping[str, object] = "mumps",
                   aso: ActiveSetOptions | None = None, timers: Timers | None = None,
                   condition: bool = False) -> Solution:
     """Solve the unilateral contact of `scene` by the penalty method on the mortar gap."""
-    options = SOLVERS[solver] if isinstance(solver, str) else solver
+    options = dict(SOLVERS[solver] if isinstance(solver, str) else solver)
     aso = aso or ActiveSetOptions()
     if uses_augmentation(options):
         raise InputError("the penalty method has no multiplier block: use the mumps solver or "
                          "single-field PETSc options, not a fieldsplit")
     timers = timers or Timers()
-    comm = scene.mesh.comm
-    setup = prepare_contact(scene, Method.PENALTY.operator, aso, timers)
-    el, B, g, w, h = setup.elasticity, setup.B, setup.g, setup.w, setup.h
-    V = el.V
-    eps = default_penalty(scene, h) if penalty is None else float(penalty)
+    setup = prepare_contact(scene, Method.PENALTY.operator, aso.penetration_tol, timers)
+    eps = default_penalty(scene, setup.h) if penalty is None else float(penalty)
     if not (np.isfinite(eps) and eps > 0):
         raise InputError(f"the penalty parameter must be a positive number (got {eps})")
-    # A penalty enforces g >= 0 only approximately: a node is in contact when its gap is
-    # negative (penetration), with the same round-off margin as the multiplier methods.
-    active = setup.initial_active(aso.penetration_tol * h)
-    seen: set[bytes] = set()
-    history: list[dict[str, float]] = []
-    u = fem.Function(V, name="u")
-    gap_u = g / w
-    entered = left = 0
-    for it in range(1, aso.max_iterations + 1):
-        n_active = comm.allreduce(int(active.sum()))
-        setup.check_not_floating(n_active)
-        key = _gather(comm, active).tobytes()
-        if key in seen:
-            raise ActiveSetError(f"active set cycles at iteration {it} ({n_active} active nodes)")
-        seen.add(key)
-        t0 = time.perf_counter()
-        with timers("solve"):
-            x, info = _solve(el.K, B, el.f, g, np.where(active, eps / w, 0.0), options,
-                             condition)
-        t_solve = time.perf_counter() - t0
-        u.x.petsc_vec.array[:] = x
-        u.x.scatter_forward()
-        gap_u = setup.normalized_gap(u)
-        new_active = gap_u < 0.0
-        entered = comm.allreduce(int(np.sum(new_active & ~active)))
-        left = comm.allreduce(int(np.sum(active & ~new_active)))
-        pen = comm.allreduce(float(np.max(-gap_u, initial=0.0)), op=MPI.MAX)
-        history.append({"iteration": it, "active": n_active, "entered": entered, "left": left,
-                        "penetration": max(pen, 0.0), "penalty": eps, "solve_time": t_solve,
-                        **info})
-        if comm.rank == 0:
-            log.info("penalty active set %2d: %5d active, +%d -%d, max penetration %.3e cm, "
-                     "%d linear its, %.3f s", it, n_active, entered, left, max(pen, 0.0),
-                     info["linear_iterations"], t_solve)
-        if entered == 0 and left == 0:
-            break
-        active = new_active
-    else:
-        raise ActiveSetError(f"active set did not converge in {aso.max_iterations} iterations "
-                             f"(last change: +{entered} -{left})")
-    return setup.solution(Method.PENALTY, u, -eps * gap_u, gap_u, active, history, timers)
+    iteration = PenaltyIteration(setup, eps, options, condition)
+    active = setup.initial_active(aso.penetration_tol * setup.h)
+    step, active, history = run_active_set(setup, iteration, active, aso, timers)
+    return setup.solution(Method.PENALTY, iteration.u, step.lam, step.gap, active, history,
+                          timers)
 
 
 def penetration(sol: Solution) -> float:

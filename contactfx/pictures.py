@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from .postprocess import sigma_field
-from .problem import Solution
+from .solution import Solution
 
 
 def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | None:
@@ -19,7 +19,8 @@ def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | N
 
     pyvista.OFF_SCREEN = True
     V = sol.elasticity.V
-    topology, cell_types, x = plot.vtk_mesh(V)
+    # vtk_mesh is a singledispatch function: mypy sees only its Mesh signature.
+    topology, cell_types, x = plot.vtk_mesh(V)  # type: ignore[arg-type]
     grid = pyvista.UnstructuredGrid(topology, cell_types, x)
     u = sol.u.x.array.reshape(-1, 2)
     grid.point_data["u_y"] = u[:, 1]
@@ -28,14 +29,15 @@ def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | N
     # DG0 dofs follow the cell order of vtk_mesh(V) (both enumerate local cells).
     grid.cell_data["sigma_yy"] = s[: grid.n_cells, 3]
     warped = grid.warp_by_vector("u", factor=scale)
-    plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)
+    # pyvista annotates window_size as list[int]; it takes any sequence (as BasePlotter says).
+    plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)  # type: ignore[arg-type]
     for col, (name, label) in enumerate((("u_y", "u_y (cm)"), ("sigma_yy", "sigma_yy (MPa)"))):
         plotter.subplot(0, col)
         plotter.add_mesh(warped, scalars=name, cmap="turbo", show_edges=False,
                          scalar_bar_args={"title": label, "vertical": True,
                                           "position_x": 0.86, "position_y": 0.15})
         plotter.add_text(f"{label}, deformation x{scale:g}", font_size=10)
-        plotter.view_xy()
+        plotter.view_xy()  # type: ignore[call-arg]  # pyvista's functools.wraps confuses mypy
     path.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(path))
     plotter.close()

@@ -11,101 +11,22 @@ that would cost more than a new numeric factorization.
 
 from __future__ import annotations
 
-import itertools
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
 from .errors import SolverError
+from .solvers import PrefixedOptions, is_direct, petsc_error_message, reason_name
 
-SOLVERS: dict[str, dict[str, object]] = {
-    # MUMPS LU directly on the MatNest (PETSc converts it): the robust reference. PORD
-    # ordering: MUMPS' METIS analysis (sequential) took half of a 1M-dof solve, 4.0 of 7.5 s;
-    # PORD's took 1.3 s for the same factorization time (4.7 s in all; 13.8 s instead of
-    # 18.7 s at 2M dofs, 10.0 s instead of 16.5 s on 2 ranks). benchmarks/README.md.
-    "mumps": {
-        "ksp_type": "preonly",
-        "pc_type": "lu",
-        "pc_factor_mat_solver_type": "mumps",
-        "mat_mumps_icntl_7": 4,
-    },
-    # Schur-complement fieldsplit, A00 = K + gamma B^T B factorized by MUMPS, S by Jacobi-GMRES.
-    "fieldsplit": {
-        "ksp_type": "fgmres",
-        "ksp_rtol": 1e-12,
-        "ksp_atol": 1e-14,
-        "ksp_max_it": 200,
-        "pc_type": "fieldsplit",
-        "pc_fieldsplit_type": "schur",
-        "pc_fieldsplit_schur_fact_type": "full",
-        "pc_fieldsplit_schur_precondition": "selfp",
-        "fieldsplit_u_ksp_type": "preonly",
-        "fieldsplit_u_pc_type": "lu",
-        "fieldsplit_u_pc_factor_mat_solver_type": "mumps",
-        "fieldsplit_u_mat_mumps_icntl_7": 4,
-        "fieldsplit_lambda_ksp_type": "gmres",
-        "fieldsplit_lambda_ksp_rtol": 1e-12,
-        "fieldsplit_lambda_ksp_max_it": 500,
-        "fieldsplit_lambda_pc_type": "jacobi",
-    },
-    # Iterative path for large meshes: A00 = K + gamma B^T B by one GAMG V-cycle with the
-    # rigid-body modes of each body as near-nullspace, S by the augmented-Lagrangian diagonal
-    # -I/gamma (see `schur_al_diagonal`), whose quality does not depend on the mesh size.
-    "fieldsplit-gamg": {
-        "ksp_type": "fgmres",
-        "ksp_rtol": 1e-10,
-        "ksp_max_it": 1000,
-        "ksp_gmres_restart": 200,
-        "pc_type": "fieldsplit",
-        "pc_fieldsplit_type": "schur",
-        "pc_fieldsplit_schur_fact_type": "upper",
-        "pc_fieldsplit_schur_precondition": "user",
-        "fieldsplit_u_ksp_type": "preonly",
-        "fieldsplit_u_pc_type": "gamg",
-        "fieldsplit_u_pc_gamg_threshold": 0.01,
-        "fieldsplit_u_pc_gamg_reuse_interpolation": True,
-        # SOR smoothing: stretched cells of graded meshes defeat Chebyshev/Jacobi (measured on
-        # the structured Hertz mesh, 115k dofs: 236 outer iterations with it, 50 with SOR).
-        "fieldsplit_u_mg_levels_pc_type": "sor",
-        "fieldsplit_lambda_ksp_type": "preonly",
-        "fieldsplit_lambda_pc_type": "jacobi",
-    },
-}
-
-_counter = itertools.count()
 # Largest set of released rows solved by a capacitance system instead of a refactorization.
 _MAX_RELEASED = 2000
 # Entries per rank of one dense block of probe right-hand sides (8 bytes each).
 _PROBE_ENTRIES = 64_000_000
-
-
-@contextmanager
-def petsc_options(options: dict[str, object]) -> Iterator[str]:
-    """Set `options` under a fresh unique prefix and remove them afterwards."""
-    prefix = f"contactfx_{next(_counter)}_"
-    db = PETSc.Options()
-    for key, value in options.items():
-        db[prefix + key] = value
-    try:
-        yield prefix
-    finally:
-        for key in options:
-            db.delValue(prefix + key)
-
-
-def uses_augmentation(options: dict[str, object]) -> bool:
-    """True if the options ask for a fieldsplit, whose A00 must be invertible on its own."""
-    return options.get("pc_type") == "fieldsplit"
-
-
-def is_direct(options: dict[str, object]) -> bool:
-    """True if the options factorize the whole saddle-point matrix (LU or Cholesky)."""
-    return options.get("pc_type") in ("lu", "cholesky")
 
 
 @dataclass
@@ -119,12 +40,13 @@ class SaddleResult:
     info: dict[str, object] = field(default_factory=dict)
 
 
-def _diagonal_matrix(comm, values: np.ndarray, offset: int) -> PETSc.Mat:
+def _diagonal_matrix(comm: PETSc.Comm, values: np.ndarray, offset: int) -> PETSc.Mat:
     """A square AIJ matrix with `values` on this rank's diagonal rows (global first row offset)."""
     m = len(values)
     csr = (np.arange(m + 1, dtype=PETSc.IntType), np.arange(offset, offset + m,
            dtype=PETSc.IntType), np.asarray(values, dtype=PETSc.ScalarType))
-    C = PETSc.Mat().createAIJ(size=((m, PETSc.DETERMINE), (m, PETSc.DETERMINE)), csr=csr,
+    # The stub asks for Sequences; petsc4py takes (and converts) numpy arrays.
+    C = PETSc.Mat().createAIJ(size=((m, PETSc.DETERMINE), (m, PETSc.DETERMINE)), csr=csr,  # type: ignore[arg-type]
                               comm=comm)
     C.assemble()
     return C
@@ -143,7 +65,7 @@ def schur_al_diagonal(active: np.ndarray, gamma: float, inactive: float = 1.0) -
 class SaddleSolver:
     """A persistent saddle-point solver for one (K, B, f): call `solve(g, active)` repeatedly."""
 
-    def __init__(self, K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, options: dict[str, object],
+    def __init__(self, K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, options: Mapping[str, object],
                  gamma: float = 0.0, nullspace: PETSc.NullSpace | None = None,
                  reuse_factorization: bool = True) -> None:
         self.options = dict(options)
@@ -172,7 +94,8 @@ class SaddleSolver:
             self._P = self._BAT.matMult(self._BA)
             zero = self._P.duplicate(copy=False)
             self._Kx = K.duplicate(copy=True)
-            self._Kx.axpy(1.0, zero, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            different = cast(PETSc.Mat.Structure, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            self._Kx.axpy(1.0, zero, structure=different)
             zero.destroy()
             self._A00 = self._Kx.duplicate(copy=True)
             self._owned += [self._P, self._Kx, self._A00]
@@ -192,22 +115,20 @@ class SaddleSolver:
         if nullspace is not None and self._is_u is not None:
             # PCFIELDSPLIT attaches a near-nullspace composed on the split's IS to its matrix.
             self._is_u.compose("nearnullspace", nullspace)
-        self._prefix = f"contactfx_{next(_counter)}_"
-        self._db = PETSc.Options()
-        self._db_keys = dict(self.options)
+        keys = dict(self.options)
         if self.reuse:
             # GMRES around the LU: one iteration with a fresh factorization, a few with a
             # lagged one (the change is low-rank); right preconditioning tests the true
             # residual, modified Gram-Schmidt keeps the basis orthogonal down to round-off.
-            self._db_keys.update({"ksp_type": "gmres", "ksp_pc_side": "right", "ksp_rtol": 1e-13,
-                                  "ksp_atol": 0.0, "ksp_max_it": 120, "ksp_gmres_restart": 120,
-                                  "ksp_gmres_modifiedgramschmidt": True})
-        for key, value in self._db_keys.items():
-            self._db[self._prefix + key] = value
+            keys.update({"ksp_type": "gmres", "ksp_pc_side": "right", "ksp_rtol": 1e-13,
+                         "ksp_atol": 0.0, "ksp_max_it": 120, "ksp_gmres_restart": 120,
+                         "ksp_gmres_modifiedgramschmidt": True})
+        self._options = PrefixedOptions(keys)
         self._ksp = PETSc.KSP().create(comm)
-        self._ksp.setOptionsPrefix(self._prefix)
+        self._ksp.setOptionsPrefix(self._options.prefix)
         self._factored: np.ndarray | None = None
-        self._cache: tuple[int, np.ndarray, np.ndarray] | None = None
+        # (factorization count, sorted global rows, responses) of the last direct probe solve.
+        self._cache: tuple[float, np.ndarray, np.ndarray] | None = None
         self._t_numeric = np.inf
         self._t_apply = 0.0
         self._ready = False
@@ -223,8 +144,7 @@ class SaddleSolver:
 
     def destroy(self) -> None:
         """Free the PETSc objects and remove this solver's options from the database."""
-        for key in self._db_keys:
-            self._db.delValue(self._prefix + key)
+        self._options.remove()
         self._ksp.destroy()
         for obj in self._owned:
             obj.destroy()
@@ -232,7 +152,8 @@ class SaddleSolver:
 
     def _update(self, g: np.ndarray, active: np.ndarray) -> None:
         """Write the values of the active set into the fixed-pattern blocks and the rhs."""
-        same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+        # The stub types the Structure values as int but the parameters as Structure.
+        same = cast(PETSc.Mat.Structure, PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self._act.array[:] = active.astype(float)
         self._B.copy(self._BA, structure=same)
         self._BA.diagonalScale(L=self._act)
@@ -247,7 +168,7 @@ class SaddleSolver:
             # body is held only by contact, and leaves the solution unchanged.
             self._BAT.matMult(self._BA, result=self._P)
             self._Kx.copy(self._A00, structure=same)
-            subset = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+            subset = cast(PETSc.Mat.Structure, PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
             self._A00.axpy(self.gamma, self._P, structure=subset)
             diag.array[:] = -self.gamma * g * active
             tmp = self._rhs_u.duplicate()
@@ -276,7 +197,8 @@ class SaddleSolver:
             pc.setFieldSplitIS(("u", self._is_u), ("lambda", self._is_l))
         ksp.setFromOptions()
         if self._Sp is not None:
-            pc.setFieldSplitSchurPreType(PETSc.PC.FieldSplitSchurPreType.USER, self._Sp)
+            user = cast(PETSc.PC.FieldSplitSchurPreType, PETSc.PC.FieldSplitSchurPreType.USER)
+            pc.setFieldSplitSchurPreType(user, self._Sp)
         if not self.reuse:
             ksp.setInitialGuessNonzero(not self.direct)
         self._ready = True
@@ -307,7 +229,7 @@ class SaddleSolver:
         if probes is not None and self.direct:
             changed = -1  # the multi-RHS probes need the exact factorization of this set
         if (self.reuse and self.gamma == 0.0 and probes is None and self.policy != "refactor"
-                and 0 < changed <= _MAX_RELEASED
+                and 0 < changed <= _MAX_RELEASED and self._factored is not None
                 and not self._mpi.allreduce(bool(np.any(active & ~self._factored)), op=MPI.LOR)):
             released = self._solve_released(g, active)
             if released is not None:
@@ -337,7 +259,7 @@ class SaddleSolver:
             t2 = time.perf_counter()
         except PETSc.Error as err:
             raise SolverError(petsc_error_message(err, "saddle-point solve")) from None
-        reason = ksp.getConvergedReason()
+        reason = cast(int, ksp.getConvergedReason())  # an int; the stub says the enum class
         its = ksp.getIterationNumber()
         if refactor:
             if changed >= 0 or self.stats["factorizations"] > 1:
@@ -353,7 +275,7 @@ class SaddleSolver:
             return self.solve(g, active)
         if not ok:
             raise SolverError(f"linear solve ({ksp.getType()}) did not converge: PETSc reason "
-                              f"{reason} ({_reason_name(reason)}) after {its} iterations")
+                              f"{reason} ({reason_name(reason)}) after {its} iterations")
         u_sub, l_sub = self._x.getSubVector(self._is_u), self._x.getSubVector(self._is_l)
         u, mu = u_sub.array.copy(), l_sub.array.copy()
         self._x.restoreSubVector(self._is_u, u_sub)
@@ -375,6 +297,7 @@ class SaddleSolver:
         pc = self._ksp.getPC()
         pc.setReusePreconditioner(True)
         factored = self._factored
+        assert factored is not None  # solve() comes here only with a factorized set
         rel = factored & ~active
         rel_global = np.flatnonzero(np.concatenate(self._mpi.allgather(rel)))
         start = self._A.getOwnershipRange()[0]
@@ -518,7 +441,7 @@ def _inactive_scale(K: PETSc.Mat, B: PETSc.Mat) -> float:
 
 
 def solve_saddle(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, active: np.ndarray,
-                 options: dict[str, object], gamma: float = 0.0,
+                 options: Mapping[str, object], gamma: float = 0.0,
                  nullspace: PETSc.NullSpace | None = None,
                  probes: np.ndarray | None = None) -> SaddleResult:
     """One fresh solve (setup, factorization or preconditioner set-up, solve), nothing kept."""
@@ -527,21 +450,10 @@ def solve_saddle(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, active
 
 
 def reference_solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray,
-                    active: np.ndarray, options: dict[str, object], gamma: float = 0.0,
+                    active: np.ndarray, options: Mapping[str, object], gamma: float = 0.0,
                     nullspace: PETSc.NullSpace | None = None) -> tuple[SaddleResult, float]:
     """A fresh solve with the active set fixed, and its wall-clock seconds (the cost floor)."""
     K.getComm().tompi4py().Barrier()
     t0 = time.perf_counter()
     res = solve_saddle(K, B, f, g, active, options, gamma, nullspace)
     return res, time.perf_counter() - t0
-
-
-def petsc_error_message(err: PETSc.Error, where: str) -> str:
-    """One line from a PETSc error: its code and PETSc's own last message line."""
-    lines = [line.removeprefix("[0]").strip() for line in str(err).splitlines()]
-    return f"PETSc error {err.ierr} in the {where}: {lines[-1] if len(lines) > 1 else 'no message'}"
-
-
-def _reason_name(reason: int) -> str:
-    names = {v: k for k, v in vars(PETSc.KSP.ConvergedReason).items() if isinstance(v, int)}
-    return names.get(reason, "unknown")

@@ -1,13 +1,13 @@
 """Alternating Dirichlet-Neumann (Schwarz) iteration between the two bodies, mortar transfer.
 
-B2 (the top body, held vertically only by contact) takes the Dirichlet data: its interface
-normal displacement is prescribed, which fixes its vertical rigid motion, so its subproblem is
-well posed whatever the iterate. B1 (supported at its base) takes the Neumann data: the
-interface force B2 exerts on it. The transfer uses the mortar matrices of the pair
-(slave B2, master B1): u2_n = D^-1 (M u1_n - g~) and, for the traction lambda = D^-1 R2 of
+The body held only by contact (D) takes the Dirichlet data: its interface normal
+displacement is prescribed, which fixes its rigid motion along the normal, so its subproblem
+is well posed whatever the iterate. The body held by its supports (N) takes the Neumann
+data: the interface force D exerts on it. The transfer uses the mortar matrices of the pair
+(slave D, master N): u2_n = D^-1 (M u1_n - g~) and, for the traction lambda = D^-1 R2 of
 B2's reaction R2, the force on B1 is -M^T lambda, so no force is lost across non-matching
 meshes. The fixed point satisfies exactly the equations of the mortar Lagrange-multiplier
-method with B2 active (full contact): the iteration is an independent solver for them.
+method with D active (full contact): the iteration is an independent solver for them.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,8 +30,11 @@ from .coupling import multiplier_layout
 from .elasticity import Elasticity
 from .errors import ConvergenceError, GeometryError, InputError, MeshError, SolverError
 from .methods import Method
-from .problem import Solution, assemble_and_gather
-from .scenes import Scene
+from .pairs import PairData
+from .prepare import assemble_and_gather
+from .scenes import Body, Scene
+from .solution import Solution
+from .supports import body_blocks, check_held
 from .surfaces import GatheredSurface
 from .timers import Timers
 
@@ -60,7 +64,8 @@ class _BodySolver:
         self.A = K.createSubMatrix(dofs, dofs)
         if dirichlet is not None:
             # Collective: every rank calls it, with its own (possibly empty) rows.
-            self.A.zeroRowsColumns(dirichlet.astype(PETSc.IntType), diag=1.0)
+            # The stub asks for a Sequence; petsc4py takes an integer array.
+            self.A.zeroRowsColumns(dirichlet.astype(PETSc.IntType), diag=1.0)  # type: ignore[arg-type]
         self.ksp = PETSc.KSP().create(K.getComm())
         self.ksp.setOperators(self.A)
         self.ksp.setType("preonly")
@@ -75,7 +80,7 @@ class _BodySolver:
         b = rhs.getSubVector(self.dofs)
         self.ksp.solve(b, self.x)
         rhs.restoreSubVector(self.dofs, b)
-        reason = self.ksp.getConvergedReason()
+        reason = cast(int, self.ksp.getConvergedReason())  # an int; the stub says the enum class
         if reason <= 0 or not np.isfinite(self.x.norm()):
             raise SolverError(f"body solve (MUMPS) failed: PETSc reason {reason}")
         o = out.getSubVector(self.dofs)
@@ -114,12 +119,11 @@ class _OwnedNodes:
         return np.flatnonzero(owned), 2 * self.block[idx] + comp
 
 
-def body_dofs(el: Elasticity, scene: Scene, body: int) -> np.ndarray:
+def body_dofs(el: Elasticity, scene: Scene, body: Body) -> np.ndarray:
     """Owned local unrolled dofs (both components) of `body`."""
     V = el.V
     nloc = V.dofmap.index_map.size_local
-    cells = scene.cell_tags.find(scene.tags[f"body{body}"])
-    blocks = np.unique(V.dofmap.list[cells].ravel())
+    blocks = body_blocks(scene, V, body)
     blocks = blocks[blocks < nloc].astype(np.int64)
     return np.sort(np.concatenate([2 * blocks, 2 * blocks + 1]))
 
@@ -129,12 +133,13 @@ def _owned_global(V: fem.FunctionSpace, local: np.ndarray) -> np.ndarray:
 
 
 def _check_flat(s1: GatheredSurface, s2: GatheredSurface) -> None:
-    """Raise unless both contact lines are horizontal, B1's facing up and B2's facing down."""
-    for gs, sign, body in ((s1, 1.0, 1), (s2, -1.0, 2)):
+    """Raise unless both contact lines are horizontal and face each other."""
+    sign = float(np.sign(s1.surface.normals[0, 1]))
+    for gs, sg in ((s1, sign), (s2, -sign)):
         ny = gs.surface.normals[:, 1]
-        if np.any(np.abs(sign * ny - 1.0) > _FLAT_TOL):
-            raise InputError(f"schwarz supports full-contact block scenes only: contact{body} "
-                             "is not a horizontal line")
+        if sg == 0.0 or np.any(np.abs(sg * ny - 1.0) > _FLAT_TOL):
+            raise InputError("schwarz supports one straight horizontal contact line in full "
+                             "contact (it iterates on u_y): use nts, sts or mortar here")
 
 
 def _norm(D: sp.csr_matrix, v: np.ndarray) -> float:
@@ -151,24 +156,42 @@ def _failed(history: list[dict[str, float | None]], message: str) -> Convergence
 
 def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
                   timers: Timers | None = None) -> Solution:
-    """Solve a full-contact block scene by the relaxed Dirichlet-Neumann iteration."""
-    if scene.name != "blocks":
-        raise InputError("schwarz supports full-contact block scenes only "
-                         f"(got the '{scene.name}' scene, whose contact zone is unknown)")
+    """Solve a two-body full-contact scene by the relaxed Dirichlet-Neumann iteration.
+
+    Body N (held by its supports) takes Neumann data, body D (held only by the contact)
+    Dirichlet data; the contact line must be straight, horizontal and closed everywhere.
+    """
+    if len(scene.bodies) != 2 or len(scene.contacts) != 1:
+        raise InputError(f"schwarz supports two bodies with one contact pair (this scene has "
+                         f"{len(scene.bodies)} bodies and {len(scene.contacts)} pairs): use "
+                         "nts, sts or mortar")
     if not 0.0 < options.relaxation <= 2.0:
         raise InputError(f"relaxation must lie in (0, 2] (got {options.relaxation})")
     timers = timers or Timers()
     comm = scene.mesh.comm
-    el, ndofs, surf1, surf2 = assemble_and_gather(scene, (1, 2), timers)
+    el, ndofs, gathered = assemble_and_gather(scene, timers)
     V = el.V
+    pair, body_a, body_p, surf_act, surf_pas = gathered[0]
+    loose = check_held(scene, V, el.bc_dofs, [(body_a, body_p, surf_act)])
+    if len(loose) != 1:
+        raise InputError("schwarz needs one body held by its supports and one held only by "
+                         f"the contact ({'both are' if loose else 'neither is'} free): use "
+                         "nts, sts or mortar")
+    dirichlet_body = loose[0]
+    # surf1/surf2: the Neumann and the Dirichlet body's contact surfaces.
+    if dirichlet_body == body_a:
+        surf1, surf2, bodies = surf_pas, surf_act, (body_p, body_a)
+    else:
+        surf1, surf2, bodies = surf_act, surf_pas, (body_a, body_p)
     _check_flat(surf1, surf2)
     with timers("contact"):
-        # Transfer pair: B2 (the Dirichlet body) is the mortar slave, whatever scene.active is.
+        # Transfer pair: D (the Dirichlet body) is the mortar slave, whatever the active side.
         op2 = contact_operator(Method.MORTAR.operator, surf2.surface, surf1.surface, ndofs)
         D_all, M_all = mortar_matrices(surf2.surface, surf1.surface)
         keep = np.flatnonzero(op2.weights > 1e-12 * max(float(op2.weights.max(initial=0)), 1e-300))
         if keep.size == 0:
-            raise GeometryError("the contact surfaces contact1 and contact2 do not overlap")
+            raise GeometryError(f"the contact surfaces '{pair.active}' and '{pair.passive}' do "
+                                "not overlap")
         D = D_all[keep][:, keep].tocsc()
         M = M_all[keep].tocsr()
         D_lu = spla.splu(D)
@@ -176,10 +199,10 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         wgap = D @ y2[keep] - M @ y1
         h = float(np.median(op2.weights[keep]))
         if np.max(np.abs(wgap / op2.weights[keep])) > 1e-6 * h:
-            raise InputError("schwarz supports full-contact block scenes only: the bodies do "
-                             "not touch along the whole contact line (non-zero initial gap)")
-        # The reported multipliers live on the scene's active body, as for the other methods.
-        if scene.active == 2:
+            raise InputError("schwarz supports full-contact scenes only: the bodies do not "
+                             "touch along the whole contact line (non-zero initial gap)")
+        # The reported multipliers live on the pair's active body, as for the other methods.
+        if dirichlet_body == body_a:
             surf_a, op = surf2, op2
         else:
             surf_a = surf1
@@ -187,9 +210,10 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         layout, order = multiplier_layout(comm, surf_a, op)
 
     nodes1, nodes2 = _OwnedNodes(surf1, V), _OwnedNodes(surf2, V)
-    dofs = [body_dofs(el, scene, b) for b in (1, 2)]
+    dofs = [body_dofs(el, scene, b) for b in bodies]
     if comm.allreduce(int(np.intersect1d(dofs[0], dofs[1]).size)):
-        raise MeshError("bodies 1 and 2 share nodes: contact needs duplicated interface nodes")
+        raise MeshError(f"bodies '{bodies[0].name}' and '{bodies[1].name}' share nodes: contact "
+                        "needs duplicated interface nodes")
     pos_d, dof_d = nodes2.dofs(keep)          # B2 Dirichlet dofs (u_y), owned here
     pos_n, dof_n = nodes1.dofs(np.arange(nodes1.n))  # B1 Neumann dofs (f_y), owned here
 
@@ -198,7 +222,8 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
     f = el.f
     rhs, tmp = f.duplicate(), f.duplicate()
     history: list[dict[str, float | None]] = []
-    iss = [PETSc.IS().createGeneral(_owned_global(V, d), comm=comm) for d in dofs]
+    # The stub asks for a Sequence; petsc4py takes an integer array.
+    iss = [PETSc.IS().createGeneral(_owned_global(V, d), comm=comm) for d in dofs]  # type: ignore[arg-type]
     t_solve = time.perf_counter()
     with timers("solve"), timers("factorize"):
         # Where B2's Dirichlet dofs sit in its own block's numbering.
@@ -276,7 +301,7 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
 
     lam2 = np.zeros(surf2.surface.n_nodes)
     lam2[keep] = lam
-    if scene.active == 2:
+    if dirichlet_body == body_a:
         pressure = lam2[order]
     else:
         # Same force on B1's nodes, expressed as the traction of B1's own mortar multipliers.
@@ -293,7 +318,9 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         for comp in (0, 1):
             ufull[gs.surface.dofs[:, comp]] = nodes.read(u.x.array, comp)
     gap = (op.gap + op.B @ ufull)[order] / layout.weights
+    pd = PairData(0, pair, body_a, body_p, surf_act, surf_pas, op, 0)
     return Solution(scene, Method.SCHWARZ, el, u, layout, pressure=pressure, gap=gap,
                     active=np.ones(layout.size, dtype=bool), operator=op, order=order,
-                    surfaces=(surf1, surf2), iterations=len(history), history=history,
-                    timers=timers)
+                    pairs=[pd], iterations=len(history), history=history, timers=timers,
+                    info={"schwarz": {"dirichlet_body": dirichlet_body.name,
+                                      "solver": "mumps (each body factorized once)"}})

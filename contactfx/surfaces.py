@@ -37,18 +37,24 @@ def vertex_to_block(V: fem.FunctionSpace) -> np.ndarray:
     return v2b
 
 
-def gather_surface(scene: Scene, V: fem.FunctionSpace, body: int) -> GatheredSurface:
-    """Allgather the contact facets of `body` with coordinates, outward normals and dofs."""
+def owned_facets(scene: Scene, name: str) -> np.ndarray:
+    """Owned facets of the curve group `name`."""
+    msh = scene.mesh
+    tdim = msh.topology.dim
+    tag = scene.curve_tag(name, "contact")
+    assert scene.facet_tags is not None  # curve_tag found the group
+    facets = scene.facet_tags.find(tag)
+    return facets[facets < msh.topology.index_map(tdim - 1).size_local]
+
+
+def gather_surface(scene: Scene, V: fem.FunctionSpace, name: str) -> GatheredSurface:
+    """Allgather the facets of curve group `name` with coordinates, outward normals and dofs."""
     msh = V.mesh
     comm = msh.comm
     tdim = msh.topology.dim
-    name = f"contact{body}"
-    if name not in scene.tags:
-        raise MeshError(f"the mesh has no physical group '{name}'")
     msh.topology.create_connectivity(tdim - 1, 0)
     msh.topology.create_connectivity(tdim - 1, tdim)
-    facets = scene.facet_tags.find(scene.tags[name])
-    facets = facets[facets < msh.topology.index_map(tdim - 1).size_local]
+    facets = owned_facets(scene, name)
     f2v = msh.topology.connectivity(tdim - 1, 0)
     f2c = msh.topology.connectivity(tdim - 1, tdim)
     c2v = msh.topology.connectivity(tdim, 0)
@@ -99,7 +105,7 @@ def vertex_coordinates(msh: dolfinx.mesh.Mesh) -> np.ndarray:
     return xv
 
 
-def check_facing(active: Surface, passive: Surface, op: ContactOperator) -> None:
+def check_facing(active: Surface, passive: Surface, op: ContactOperator, label: str = "") -> None:
     """Raise GeometryError if the active nodes nearest the passive surface do not face it."""
     tol = 1e-12 * max(float(op.weights.max(initial=0.0)), 1e-300)
     nodes = np.flatnonzero(op.weights > tol)
@@ -115,6 +121,6 @@ def check_facing(active: Surface, passive: Surface, op: ContactOperator) -> None
         j = int(np.argmax(dot))
         xa = active.x[near[j]]
         angle = np.degrees(np.arccos(min(dot[j], 1.0)))
-        raise GeometryError(f"the contact surfaces do not face each other: at ({xa[0]:.4g}, "
+        raise GeometryError(f"the contact surfaces{label} do not face each other: at ({xa[0]:.4g}, "
                             f"{xa[1]:.4g}) the outward normals of the active and passive "
                             f"surfaces make an angle of {angle:.0f} degrees (180 expected)")

@@ -61,7 +61,7 @@ def say(*args: object) -> None:
 def unit(sol) -> float:
     """E_max / h: the natural penalty unit of a solution's mesh (MPa/cm)."""
     h = float(np.median(sol.layout.weights))
-    return max(m.E for m in sol.scene.materials) / h
+    return max(b.material.E for b in sol.scene.bodies) / h
 
 
 # -
@@ -82,7 +82,7 @@ for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
     eu = unit(ref)
     u_ref = ref.u.x.array.copy()
     u_scale = comm.allreduce(float(np.abs(u_ref).max()), op=MPI.MAX)
-    p_scale = params.p if kind == "blocks" else scene.extra["hertz_exact"]["p0"]
+    p_scale = params.p if kind == "blocks" else scene.params["hertz_exact"]["p0"]
     ref_l2 = hertz_summary(ref)["l2_error"] if kind == "hertz" else 0.0
     for factor in FACTORS:
         eps = factor * eu

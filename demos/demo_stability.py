@@ -35,7 +35,8 @@ from mpi4py import MPI
 from contactfx.methods import Method
 from contactfx.metrics import mismatch, patch_errors
 from contactfx.penalty import solve_penalty
-from contactfx.postprocess import body_stress_deviation, interface, surface_stress
+from contactfx.postprocess import body_stress_deviation, surface_stress
+from contactfx.postprocess import cartesian_interface as interface
 from contactfx.problem import solve_contact
 from contactfx.scenes import BLOCK_SCENES, build_scene
 
@@ -196,7 +197,7 @@ for name in OSC_SCENES:
                        "method": method.value,
                        "pressure": zigzag(xp, pp, 0.7 * xc, 0.95 * xc) / base.p}
                 for body in (1, 2):
-                    xs, s = surface_stress(sol, body)
+                    xs, s = surface_stress(sol, f"contact{body}")
                     row[f"sigma_yy_{body}"] = zigzag(xs, s, 0.7 * xc, 0.95 * xc) / base.p
                 row["mismatch_corner"] = mismatch(interface(sol), xc)["corner"] / base.p
                 osc.append(row)

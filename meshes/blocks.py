@@ -2,8 +2,6 @@
 
 import gmsh
 
-from contactfx.errors import InputError
-
 
 def _divisions(length: float, size: float) -> int:
     """Return the number of elements along an edge of `length` for target size `size`."""
@@ -12,7 +10,7 @@ def _divisions(length: float, size: float) -> int:
 
 def _body(
     xs: list[float], y0: float, y1: float, size: float, grading: float
-) -> tuple[list[int], dict[str, list[int]], list[tuple[int, int, float]], list[int]]:
+) -> tuple[list[int], dict[str, list[int]], list[tuple[int, int, float]], list[list[int]]]:
     """Add a row of rectangles [xs[i], xs[i+1]] x [y0, y1] sharing their vertical curves.
 
     Returns the surfaces, the boundary curves by side, the transfinite curve data
@@ -51,7 +49,7 @@ def build_blocks(
 ) -> None:
     """Add the two-block half model (S1-S4) to the current gmsh model and mesh it with quads."""
     if min(l1, l2, h1, h2, size1, size2, grading1, grading2) <= 0.0:
-        raise InputError("block dimensions, mesh sizes and gradings must be positive")
+        raise ValueError("block dimensions, mesh sizes and gradings must be positive")
     half1, half2 = 0.5 * l1, 0.5 * l2
     # The narrower body's corner must be a node of the wider body's contact edge, so the
     # wider body is built from two rectangles split there (conforming inside the body).

@@ -4,8 +4,6 @@ import math
 
 import gmsh
 
-from contactfx.errors import InputError, MeshError
-
 # Growth of the element size with distance from the refined zone (size per unit distance).
 # The elastic field decays like 1/r in 2D, so every decade of distance adds about the same
 # discretization error: the slope, not the far size, sets the error in the compliance.
@@ -34,11 +32,11 @@ def build_hertz(
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
     if min(R, width, height, h_contact, r_refine, h_far, slope) <= 0.0:
-        raise InputError("radius, block size, mesh sizes, r_refine and slope must be positive")
+        raise ValueError("radius, block size, mesh sizes, r_refine and slope must be positive")
     if edge is not None and not (0.0 <= edge[0] < width and edge[1] > 0.0):
-        raise InputError(f"edge = {edge}: need 0 <= x_edge < width and h_edge > 0")
+        raise ValueError(f"edge = {edge}: need 0 <= x_edge < width and h_edge > 0")
     if not 0.0 < extent < min(width, R):
-        raise InputError(f"contact_extent={extent} must lie in (0, min(width, R))")
+        raise ValueError(f"contact_extent={extent} must lie in (0, min(width, R))")
     h_far = max(h_far, h_contact)
     # Plain floats: numpy scalars would print as np.float64(...) in the gmsh expression.
     R, height, h_contact, r_refine, h_far, slope = map(
@@ -124,4 +122,4 @@ def build_hertz(
 
     types, _, _ = gmsh.model.mesh.getElements(2)
     if any(t != _QUAD4 for t in types):
-        raise MeshError(f"Hertz mesh has non-quadrilateral elements (gmsh types {list(types)})")
+        raise ValueError(f"Hertz mesh has non-quadrilateral elements (gmsh types {list(types)})")

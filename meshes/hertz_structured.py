@@ -1,4 +1,4 @@
-"""Hertz scene (S5) on a structured graded quad mesh, built directly in DOLFINx (no gmsh).
+"""Hertz scene (S5) as a structured graded quad grid (numpy only; loaded by contactfx).
 
 gmsh's frontal quad mesher with Blossom recombination takes about 45 s for 470k elements on
 this machine class, too slow for the 1-2 million dof benchmarks. This mesh is a tensor
@@ -13,36 +13,11 @@ scaling study needs. Far from the contact the cells are stretched (up to h_far/h
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
-import basix.ufl
 import numpy as np
-import ufl
-from dolfinx import mesh as dmesh
-from mpi4py import MPI
 
-from contactfx.errors import InputError
-
-if TYPE_CHECKING:
-    from contactfx.scenes import HertzParams, Scene
-
-# Physical groups, numbered like the gmsh scene's names (the numbers themselves are free).
-TAGS = {"body1": 1, "body2": 2, "contact1": 3, "contact2": 4, "symmetry": 5, "support": 6,
-        "load": 7}
 # The inner square of the disc's butterfly, as a fraction of R.
 _SQUARE = 0.4
-
-
-@dataclass(frozen=True)
-class StructuredMesh:
-    """A distributed mesh with its cell and facet tags (names in `physical_groups`)."""
-
-    mesh: dmesh.Mesh
-    cell_tags: dmesh.MeshTags
-    facet_tags: dmesh.MeshTags
-    physical_groups: dict[str, int]
 
 
 def graded_points(length: float, h0: float, r: float, slope: float, h_far: float) -> np.ndarray:
@@ -50,7 +25,7 @@ def graded_points(length: float, h0: float, r: float, slope: float, h_far: float
     h_far = max(h_far, h0)
     s1 = r + (h_far - h0) / slope
 
-    def count(s: np.ndarray) -> np.ndarray:
+    def count(s: float | np.ndarray) -> np.ndarray:
         # Number of cells between 0 and s: the integral of 1 / h(s).
         s = np.asarray(s, dtype=float)
         grow = np.log((h0 + slope * (np.clip(s, r, s1) - r)) / h0) / slope
@@ -96,13 +71,16 @@ def hertz_grid(R: float, width: float, height: float, h_contact: float, r_refine
     nw = max(1, math.ceil(0.25 * math.pi * R / h_far))
     w = np.linspace(0.0, 1.0, nw + 1)
     C = np.array([0.0, yc])
-    D, F, G = C + [0.0, -d], C + [d, -d], C + [d, 0.0]
-    Pb, P45, Pr = C + [0.0, -R], C + R * np.array([math.sqrt(0.5), -math.sqrt(0.5)]), C + [R, 0.0]
+    D, F, G = C + np.array([0.0, -d]), C + np.array([d, -d]), C + np.array([d, 0.0])
+    Pb, P45, Pr = (C + np.array([0.0, -R]), C + R * np.array([math.sqrt(0.5), -math.sqrt(0.5)]),
+                   C + np.array([R, 0.0]))
 
     def arc(theta: np.ndarray) -> np.ndarray:
         return C + R * np.column_stack([np.cos(theta), np.sin(theta)])
 
-    def coons(bottom, top, left, right, corners, s, t):
+    def coons(bottom: np.ndarray, top: np.ndarray, left: np.ndarray, right: np.ndarray,
+              corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], s: np.ndarray,
+              t: np.ndarray) -> np.ndarray:
         # Transfinite interpolation of four boundary curves, s along bottom/top, t along sides.
         S, T = s[:, None, None], t[None, :, None]
         c00, c10, c01, c11 = corners
@@ -141,76 +119,3 @@ def hertz_grid(R: float, width: float, height: float, h_contact: float, r_refine
     disc_cells = np.vstack([_quads(ida), _quads(idb), _quads(ids)]) + len(block_x)
     x = np.vstack([block_x, disc_x])
     return x, np.vstack([block_cells, disc_cells]), len(block_cells)
-
-
-def build_hertz_structured(comm: MPI.Comm, R: float, width: float, height: float,
-                           h_contact: float, r_refine: float, h_far: float | None = None,
-                           slope: float = 0.1, contact_extent: float | None = None,
-                           partitioner: Callable | None = None) -> StructuredMesh:
-    """The Hertz half model (quarter disc on a block) as a distributed structured quad mesh."""
-    h_far = R / 6.0 if h_far is None else h_far
-    extent = min(width, R / 4.0) if contact_extent is None else contact_extent
-    if min(R, width, height, h_contact, h_far, slope) <= 0.0 or r_refine < 0.0:
-        raise InputError("radius, block size, mesh sizes and slope must be positive")
-    if not 0.0 < extent < min(width, R):
-        raise InputError(f"contact_extent={extent} must lie in (0, min(width, R))")
-    if comm.rank == 0:
-        x, cells, n_block = hertz_grid(R, width, height, h_contact, r_refine, h_far, slope)
-    else:
-        x, cells, n_block = np.zeros((0, 2)), np.zeros((0, 4), dtype=np.int64), 0
-    n_block = comm.bcast(n_block, root=0)
-    element = ufl.Mesh(basix.ufl.element("Lagrange", "quadrilateral", 1, shape=(2,)))
-    if partitioner is None:
-        from meshes import balanced_partitioner
-
-        partitioner = balanced_partitioner(np.column_stack([x, np.zeros(len(x))]))
-    msh = dmesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
-    tdim = msh.topology.dim
-    ncells = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
-    body = np.where(np.asarray(msh.topology.original_cell_index)[:ncells] < n_block, 1, 2)
-    cell_tags = dmesh.meshtags(msh, tdim, np.arange(ncells, dtype=np.int32),
-                               body.astype(np.int32))
-    msh.topology.create_connectivity(tdim - 1, tdim)
-    facets = dmesh.exterior_facet_indices(msh.topology)
-    f2c = msh.topology.connectivity(tdim - 1, tdim)
-    fbody = body[f2c.array[f2c.offsets[facets]]]
-    xf = msh.geometry.x[dmesh.entities_to_geometry(msh, tdim - 1, facets)][:, :, :2]
-    both = lambda cond: cond.all(axis=1)  # noqa: E731
-    yc = height + R
-    mid_x = xf[:, :, 0].mean(axis=1)
-    on_arc = np.abs(np.hypot(xf[:, :, 0], xf[:, :, 1] - yc) - R) <= 1e-10 * R
-    values = np.zeros(len(facets), dtype=np.int32)
-    rules = [
-        (fbody == 1, both(xf[:, :, 1] == height) & (mid_x <= extent), "contact1"),
-        (fbody == 2, both(on_arc) & (mid_x <= extent), "contact2"),
-        (fbody > 0, both(xf[:, :, 0] == 0.0), "symmetry"),
-        (fbody == 1, both(xf[:, :, 1] == 0.0), "support"),
-        (fbody == 2, both(xf[:, :, 1] == yc), "load"),
-    ]
-    for in_body, cond, name in rules:
-        values[(values == 0) & in_body & cond] = TAGS[name]
-    keep = values > 0
-    order = np.argsort(facets[keep])
-    facet_tags = dmesh.meshtags(msh, tdim - 1, facets[keep][order].astype(np.int32),
-                                values[keep][order])
-    return StructuredMesh(msh, cell_tags, facet_tags, dict(TAGS))
-
-
-def hertz_structured_scene(params: HertzParams, comm: MPI.Comm = MPI.COMM_WORLD,
-                           h_far: float | None = None, slope: float = 0.1,
-                           active: int = 2) -> Scene:
-    """A contactfx Scene of `params` (HertzParams) on the structured mesh (refine = h_contact)."""
-    from dataclasses import replace
-
-    from contactfx.scenes import Material, Scene, hertz_exact, validate
-
-    validate(params)
-    exact = hertz_exact(params)
-    if params.r_refine == 0.0:
-        params = replace(params, r_refine=round(1.4 * exact["a"], 6))
-    data = build_hertz_structured(comm, params.R, params.width, params.height, params.refine,
-                                  params.r_refine, h_far, slope)
-    materials = (Material(params.E1, params.nu1), Material(params.E2, params.nu2))
-    extra = {"hertz_exact": exact, "mesh": "structured", "h_far": h_far, "slope": slope}
-    return Scene("hertz", params, data.mesh, data.cell_tags, data.facet_tags,
-                 data.physical_groups, materials, params.P / (2 * params.R), active, extra)

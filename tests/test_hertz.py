@@ -1,9 +1,6 @@
 """Hertz scene (S5) against the exact plane-strain solution; the active-set loop's behaviour."""
 
 import json
-import os
-import subprocess
-import sys
 import textwrap
 from pathlib import Path
 
@@ -157,14 +154,12 @@ if MPI.COMM_WORLD.rank == 0:
 """
 
 
-def test_mpi_equals_serial(tmp_path: Path) -> None:
+@pytest.mark.mpi
+def test_mpi_equals_serial(tmp_path: Path, mpi_script) -> None:
     script = tmp_path / "hertz_mpi.py"
     script.write_text(textwrap.dedent(MPI_SCRIPT))
     out = tmp_path / "mpi.json"
-    mpirun = str(Path(sys.executable).parent / "mpirun")
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
-    subprocess.run([mpirun, "-n", "2", sys.executable, "-m", "mpi4py", str(script), str(out)],
-                   check=True, env=env, timeout=120)
+    mpi_script(script, str(out), timeout=120)
     par = json.loads(out.read_text())
     assert par["ranks"] == 2
     _, ser = run_case("hertz", HertzParams(refine=0.08, refine_edge=0.02, slope=0.2), "mortar",

@@ -1,8 +1,5 @@
 """Scene meshes: cell type, physical groups, duplicated interface nodes, contact lines, MPI."""
 
-import os
-import subprocess
-import sys
 import textwrap
 from functools import partial
 from pathlib import Path
@@ -14,7 +11,8 @@ from dolfinx.io.gmsh import MeshData
 from dolfinx.mesh import CellType, entities_to_geometry
 from mpi4py import MPI
 
-from meshes import balanced_partitioner, build_blocks, build_hertz, to_dolfinx
+from contactfx.scenes.gmsh_io import balanced_partitioner, to_dolfinx
+from meshes import build_blocks, build_hertz
 
 NAMES = {"body1", "body2", "contact1", "contact2", "symmetry", "support", "load"}
 # (l1, l2, h1, h2, size1, size2, grading1, grading2) of the block scenes
@@ -155,7 +153,8 @@ import dolfinx_solver  # noqa: F401
 import numpy as np
 from functools import partial
 from mpi4py import MPI
-from meshes import balanced_partitioner, build_blocks, to_dolfinx
+from contactfx.scenes.gmsh_io import balanced_partitioner, to_dolfinx
+from meshes import build_blocks
 
 comm = MPI.COMM_WORLD
 md = to_dolfinx(comm, partial(build_blocks, {args}), balanced_partitioner())
@@ -179,21 +178,10 @@ print("OK", comm.rank, counts, flush=True)
 
 
 @pytest.mark.mpi
-def test_balanced_partition_under_mpirun(tmp_path: Path) -> None:
-    mpirun = Path(sys.executable).parent / "mpirun"
-    if not mpirun.exists():
-        pytest.skip(f"no mpirun next to {sys.executable}")
+def test_balanced_partition_under_mpirun(tmp_path: Path, mpi_script) -> None:
     script = tmp_path / "partition.py"
     script.write_text(textwrap.dedent(MPI_SCRIPT.format(args=", ".join(map(str, S1)))))
-    root = str(Path(__file__).resolve().parents[1])
-    env = os.environ | {
-        "OPENBLAS_NUM_THREADS": "1",
-        "OMP_NUM_THREADS": "1",
-        "PYTHONPATH": os.pathsep.join(filter(None, [root, os.environ.get("PYTHONPATH")])),
-    }
-    cmd = [str(mpirun), "-n", "2", sys.executable, "-m", "mpi4py", str(script)]
-    run = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
-    assert run.returncode == 0, run.stdout + run.stderr
+    run = mpi_script(script, timeout=120)
     assert run.stdout.count("OK") == 2, run.stdout
 
 

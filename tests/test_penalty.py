@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 from dataclasses import replace
@@ -12,17 +11,17 @@ from pathlib import Path
 import dolfinx_solver  # noqa: F401
 import numpy as np
 import pytest
+from conftest import ENV, MPIRUN
 from mpi4py import MPI
 
 from contactfx.api import run_case
 from contactfx.metrics import patch_errors
 from contactfx.penalty import DEFAULT_FACTOR, penetration
-from contactfx.postprocess import body_stress_deviation
+from contactfx.postprocess import body_stress_deviation, u_at_points
 from contactfx.scenes import BLOCK_SCENES, HertzParams
 
 S4 = replace(BLOCK_SCENES["S4"], size1=0.3, size2=0.4)
 HERTZ = HertzParams(refine=0.1)
-ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
 
 @pytest.mark.parametrize("active", [1, 2])
@@ -84,10 +83,9 @@ def test_cli_json_has_penalty_and_penetration(tmp_path: Path) -> None:
 def test_penalty_mpi_matches_serial(tmp_path: Path) -> None:
     args = ["-m", "contactfx", "solve", "hertz", "--refine", "0.1", "--method", "penalty",
             "--penalty", "1e6", "-q", "--json"]
-    mpirun = str(Path(sys.executable).parent / "mpirun")
     subprocess.run([sys.executable, *args, str(tmp_path / "s.json")], check=True, env=ENV,
                    timeout=120)
-    subprocess.run([mpirun, "-n", "2", sys.executable, *args, str(tmp_path / "m.json")],
+    subprocess.run([MPIRUN, "-n", "2", sys.executable, *args, str(tmp_path / "m.json")],
                    check=True, env=ENV, timeout=300)
     s, m = (json.loads((tmp_path / f"{k}.json").read_text()) for k in "sm")
     assert m["ranks"] == 2
@@ -97,6 +95,19 @@ def test_penalty_mpi_matches_serial(tmp_path: Path) -> None:
     assert m["penetration"] == pytest.approx(s["penetration"], rel=1e-8)
 
 
-def test_penalty_of_default_matches_penetration_helper() -> None:
+def test_default_penalty_penetration_is_load_over_stiffness() -> None:
+    """The default eps (1e3 E_max / h) carries the uniform S4 pressure with the uniform
+    penetration p / eps, measured on the displacement field itself (not on the gap)."""
     sol, data = run_case("blocks", S4, "penalty", comm=MPI.COMM_SELF)
-    assert penetration(sol) == data["penetration"] > 0
+    eps = data["penalty"]
+    # Jump of u_y across the interface at the multiplier nodes (x sorted, both bodies).
+    u = u_at_points(sol)
+    at_line = np.abs(u[:, 1] - S4.h1) < 1e-9
+    uy = u[at_line]
+    x_nodes = np.unique(np.round(uy[:, 0], 9))
+    lower = [uy[(np.abs(uy[:, 0] - x) < 1e-9), 3] for x in x_nodes]
+    # Where both bodies have a node at the same x the jump is the penetration there.
+    jumps = [abs(v.max() - v.min()) for v in lower if len(v) == 2]
+    assert jumps, "no coincident interface nodes to compare"
+    assert np.allclose(jumps, S4.p / eps, rtol=1e-6)
+    assert penetration(sol) == pytest.approx(S4.p / eps, rel=1e-8)

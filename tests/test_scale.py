@@ -15,18 +15,19 @@ from mpi4py import MPI
 from contactfx.elasticity import material_fields, sigma
 from contactfx.methods import Method
 from contactfx.nullspace import rigid_body_modes
-from contactfx.problem import ActiveSetOptions, prepare_contact, solve_contact
+from contactfx.prepare import prepare_contact
+from contactfx.problem import ActiveSetOptions, solve_contact
 from contactfx.saddle import SaddleSolver, solve_saddle
-from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene
+from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
 from contactfx.timers import Timers
-from meshes.hertz_structured import graded_points, hertz_grid, hertz_structured_scene
+from meshes.hertz_structured import graded_points, hertz_grid
 
 
 @pytest.fixture(scope="module")
 def hertz_system():
     """K, B, f and the weighted gaps of the default Hertz scene with mortar (small)."""
     scene = build_scene("hertz", HertzParams())
-    setup = prepare_contact(scene, "mortar", ActiveSetOptions(), Timers())
+    setup = prepare_contact(scene, "mortar", ActiveSetOptions().penetration_tol, Timers())
     yield setup.elasticity, setup.B, setup.g, setup.layout.x[setup.layout.mine, 0]
     setup.B.destroy()
 
@@ -175,12 +176,12 @@ def test_structured_hertz_geometry_and_contact() -> None:
     # The polygonal arc cuts off at most (chord^3 / 12 R) per facet: under 0.1%.
     assert area[n_block:].sum() == pytest.approx(math.pi * 900.0, rel=1e-3)
     assert len(np.unique(cells)) == len(x)  # no orphan nodes
-    scene = hertz_structured_scene(HertzParams(refine=0.05), h_far=2.0)
+    scene = hertz(HertzParams(refine=0.05, h_far=2.0, mesh="structured"))
     for name in ("contact1", "contact2", "symmetry", "support", "load"):
-        n = MPI.COMM_WORLD.allreduce(len(scene.facet_tags.find(scene.tags[name])))
+        n = MPI.COMM_WORLD.allreduce(len(scene.facet_tags.find(scene.groups.by_name[name][1])))
         assert n > 0, name
     sol = solve_contact(scene, Method.MORTAR, "mumps")
-    a_exact = scene.extra["hertz_exact"]["a"]
+    a_exact = scene.params["hertz_exact"]["a"]
     xs = sol.layout.x[sol.active, 0]
     # Half-width within one contact element of Hertz's a.
     assert abs(xs.max() - a_exact) < 0.05 + 1e-9
@@ -195,9 +196,9 @@ MPI_SCRIPT = textwrap.dedent("""
     from contactfx.methods import Method
     from contactfx.problem import solve_contact
     from contactfx.scenes import HertzParams
-    from meshes.hertz_structured import hertz_structured_scene
+    from contactfx.scenes import hertz
 
-    scene = hertz_structured_scene(HertzParams(refine=0.05), h_far=2.0)
+    scene = hertz(HertzParams(refine=0.05, h_far=2.0, mesh="structured"))
     sol = solve_contact(scene, Method.MORTAR, sys.argv[2])
     if MPI.COMM_WORLD.rank == 0:
         np.savez(sys.argv[1], p=sol.pressure, x=sol.layout.x, it=sol.iterations)
@@ -222,8 +223,8 @@ def test_structured_hertz_two_ranks_equal_serial(tmp_path, mpi_script, solver) -
 @pytest.fixture(scope="module")
 def structured_pair():
     """A structured Hertz scene (70k dofs, 58 active nodes) and the same scene 8x coarser."""
-    fine = hertz_structured_scene(HertzParams(refine=0.025), h_far=1.0)
-    coarse = hertz_structured_scene(HertzParams(refine=0.2), h_far=8.0)
+    fine = hertz(HertzParams(refine=0.025, h_far=1.0, mesh="structured"))
+    coarse = hertz(HertzParams(refine=0.2, h_far=8.0, mesh="structured"))
     return fine, coarse
 
 
@@ -253,7 +254,7 @@ def test_coarse_predictor_same_answer_one_factorization(structured_pair, method)
 def test_any_initial_set_converges_to_the_same_answer(structured_pair, guess) -> None:
     """A wrong first set (a subset, a wide superset, empty) costs iterations, not accuracy."""
     fine, _ = structured_pair
-    a = fine.extra["hertz_exact"]["a"]
+    a = fine.params["hertz_exact"]["a"]
     radius = {"inside": 0.5 * a, "far": 3.0 * a, "nothing": -1.0}[guess]
     plain = solve_contact(fine, Method.MORTAR, "mumps")
     sol = solve_contact(fine, Method.MORTAR, "mumps",

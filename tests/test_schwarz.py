@@ -132,10 +132,13 @@ def test_logs_every_iteration(caplog) -> None:
 
 
 def test_hertz_is_rejected() -> None:
-    """The contact zone of Hertz is unknown: Schwarz refuses it with an InputError."""
+    """Hertz's contact line is curved (and its zone unknown): Schwarz refuses it clearly."""
+    from contactfx.scenes import HertzParams
+
+    hertz = build_scene("hertz", HertzParams(refine=0.2, refine_edge=0.0))
+    with pytest.raises(InputError, match="straight horizontal contact line"):
+        solve_schwarz(hertz)
     scene = build_scene("blocks", BLOCK_SCENES["S1"])
-    with pytest.raises(InputError, match="full-contact block scenes only"):
-        solve_schwarz(replace(scene, name="hertz"))
     with pytest.raises(InputError, match="relaxation"):
         solve_schwarz(scene, SchwarzOptions(relaxation=0.0))
 

@@ -125,6 +125,7 @@ class SegmentSearch:
         t = np.zeros(npts)
         if m == 0 or npts == 0:
             return seg, t, np.zeros(npts, dtype=bool)
+        assert self._tree is not None  # built whenever there are segments
         nsamples = len(self._owner)
         todo = np.arange(npts)
         if group > 1 and npts % group == 0 and 2 * _FIRST_K < nsamples:
@@ -155,6 +156,7 @@ class SegmentSearch:
         self, points: np.ndarray, group: int, seg: np.ndarray, t: np.ndarray
     ) -> np.ndarray:
         """First round shared by runs of `group` points; returns the unsettled point ids."""
+        assert self._tree is not None  # only called by closest() with segments present
         k = 2 * _FIRST_K
         centre = points.reshape(-1, group, 2).mean(axis=1)
         spread = np.linalg.norm(points - np.repeat(centre, group, axis=0), axis=1)
@@ -239,7 +241,7 @@ def chains(surface: Surface) -> Chains:
     key = np.minimum(s0, s1) * n + np.maximum(s0, s1)
     key_order = np.argsort(key, kind="stable")
     adj = sp.coo_matrix((np.ones(m), (s0, s1)), shape=(n, n)).tocsr()
-    ncomp, label = connected_components(adj, directed=False)
+    _, label = connected_components(adj, directed=False)
     seg_comp = label[s0]
     order, position = np.empty(m, np.int64), np.empty(m, np.int64)
     start, length = np.empty(m, np.int64), np.empty(m, np.int64)

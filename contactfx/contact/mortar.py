@@ -1,4 +1,40 @@
-"""Segment-based mortar: active segments cut into sub-segments each facing one passive segment."""
+"""Segment-based mortar: active segments cut into sub-segments each facing one passive segment.
+
+Multiplier bases (`basis=`): "standard" weights row j with the active shape function N_j;
+"dual" weights it with the biorthogonal function psi_j (Wohlmuth's dual mortar), which makes
+D = int psi_j N_k diagonal so that a solver can eliminate the multipliers.
+
+Dual basis, per active segment e and from the integrals over its OVERLAPPED part only (the
+union of its sub-segments; "consistent" duals, A_e = D_e M_e^-1 with D_e = diag int N_k and
+M_e = int N_j N_k, so int psi_j N_k = delta_jk int N_k holds there exactly). About the overlap
+centroid xbar (mean of xi over the overlap) this reads
+
+    psi_0 = N_0(xbar) - beta (xi - xbar),  psi_1 = N_1(xbar) + beta (xi - xbar),
+    beta = N_0(xbar) N_1(xbar) / var(xi),
+
+which is how it is computed (`_dual_affine`): in the basis (1, xi - xbar), whose Gram matrix is
+diagonal, instead of inverting M_e, whose two rows become nearly parallel on short overlaps.
+psi_0 + psi_1 = 1, so a constant is reproduced, and int psi_j = int N_j: the dual weights equal
+the standard ones. On a fully overlapped segment xbar = 1/2, var = 1/12 and
+psi = (2 - 3 xi, 3 xi - 1).
+
+Near-singular M_e: the dipole strength kappa = beta * std(xi) is <= sqrt(3) whenever the overlap
+touches a node of the segment (every partly overlapped segment at a surface end), but grows like
+1 / (overlap length) for an overlap lying strictly inside the segment (a passive surface much
+shorter than one active segment); round-off in psi grows with it. Segments with
+kappa > DUAL_MAX_DIPOLE (an inner overlap shorter than ~1e-4 of the segment) are DROPPED from
+the dual operator and from its D, M and weights: keeping them with the standard or lumped
+choice would break the diagonal D that the dual basis exists for (and lumping would make the
+two rows of the segment proportional). The dropped overlap is reported by `dual_coefficients`.
+
+End nodes of the active surface: a node with no overlap gets no row (weight 0), as in the
+standard basis. Nodes on partly overlapped end segments keep their own multiplier, with the
+consistent psi above. Wohlmuth's end modification (dropping the end multiplier and setting the
+neighbour's psi to 1 on the end segment) is NOT applied: it is meant for end nodes that carry no
+multiplier (crosspoints, Dirichlet ends), which this kernel does not know about, and it would put
+an entry D_(j, end) off the diagonal. Without it every segment still has psi_0 + psi_1 = 1, so
+the patch test stays exact.
+"""
 
 from __future__ import annotations
 
@@ -13,6 +49,11 @@ GAUSS_POINTS = 2
 # Sub-segments shorter than this fraction of their active segment are round-off slivers (an
 # active node sitting on a cut line) and are dropped.
 SLIVER = 1e-12
+# Multiplier bases of `contact_operator` and `mortar_matrices`.
+BASES = ("standard", "dual")
+# Largest dual dipole strength kappa kept (see the module docstring). psi reaches ~sqrt(3) kappa
+# on the overlap and its integrals lose ~kappa * 1e-16 to round-off: ~1e-12 at this bound.
+DUAL_MAX_DIPOLE = 1e4
 
 
 def _chain_ranges(
@@ -130,7 +171,7 @@ def subsegments(
 
 
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """z component of the 2D cross product, row by row."""
+    """The z component of the 2D cross product, row by row."""
     return u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
 
 
@@ -155,10 +196,88 @@ def _gauss_points(
     return seg_a, seg_p, xi, eta, w
 
 
+def _check_basis(basis: str) -> None:
+    """Reject an unknown multiplier basis name."""
+    if basis not in BASES:
+        raise ValueError(f"unknown multiplier basis {basis!r} (known: {', '.join(BASES)})")
+
+
+def _overlap_moments(
+    n_segments: int, seg_a: np.ndarray, xi: np.ndarray, w: np.ndarray
+) -> tuple[np.ndarray, ...]:
+    """Per active segment: int 1, int N_k (m, 2), centroid c, int (xi - c), int (xi - c)^2."""
+
+    def total(v: np.ndarray) -> np.ndarray:
+        return np.bincount(seg_a, weights=w * v, minlength=n_segments)
+
+    # Gauss sums, exact for these (at most quadratic) integrands. The first moment about the
+    # rounded centroid is kept: beta times it would otherwise be an O(eps / overlap) error.
+    size = total(np.ones_like(xi))
+    d = np.stack([total(sh) for sh in linear_shape(xi).T], axis=1)
+    c = d[:, 1] / np.where(size > 0, size, 1.0)
+    t = xi - c[seg_a]
+    return size, d, c, total(t), total(t * t)
+
+
+def _dual_affine(
+    n_segments: int, seg_a: np.ndarray, xi: np.ndarray, w: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """psi_j = a[:, j] + b[:, j] (xi - c) on each segment: (a, b, c, usable)."""
+    # int psi_j = int N_j and int psi_j (xi - c) = int psi_j (N_1 - c) = (delta_j1 - c) int N_j
+    # (biorthogonality) fix (a_j, b_j) through the Gram matrix [[int 1, t1], [t1, t2]] of
+    # (1, xi - c); t1 is round-off, so det = int 1 * t2 - t1^2 suffers no cancellation.
+    size, d, c, t1, t2 = _overlap_moments(n_segments, seg_a, xi, w)
+    det = size * t2 - t1 * t1
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = np.stack([d[:, 0] * (t2 + t1 * c), d[:, 1] * (t2 - t1 * (1.0 - c))], axis=1)
+        b = np.stack([-d[:, 0] * (t1 + c * size), d[:, 1] * (size * (1.0 - c) - t1)], axis=1)
+        a, b = a / det[:, None], b / det[:, None]
+        kappa = d[:, 0] * d[:, 1] / (size * np.sqrt(size * t2))
+    usable = (size > 0) & (det > 0) & (kappa <= DUAL_MAX_DIPOLE)
+    a[~usable] = b[~usable] = 0.0
+    return a, b, c, usable
+
+
+def _dual_values(
+    n_segments: int, seg_a: np.ndarray, xi: np.ndarray, w: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """psi_0, psi_1 at the points (p, 2) and which points lie on usable segments."""
+    a, b, c, usable = _dual_affine(n_segments, seg_a, xi, w)
+    t = (xi - c[seg_a])[:, None]
+    return a[seg_a] + b[seg_a] * t, usable[seg_a]
+
+
+def _multiplier_points(
+    active: Surface, passive: Surface, basis: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Gauss points (seg_a, seg_p, xi, eta, w) and the multiplier shape values there (p, 2)."""
+    _check_basis(basis)
+    seg_a, seg_p, xi, eta, w = _gauss_points(active, passive)
+    if basis == "standard":
+        return seg_a, seg_p, xi, eta, w, linear_shape(xi)
+    psi, keep = _dual_values(active.n_segments, seg_a, xi, w)
+    # Whole segments are dropped, so the runs of GAUSS_POINTS points stay intact.
+    return seg_a[keep], seg_p[keep], xi[keep], eta[keep], w[keep], psi[keep]
+
+
+def dual_coefficients(active: Surface, passive: Surface) -> tuple[np.ndarray, np.ndarray]:
+    """Dual coefficients A (m, 2, 2), psi_j = sum_k A[e, j, k] N_k on segment e, and usable (m,)."""
+    # A[e, j, k] is the value of psi_j at node k. Segments with no overlap or dropped as near
+    # singular (usable False) have A = 0.
+    seg_a, _, xi, _, w = _gauss_points(active, passive)
+    a, b, c, usable = _dual_affine(active.n_segments, seg_a, xi, w)
+    node_xi = np.array([0.0, 1.0])
+    A = a[:, :, None] + b[:, :, None] * (node_xi - c[:, None])[:, None, :]
+    return A, usable
+
+
 def overlap_weights(
     active: Surface, passive: Surface, near: np.ndarray | None = None
 ) -> np.ndarray:
-    """int N_j dGamma over the part of the active surface facing the passive one, (n_active,)."""
+    """Integrals of N_j dGamma over the part of the active surface facing the passive one.
+
+    Returns an array of shape (n_active,).
+    """
     seg_a, _, xi_int = subsegments(active, passive, near)
     lo, hi = xi_int[:, 0], xi_int[:, 1]
     length = segment_lengths(active)[seg_a]
@@ -172,10 +291,13 @@ def overlap_weights(
     )
 
 
-def mortar_matrices(active: Surface, passive: Surface) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-    """D = int N_j N_k (n_active x n_active) and M = int N_j N_A (n_active x n_passive)."""
-    seg_a, seg_p, xi, eta, w = _gauss_points(active, passive)
-    nj = linear_shape(xi) * w[:, None]
+def mortar_matrices(
+    active: Surface, passive: Surface, basis: str = "standard"
+) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """D = int phi_j N_k (n_active x n_active), M = int phi_j N_A (n_active x n_passive)."""
+    # phi = N (standard) or psi (dual: D is diagonal up to round-off; a solver takes D.diagonal()).
+    seg_a, seg_p, xi, eta, w, phi = _multiplier_points(active, passive, basis)
+    nj = phi * w[:, None]
     rows = active.segments[seg_a]
     d_vals = nj[:, :, None] * linear_shape(xi)[:, None, :]
     m_vals = nj[:, :, None] * linear_shape(eta)[:, None, :]
@@ -190,9 +312,12 @@ def mortar_matrices(active: Surface, passive: Surface) -> tuple[sp.csr_matrix, s
     return D, M
 
 
-def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOperator:
+def contact_operator(
+    active: Surface, passive: Surface, ndofs: int, basis: str = "standard"
+) -> ContactOperator:
     """Mortar operator: exact Gauss integration on sub-segments, normal of the paired segment."""
-    seg_a, seg_p, xi, eta, w = _gauss_points(active, passive)
+    # Row j = int phi_j n . (x_active - x_passive), phi = N_j (standard) or psi_j (dual).
+    seg_a, seg_p, xi, eta, w, phi = _multiplier_points(active, passive, basis)
     na = linear_shape(xi)
     nodes = active.segments[seg_a]
     return assemble(
@@ -200,7 +325,7 @@ def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOp
         passive,
         ndofs,
         rows=nodes,
-        row_coef=w[:, None] * na,
+        row_coef=w[:, None] * phi,
         act_nodes=nodes,
         act_coef=na,
         pas_nodes=passive.segments[seg_p],

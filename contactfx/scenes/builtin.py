@@ -1,0 +1,201 @@
+"""The paper's scenes as small functions returning a Scene: blocks (S1-S4) and Hertz (S5)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, replace
+from functools import partial
+from typing import TYPE_CHECKING, Any
+
+from mpi4py import MPI
+
+from meshes import build_blocks, build_hertz
+
+from ..errors import InputError
+from .gmsh_io import balanced_partitioner, to_dolfinx
+from .model import (
+    Body,
+    ContactPair,
+    Dirichlet,
+    Groups,
+    HertzReference,
+    Material,
+    Pressure,
+    Reference,
+    Scene,
+    UniformStress,
+)
+
+if TYPE_CHECKING:
+    from dolfinx.io.gmsh import MeshData
+
+    from .structured import StructuredMesh
+
+
+@dataclass(frozen=True)
+class BlockParams:
+    """Two blocks, half model (SPEC S1-S4); lengths in cm, E and p in MPa."""
+
+    l1: float = 10.0
+    l2: float = 6.0
+    h1: float = 3.0
+    h2: float = 3.0
+    E1: float = 70000.0
+    E2: float = 70000.0
+    nu1: float = 0.3
+    nu2: float = 0.3
+    p: float = 50.0
+    size1: float = 0.125
+    size2: float = 0.125
+    grading1: float = 1.0
+    grading2: float = 1.0
+
+
+@dataclass(frozen=True)
+class HertzParams:
+    """Cylinder on a block, half model (SPEC S5); P is the force per unit thickness (MPa*cm)."""
+
+    R: float = 60.0
+    P: float = 100.0
+    E1: float = 7000.0
+    E2: float = 7000.0
+    nu1: float = 0.23
+    nu2: float = 0.23
+    refine: float = 0.02        # element size on the contact zone, x <= r_refine (cm)
+    r_refine: float = 0.0       # end of the refined zone; 0 = 1.4 a (Hertz's half-width)
+    refine_edge: float = 0.005  # element size at x = a, the pressure's sqrt edge; 0 = off
+    slope: float = 0.1          # growth of the element size per unit distance
+    width: float = 60.0
+    height: float = 60.0
+    mesh: str = "gmsh"          # "gmsh" (graded unstructured quads) or "structured" (large runs)
+    h_far: float = 0.0          # largest element size (cm); 0 = R / 6
+
+
+MESHERS = ("gmsh", "structured")
+
+BLOCK_SCENES: dict[str, BlockParams] = {
+    "S1": BlockParams(),
+    "S2": BlockParams(size1=0.08, size2=0.1),
+    "S3": BlockParams(E1=700000.0, size1=0.08, size2=0.1),
+    "S4": BlockParams(l2=10.0, E1=700000.0, size1=0.12, size2=0.15, grading1=1.01, grading2=0.99),
+}
+
+
+def hertz_exact(params: HertzParams) -> dict[str, float]:
+    """Plane-strain line contact (Johnson sec. 4.2): E*, half-width a and peak pressure p0."""
+    inv = (1 - params.nu1**2) / params.E1 + (1 - params.nu2**2) / params.E2
+    e_star = 1.0 / inv
+    a = math.sqrt(4 * params.P * params.R / (math.pi * e_star))
+    return {"E_star": e_star, "a": a, "p0": 2 * params.P / (math.pi * a)}
+
+
+def validate(params: BlockParams | HertzParams) -> None:
+    """Raise InputError naming the first parameter out of its range."""
+    Material(params.E1, params.nu1).check("body 1")
+    Material(params.E2, params.nu2).check("body 2")
+    positive = {
+        BlockParams: ("l1", "l2", "h1", "h2", "size1", "size2", "grading1", "grading2"),
+        HertzParams: ("R", "P", "refine", "slope", "width", "height"),
+    }[type(params)]
+    for key in positive:
+        value = getattr(params, key)
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{key} must be a positive number (got {value})")
+    if isinstance(params, BlockParams):
+        if params.l2 > params.l1:
+            raise InputError(f"l2 = {params.l2} > l1 = {params.l1}: the top block must not "
+                             "overhang the base")
+        for key, length in (("size1", params.l1), ("size2", params.l2)):
+            if getattr(params, key) > length / 2:
+                raise InputError(f"{key} = {getattr(params, key)} is larger than the half width")
+        if not math.isfinite(params.p):
+            raise InputError(f"p must be finite (got {params.p})")
+    else:
+        if params.refine > params.R / 10:
+            raise InputError(f"refine = {params.refine} is too coarse for R = {params.R}")
+        if params.mesh not in MESHERS:
+            raise InputError(f"unknown mesh '{params.mesh}' (choose {' or '.join(MESHERS)})")
+        if params.r_refine < 0:
+            raise InputError(f"r_refine must be >= 0 (got {params.r_refine})")
+        if not (math.isfinite(params.refine_edge) and params.refine_edge >= 0):
+            raise InputError(f"refine_edge must be >= 0 (got {params.refine_edge})")
+        if not (math.isfinite(params.h_far) and params.h_far >= 0):
+            raise InputError(f"h_far must be >= 0 (got {params.h_far})")
+
+
+def _two_body_scene(data: Any, groups: dict[str, tuple[int, int]],
+                    params: BlockParams | HertzParams, load: float, active: int, name: str,
+                    references: tuple[Reference, ...], extra: dict[str, Any]) -> Scene:
+    """The common shape of the paper's scenes: body1 below, body2 on top, rollers, one load."""
+    if active not in (1, 2):
+        raise InputError(f"active body must be 1 or 2 (got {active})")
+    bodies = (Body("body1", Material(params.E1, params.nu1)),
+              Body("body2", Material(params.E2, params.nu2)))
+    pair = ContactPair(f"contact{active}", f"contact{3 - active}")
+    # Rollers, as in the paper: u_x = 0 on the symmetry axis, u_y = 0 on the base only.
+    supports = (Dirichlet("symmetry", ux=0.0), Dirichlet("support", uy=0.0))
+    return Scene(data.mesh, data.cell_tags, data.facet_tags, None, Groups(groups), bodies,
+                 (pair,), supports, (Pressure("load", load),), references, name=name,
+                 params={**asdict(params), "active": active, **extra},
+                 cartesian_interface=True)
+
+
+def blocks(params: BlockParams = BlockParams(), active: int = 2,
+           comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """Two stacked blocks (S1-S4): pressure p on top, rollers on the axis and the base."""
+    validate(params)
+    p = params
+    build = partial(build_blocks, p.l1, p.l2, p.h1, p.h2, p.size1, p.size2, p.grading1,
+                    p.grading2)
+    data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
+    groups = {k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()}
+    # Equal widths make the stress uniaxial and uniform: the contact patch test.
+    refs: tuple[Reference, ...] = ((UniformStress(((0.0, 0.0), (0.0, -p.p))),)
+                                   if p.l1 == p.l2 else ())
+    scene = _two_body_scene(data, groups, p, p.p, active, "blocks", refs, {})
+    return replace(scene, resize=lambda f: blocks(
+        replace(p, size1=p.size1 * f, size2=p.size2 * f), active, comm))
+
+
+def hertz(params: HertzParams = HertzParams(), active: int = 2,
+          comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """A quarter cylinder on a block (S5), line load P, on the gmsh or the structured mesh."""
+    validate(params)
+    exact = hertz_exact(params)
+    if params.r_refine == 0.0:
+        # Refine where the contact zone will be: Hertz's a, with margin for the active set.
+        params = replace(params, r_refine=round(1.4 * exact["a"], 6))
+    h = params
+    h_far = h.h_far or None
+    extra: dict[str, Any] = {"hertz_exact": exact}
+    data: StructuredMesh | MeshData
+    if h.mesh == "structured":
+        # Built directly in DOLFINx: gmsh's quad mesher is too slow for millions of DOFs.
+        from .structured import build_hertz_structured
+
+        data = build_hertz_structured(comm, h.R, h.width, h.height, h.refine, h.r_refine,
+                                      h_far, h.slope)
+        groups = data.physical_groups
+    else:
+        # The edge grading targets the Hertz estimate of a, as a user would plan a mesh.
+        edge = (exact["a"], h.refine_edge) if h.refine_edge > 0 else None
+        build = partial(build_hertz, h.R, h.width, h.height, h.refine, h.r_refine,
+                        h_far=h_far, slope=h.slope, edge=edge)
+        data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
+        groups = {k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()}
+    ref = (HertzReference(pair=0, R=h.R, P=h.P, symmetric=True),)
+    scene = _two_body_scene(data, groups, h, h.P / (2 * h.R), active, "hertz", ref, extra)
+    return replace(scene, resize=lambda f: hertz(
+        replace(h, refine=h.refine * f, refine_edge=h.refine_edge * f, h_far=h.h_far * f),
+        active, comm))
+
+
+def build_scene(kind: str, params: BlockParams | HertzParams, active: int = 2,
+                comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+    """A built-in scene by name: 'blocks' with BlockParams or 'hertz' with HertzParams."""
+    if kind == "blocks" and isinstance(params, BlockParams):
+        return blocks(params, active, comm)
+    if kind == "hertz" and isinstance(params, HertzParams):
+        return hertz(params, active, comm)
+    raise InputError(f"unknown scene '{kind}' with {type(params).__name__} "
+                     "(choose blocks with BlockParams or hertz with HertzParams)")

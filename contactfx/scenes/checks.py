@@ -1,0 +1,105 @@
+"""Checks of a Scene against its mesh: groups exist with the right dimension, pairs join bodies.
+
+All checks are collective and raise the same typed error on every rank.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import InputError, MeshError
+
+if TYPE_CHECKING:
+    from .model import Body, Scene
+
+
+def _global_count(scene: Scene, local: int) -> int:
+    return int(scene.comm.allreduce(int(local)))
+
+
+def body_of_curve(scene: Scene, name: str) -> Body:
+    """The one body whose cells carry the facets of curve group `name`."""
+    msh = scene.mesh
+    tdim = msh.topology.dim
+    tag = scene.curve_tag(name, f"curve group '{name}'")
+    if scene.facet_tags is None:
+        raise MeshError(f"the mesh has no curve groups (needed: '{name}')")
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    facets = scene.facet_tags.find(tag)
+    f2c = msh.topology.connectivity(tdim - 1, tdim)
+    cells = f2c.array[f2c.offsets[facets]] if facets.size else np.zeros(0, np.int32)
+    cell_values = np.full(msh.topology.index_map(tdim).size_local
+                          + msh.topology.index_map(tdim).num_ghosts, -1, dtype=np.int64)
+    cell_values[scene.cell_tags.indices] = scene.cell_tags.values
+    local = set(np.unique(cell_values[cells]).tolist())
+    found = set().union(*scene.comm.allgather(local))
+    names = [b for b in scene.bodies if scene.body_tag(b) in found]
+    if not names:
+        raise MeshError(f"curve group '{name}' has no facet on the boundary of any body")
+    if len(names) > 1:
+        raise MeshError(f"curve group '{name}' lies on several bodies "
+                        f"({', '.join(b.name for b in names)}): give one group per body")
+    return names[0]
+
+
+def _check_bodies(scene: Scene) -> None:
+    if len(scene.bodies) < 2:
+        raise InputError(f"a contact scene needs at least two bodies (got {len(scene.bodies)})")
+    known = set()
+    for body in scene.bodies:
+        tag = scene.body_tag(body)
+        known.add(tag)
+        if _global_count(scene, len(scene.cell_tags.find(tag))) == 0:
+            raise MeshError(f"body '{body.name}': its physical surface group has no cells")
+    surfaces = {n: t for n, (d, t) in scene.groups.by_name.items() if d == 2}
+    extra = [n for n, t in surfaces.items() if t not in known]
+    if extra:
+        raise InputError(f"physical surface group '{extra[0]}' is not a body of the scene: "
+                         f"give it a material ([bodies.{extra[0]}] with E and nu)")
+
+
+def _check_pairs(scene: Scene) -> None:
+    if not scene.contacts:
+        raise InputError("the scene has no contact pair (add a [[contact]] entry)")
+    for k, pair in enumerate(scene.contacts):
+        a = body_of_curve(scene, pair.active)
+        p = body_of_curve(scene, pair.passive)
+        if a == p:
+            raise InputError(f"contact pair {k}: '{pair.active}' and '{pair.passive}' lie on "
+                             f"the same body '{a.name}' (self-contact is not supported)")
+
+
+def _check_conditions(scene: Scene) -> None:
+    for bc in scene.dirichlet:
+        if bc.group not in scene.groups.by_name:
+            scene.curve_tag(bc.group, "dirichlet")  # raises, listing the groups
+        dim = scene.groups.by_name[bc.group][0]
+        if dim not in (0, 1):
+            raise MeshError(f"dirichlet: group '{bc.group}' must be a curve or point group")
+        if not bc.components():
+            raise InputError(f"dirichlet on '{bc.group}': give ux and/or uy")
+        for c, v in bc.components():
+            if not math.isfinite(v):
+                raise InputError(f"dirichlet on '{bc.group}': {'xy'[c]} value must be finite")
+    for load in scene.loads:
+        scene.curve_tag(load.group, "load")
+        values = [load.p] if hasattr(load, "p") else list(load.t)
+        if not all(math.isfinite(float(v)) for v in values):
+            raise InputError(f"load on '{load.group}': values must be finite")
+    for ref in scene.references:
+        pair = getattr(ref, "pair", 0)
+        if not 0 <= pair < len(scene.contacts):
+            raise InputError(f"reference: pair {pair} does not exist "
+                             f"(the scene has {len(scene.contacts)} contact pairs)")
+
+
+def check_scene(scene: Scene) -> None:
+    """Raise InputError/MeshError naming the first inconsistency between scene and mesh."""
+    for body in scene.bodies:
+        body.material.check(f"body '{body.name}'")
+    _check_bodies(scene)
+    _check_pairs(scene)
+    _check_conditions(scene)

@@ -1,0 +1,212 @@
+"""gmsh models into DOLFINx: a body-balancing partitioner, quad checks, and Scene.from_gmsh.
+
+gmsh runs on rank 0 only; every failure there is broadcast so that all ranks raise the same
+typed error (no rank is left waiting in a collective call).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import gmsh
+import numpy as np
+from dolfinx.cpp.mesh import cell_num_vertices
+from dolfinx.graph import adjacencylist
+from dolfinx.io.gmsh import MeshData, model_to_mesh
+from mpi4py import MPI
+from scipy.sparse import coo_array
+from scipy.sparse.csgraph import connected_components
+
+from ..errors import ContactFxError, InputError, MeshError
+from .model import ContactPair, Dirichlet, Groups, Load, Material, Reference, Scene
+
+# gmsh element type of the 4-node quadrangle; the other 2D types named for the error message.
+QUAD4 = 3
+_GMSH_2D_NAMES = {2: "3-node triangles", 9: "6-node triangles", 10: "9-node quadrangles",
+                  16: "8-node quadrangles"}
+
+
+def _gmsh_node_coordinates() -> np.ndarray:
+    """The current gmsh model's node coordinates, row i = node tag i + 1."""
+    if not gmsh.isInitialized():
+        raise MeshError("balanced_partitioner needs node coordinates: no gmsh session is open")
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    x = np.zeros((int(tags.max()) if len(tags) else 0, 3))
+    x[tags.astype(np.int64) - 1] = xyz.reshape(-1, 3)
+    return x
+
+
+def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[..., Any]:
+    """A cell partitioner that splits every body (connected component) over all ranks."""
+
+    def partition(comm: MPI.Comm, nparts: int, cell_types: list[Any], cells: list[Any]) -> Any:
+        # Cells of one type per list entry, flattened; node index = gmsh node tag - 1.
+        conn = [
+            np.asarray(c, dtype=np.int64).reshape(-1, cell_num_vertices(ct))
+            for ct, c in zip(cell_types, cells, strict=True)
+        ]
+        num_cells = sum(len(c) for c in conn)
+        dest = np.zeros(num_cells, dtype=np.int32)
+        if num_cells == 0 or nparts == 1:
+            return adjacencylist(dest)._cpp_object
+        x = _gmsh_node_coordinates() if coordinates is None else np.asarray(coordinates)
+        mid = np.vstack([x[c, :2].mean(axis=1) for c in conn])
+        # Bodies share no node, so the connected components of the node graph are the
+        # bodies: linking each cell's first vertex to its others is enough to find them.
+        first = np.concatenate([np.repeat(c[:, 0], c.shape[1]) for c in conn])
+        other = np.concatenate([c.ravel() for c in conn])
+        n = int(max(first.max(), other.max())) + 1
+        graph = coo_array((np.ones(len(first)), (first, other)), shape=(n, n))
+        _, node_label = connected_components(graph, directed=False)
+        cell_label = node_label[np.concatenate([c[:, 0] for c in conn])]
+        # Within each body, equal-count strips by midpoint x (then y): the contact line of
+        # each body is spread over all ranks, and the strips of the bodies overlap.
+        for label in np.unique(cell_label):
+            ids = np.flatnonzero(cell_label == label)
+            order = ids[np.lexsort((mid[ids, 1], mid[ids, 0]))]
+            dest[order] = (np.arange(len(order)) * nparts) // len(order)
+        return adjacencylist(dest)._cpp_object
+
+    return partition
+
+
+def check_quadrilaterals() -> None:
+    """Raise MeshError unless the current gmsh model's 2D elements are all 4-node quads."""
+    types, tags, _ = gmsh.model.mesh.getElements(2)
+    if not len(types):
+        raise MeshError("the gmsh model has no 2D elements (mesh it in 2D, or give a .geo)")
+    other = [(int(t), len(e)) for t, e in zip(types, tags, strict=True) if t != QUAD4]
+    if other:
+        what = ", ".join(f"{n} {_GMSH_2D_NAMES.get(t, f'type-{t} elements')}" for t, n in other)
+        raise MeshError(f"contactfx needs an all-quadrilateral mesh (Q1 only), the mesh has "
+                        f"{what}: recombine it (Mesh.RecombineAll = 1, Mesh.Algorithm = 8)")
+
+
+def _run_on_root(comm: MPI.Comm, build: Callable[[], None], own_session: bool) -> tuple[
+        bool | None, str | None]:
+    """Open a model on rank 0 and run `build` there; the error text is broadcast."""
+    error = ""
+    fresh, previous = None, None
+    if comm.rank == 0:
+        if own_session:
+            fresh = not gmsh.isInitialized()
+            if fresh:
+                # gmsh's SIGINT handler can only be installed from the main thread.
+                gmsh.initialize(interruptible=threading.current_thread() is threading.main_thread())
+                gmsh.option.setNumber("General.Terminal", 0)
+            else:
+                previous = gmsh.model.getCurrent()
+            gmsh.model.add(f"contactfx-{id(build)}")
+        try:
+            build()
+            check_quadrilaterals()
+        except ContactFxError as exc:
+            error = f"{type(exc).__name__}:{exc}"
+        except ValueError as exc:  # a geometry builder's parameter check
+            error = f"InputError:{exc}"
+        except Exception as exc:  # gmsh raises plain Exceptions
+            error = f"MeshError:gmsh failed: {exc}"
+    error = comm.bcast(error, root=0)
+    if error:
+        if comm.rank == 0 and own_session:
+            _close(fresh, previous)
+        kind, _, text = error.partition(":")
+        raise {"InputError": InputError}.get(kind, MeshError)(text)
+    return fresh, previous
+
+
+def _close(fresh: bool | None, previous: str | None) -> None:
+    if fresh:
+        gmsh.finalize()
+    else:
+        gmsh.model.remove()
+        if previous:
+            gmsh.model.setCurrent(previous)
+
+
+def to_dolfinx(comm: MPI.Comm, build: Callable[[], None],
+               partitioner: Callable[..., Any] | None = None,
+               own_session: bool = True) -> MeshData:
+    """Run `build` on rank 0 (in a fresh gmsh model) and return the distributed MeshData."""
+    fresh, previous = _run_on_root(comm, build, own_session)
+    try:
+        return model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=2,
+                             partitioner=partitioner)
+    except RuntimeError as exc:  # raised on every rank alike (DOLFINx broadcasts the check)
+        raise MeshError(f"the gmsh mesh cannot be loaded: {exc} (every cell must belong to "
+                        "exactly one physical surface group)") from None
+    finally:
+        if comm.rank == 0 and own_session:
+            _close(fresh, previous)
+
+
+def open_mesh_file(path: Path, size_factor: float = 1.0) -> Callable[[], None]:
+    """A build step that reads a .msh, or meshes a .geo in 2D with sizes times `size_factor`."""
+    suffix = path.suffix.lower()
+    if suffix not in (".msh", ".geo"):
+        raise InputError(f"mesh file {path}: expected a gmsh .msh or .geo file")
+    if not path.is_file():
+        raise InputError(f"mesh file {path} does not exist")
+    if suffix == ".msh" and size_factor != 1.0:
+        raise InputError(f"mesh file {path} is a .msh: it cannot be refined (give a .geo)")
+
+    def build() -> None:
+        try:
+            gmsh.open(str(path))
+        except Exception as exc:
+            raise MeshError(f"cannot read mesh file {path}: {exc}") from None
+        if suffix == ".geo":
+            factor = gmsh.option.getNumber("Mesh.MeshSizeFactor")
+            gmsh.option.setNumber("Mesh.MeshSizeFactor", factor * size_factor)
+            try:
+                gmsh.model.mesh.generate(2)
+            finally:
+                gmsh.option.setNumber("Mesh.MeshSizeFactor", factor)
+
+    return build
+
+
+def load_meshdata(model_or_path: Any, comm: MPI.Comm, size_factor: float = 1.0) -> MeshData:
+    """Distributed MeshData of a gmsh .msh/.geo path, or of the gmsh module's current model."""
+    if isinstance(model_or_path, str | Path):
+        build = open_mesh_file(Path(model_or_path), size_factor)
+        return to_dolfinx(comm, build, balanced_partitioner())
+    # A model the user built with the gmsh API: mesh it if it has no 2D elements yet.
+    def mesh_model() -> None:
+        if not len(gmsh.model.mesh.getElements(2)[0]):
+            gmsh.model.mesh.generate(2)
+
+    return to_dolfinx(comm, mesh_model, balanced_partitioner(), own_session=False)
+
+
+def scene_from_gmsh(model_or_path: Any, bodies: dict[str, Material], contacts: list[ContactPair],
+                    dirichlet: list[Dirichlet], loads: list[Load], references: list[Reference],
+                    comm: MPI.Comm, name: str, size_factor: float = 1.0) -> Scene:
+    """Load the mesh, build the Scene and check it against the mesh's groups."""
+    from .checks import check_scene
+    from .model import Body
+
+    for body, mat in bodies.items():
+        mat.check(f"body '{body}'")
+    data = load_meshdata(model_or_path, comm, size_factor)
+    assert data.cell_tags is not None  # one cell type (all quads, checked on rank 0): tagged
+    groups = Groups({k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()})
+    path = model_or_path if isinstance(model_or_path, str | Path) else None
+
+    def resize(factor: float) -> Scene:
+        if path is None:
+            raise InputError("a scene built from an in-memory gmsh model cannot be remeshed")
+        return scene_from_gmsh(path, bodies, contacts, dirichlet, loads, references, comm,
+                               name, size_factor * factor)
+
+    scene = Scene(data.mesh, data.cell_tags, data.facet_tags, data.ridge_tags, groups,
+                  tuple(Body(k, m) for k, m in bodies.items()), tuple(contacts),
+                  tuple(dirichlet), tuple(loads), tuple(references), name=name,
+                  params={"mesh": str(path) if path is not None else "gmsh model",
+                          "size_factor": size_factor},
+                  resize=resize if path is not None and Path(path).suffix == ".geo" else None)
+    check_scene(scene)
+    return scene

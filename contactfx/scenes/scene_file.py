@@ -1,0 +1,168 @@
+"""Scene files: a TOML description of bodies, pairs, supports and loads next to a gmsh mesh.
+
+Every key is checked: an unknown or misspelled one is an InputError naming it and the keys
+allowed there (the schema is documented in README.md, "Your own scene").
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from mpi4py import MPI
+
+from ..errors import InputError
+from .model import (
+    ContactPair,
+    Dirichlet,
+    HertzReference,
+    Load,
+    Material,
+    Pressure,
+    Reference,
+    Scene,
+    Traction,
+    UniformStress,
+)
+
+TOP_KEYS = {"mesh", "name", "bodies", "contact", "dirichlet", "pressure", "traction", "reference"}
+SECTION_KEYS = {
+    "bodies": {"E", "nu"},
+    "contact": {"active", "passive"},
+    "dirichlet": {"group", "ux", "uy"},
+    "pressure": {"group", "p"},
+    "traction": {"group", "t"},
+    "reference.hertz": {"type", "pair", "R", "P", "symmetric"},
+    "reference.uniform_stress": {"type", "sigma"},
+}
+
+
+def _keys(where: str, table: Any, allowed: set[str], required: set[str]) -> dict[str, Any]:
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: expected a table of keys")
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise InputError(f"{where}: unknown key '{unknown[0]}' (allowed: "
+                         f"{', '.join(sorted(allowed))})")
+    missing = sorted(required - set(table))
+    if missing:
+        raise InputError(f"{where}: missing key '{missing[0]}'")
+    return table
+
+
+def _number(where: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise InputError(f"{where}: expected a number, got {value!r}")
+    if not math.isfinite(float(value)):
+        raise InputError(f"{where}: expected a finite number, got {value!r}")
+    return float(value)
+
+
+def _string(where: str, value: Any) -> str:
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{where}: expected a group name (a string), got {value!r}")
+    return value
+
+
+def _entries(doc: dict[str, Any], key: str) -> list[Any]:
+    value = doc.get(key, [])
+    if isinstance(value, dict):
+        return [value]
+    if not isinstance(value, list):
+        raise InputError(f"{key}: expected one or more [[{key}]] tables")
+    return value
+
+
+def _reference(k: int, entry: Any) -> Reference:
+    kind = entry.get("type") if isinstance(entry, dict) else None
+    if kind not in ("hertz", "uniform_stress"):
+        raise InputError(f"reference {k}: type must be 'hertz' or 'uniform_stress' "
+                         f"(got {kind!r})")
+    where = f"reference {k} ({kind})"
+    if kind == "hertz":
+        e = _keys(where, entry, SECTION_KEYS["reference.hertz"], {"type", "R", "P"})
+        pair = e.get("pair", 0)
+        if isinstance(pair, bool) or not isinstance(pair, int):
+            raise InputError(f"{where}: pair must be an integer index into [[contact]]")
+        symmetric = e.get("symmetric", False)
+        if not isinstance(symmetric, bool):
+            raise InputError(f"{where}: symmetric must be true or false")
+        R, P = _number(f"{where}.R", e["R"]), _number(f"{where}.P", e["P"])
+        if R <= 0 or P <= 0:
+            raise InputError(f"{where}: R and P must be positive")
+        return HertzReference(pair, R, P, symmetric)
+    e = _keys(where, entry, SECTION_KEYS["reference.uniform_stress"], {"type", "sigma"})
+    s = e["sigma"]
+    if not (isinstance(s, list) and len(s) == 2 and all(isinstance(r, list) and len(r) == 2
+                                                        for r in s)):
+        raise InputError(f"{where}: sigma must be [[sxx, sxy], [syx, syy]]")
+    sig = tuple(tuple(_number(f"{where}.sigma", v) for v in row) for row in s)
+    if sig[0][1] != sig[1][0]:
+        raise InputError(f"{where}: sigma must be symmetric")
+    return UniformStress(sig)  # type: ignore[arg-type]
+
+
+def parse_scene_file(path: Path) -> tuple[Path, str, dict[str, Material], list[ContactPair],
+                                          list[Dirichlet], list[Load], list[Reference]]:
+    """Read and check a scene file; return the mesh path and the scene's parts."""
+    try:
+        doc = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise InputError(f"scene file {path} does not exist") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read scene file {path}: {exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"scene file {path} is not valid TOML: {exc}") from None
+    _keys(str(path.name), doc, TOP_KEYS, {"mesh", "bodies", "contact"})
+    mesh = path.parent / _string("mesh", doc["mesh"])
+    name = str(doc.get("name", path.stem))
+    if not isinstance(doc["bodies"], dict) or not doc["bodies"]:
+        raise InputError("bodies: expected [bodies.NAME] tables with E and nu")
+    bodies = {}
+    for body, table in doc["bodies"].items():
+        e = _keys(f"bodies.{body}", table, SECTION_KEYS["bodies"], {"E", "nu"})
+        mat = Material(_number(f"bodies.{body}.E", e["E"]), _number(f"bodies.{body}.nu", e["nu"]))
+        mat.check(f"bodies.{body}")
+        bodies[body] = mat
+    pairs = []
+    for k, entry in enumerate(_entries(doc, "contact")):
+        e = _keys(f"contact {k}", entry, SECTION_KEYS["contact"], {"active", "passive"})
+        pairs.append(ContactPair(_string(f"contact {k}.active", e["active"]),
+                                 _string(f"contact {k}.passive", e["passive"])))
+    bcs = []
+    for k, entry in enumerate(_entries(doc, "dirichlet")):
+        e = _keys(f"dirichlet {k}", entry, SECTION_KEYS["dirichlet"], {"group"})
+        comps = {c: _number(f"dirichlet {k}.{c}", e[c]) for c in ("ux", "uy") if c in e}
+        if not comps:
+            raise InputError(f"dirichlet {k} on '{e['group']}': give ux and/or uy")
+        bcs.append(Dirichlet(_string(f"dirichlet {k}.group", e["group"]), **comps))
+    loads: list[Load] = []
+    for k, entry in enumerate(_entries(doc, "pressure")):
+        e = _keys(f"pressure {k}", entry, SECTION_KEYS["pressure"], {"group", "p"})
+        loads.append(Pressure(_string(f"pressure {k}.group", e["group"]),
+                              _number(f"pressure {k}.p", e["p"])))
+    for k, entry in enumerate(_entries(doc, "traction")):
+        e = _keys(f"traction {k}", entry, SECTION_KEYS["traction"], {"group", "t"})
+        t = e["t"]
+        if not (isinstance(t, list) and len(t) == 2):
+            raise InputError(f"traction {k}: t must be a vector [tx, ty]")
+        loads.append(Traction(_string(f"traction {k}.group", e["group"]),
+                              (_number(f"traction {k}.t", t[0]), _number(f"traction {k}.t", t[1]))))
+    refs = [_reference(k, e) for k, e in enumerate(_entries(doc, "reference"))]
+    return mesh, name, bodies, pairs, bcs, loads, refs
+
+
+def load_scene_file(path: str | Path, comm: MPI.Comm = MPI.COMM_WORLD,
+                    size_factor: float = 1.0) -> Scene:
+    """The Scene of a TOML scene file (mesh path relative to the file)."""
+    from .gmsh_io import scene_from_gmsh
+
+    path = Path(path)
+    mesh, name, bodies, pairs, bcs, loads, refs = parse_scene_file(path)
+    scene = scene_from_gmsh(mesh, bodies, pairs, bcs, loads, refs, comm, name, size_factor)
+    params = {**scene.params, "scene_file": str(path)}
+    from dataclasses import replace
+
+    return replace(scene, params=params)

@@ -1,0 +1,79 @@
+"""The structured Hertz grid of meshes/ as a distributed DOLFINx mesh with named groups."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import basix.ufl
+import numpy as np
+import ufl
+from dolfinx import mesh as dmesh
+from mpi4py import MPI
+
+from meshes.hertz_structured import hertz_grid
+
+from ..errors import InputError
+from .gmsh_io import balanced_partitioner
+
+# Physical groups, named like the gmsh scene's (the numbers themselves are free).
+TAGS = {"body1": (2, 1), "body2": (2, 2), "contact1": (1, 3), "contact2": (1, 4),
+        "symmetry": (1, 5), "support": (1, 6), "load": (1, 7)}
+
+
+@dataclass(frozen=True)
+class StructuredMesh:
+    """A distributed mesh with its cell and facet tags (names in `physical_groups`)."""
+
+    mesh: dmesh.Mesh
+    cell_tags: dmesh.MeshTags
+    facet_tags: dmesh.MeshTags
+    physical_groups: dict[str, tuple[int, int]]
+
+
+def build_hertz_structured(comm: MPI.Comm, R: float, width: float, height: float,
+                           h_contact: float, r_refine: float, h_far: float | None = None,
+                           slope: float = 0.1, contact_extent: float | None = None
+                           ) -> StructuredMesh:
+    """The Hertz half model (quarter disc on a block) as a distributed structured quad mesh."""
+    h_far = R / 6.0 if h_far is None else h_far
+    extent = min(width, R / 4.0) if contact_extent is None else contact_extent
+    if min(R, width, height, h_contact, h_far, slope) <= 0.0 or r_refine < 0.0:
+        raise InputError("radius, block size, mesh sizes and slope must be positive")
+    if not 0.0 < extent < min(width, R):
+        raise InputError(f"contact_extent={extent} must lie in (0, min(width, R))")
+    if comm.rank == 0:
+        x, cells, n_block = hertz_grid(R, width, height, h_contact, r_refine, h_far, slope)
+    else:
+        x, cells, n_block = np.zeros((0, 2)), np.zeros((0, 4), dtype=np.int64), 0
+    n_block = comm.bcast(n_block, root=0)
+    element = ufl.Mesh(basix.ufl.element("Lagrange", "quadrilateral", 1, shape=(2,)))
+    partitioner = balanced_partitioner(np.column_stack([x, np.zeros(len(x))]))
+    msh = dmesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
+    tdim = msh.topology.dim
+    ncells = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
+    body = np.where(np.asarray(msh.topology.original_cell_index)[:ncells] < n_block, 1, 2)
+    cell_tags = dmesh.meshtags(msh, tdim, np.arange(ncells, dtype=np.int32),
+                               body.astype(np.int32))
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    facets = dmesh.exterior_facet_indices(msh.topology)
+    f2c = msh.topology.connectivity(tdim - 1, tdim)
+    fbody = body[f2c.array[f2c.offsets[facets]]]
+    xf = msh.geometry.x[dmesh.entities_to_geometry(msh, tdim - 1, facets)][:, :, :2]
+    yc = height + R
+    mid_x = xf[:, :, 0].mean(axis=1)
+    on_arc = np.abs(np.hypot(xf[:, :, 0], xf[:, :, 1] - yc) - R) <= 1e-10 * R
+    values = np.zeros(len(facets), dtype=np.int32)
+    rules = [
+        (fbody == 1, (xf[:, :, 1] == height).all(axis=1) & (mid_x <= extent), "contact1"),
+        (fbody == 2, on_arc.all(axis=1) & (mid_x <= extent), "contact2"),
+        (fbody > 0, (xf[:, :, 0] == 0.0).all(axis=1), "symmetry"),
+        (fbody == 1, (xf[:, :, 1] == 0.0).all(axis=1), "support"),
+        (fbody == 2, (xf[:, :, 1] == yc).all(axis=1), "load"),
+    ]
+    for in_body, cond, name in rules:
+        values[(values == 0) & in_body & cond] = TAGS[name][1]
+    keep = values > 0
+    order = np.argsort(facets[keep])
+    facet_tags = dmesh.meshtags(msh, tdim - 1, facets[keep][order].astype(np.int32),
+                                values[keep][order])
+    return StructuredMesh(msh, cell_tags, facet_tags, dict(TAGS))

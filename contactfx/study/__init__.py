@@ -1,0 +1,27 @@
+"""Convergence studies: every method on a sequence of refined meshes of one scene.
+
+`python -m contactfx study SCENE ...` (contactfx.study.command) and demos/demo_hertz.py are
+thin layers over `run_study` and `write_outputs`; docs/study.md says what is measured.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .core import Run, Study, run_study
+from .levels import Level, builtin_levels, hertz_at, scene_file_levels, size_factors
+from .measures import fit_rate
+from .report import level_lines, table_lines, write_csv, write_json
+
+__all__ = ["Level", "Run", "Study", "builtin_levels", "fit_rate", "hertz_at", "level_lines",
+           "run_study", "scene_file_levels", "size_factors", "table_lines", "write_outputs"]
+
+
+def write_outputs(study: Study, out: Path) -> list[Path]:
+    """study.json, study.csv, convergence.png and accuracy_vs_time.png in `out` (call on rank 0)."""
+    from .charts import plot_convergence, plot_time
+
+    out.mkdir(parents=True, exist_ok=True)
+    return [write_json(study, out / "study.json"), write_csv(study, out / "study.csv"),
+            plot_convergence(study, out / "convergence.png"),
+            plot_time(study, out / "accuracy_vs_time.png")]

@@ -1,0 +1,96 @@
+"""The two charts of a study: error against contact element size, and against time."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .core import Study  # noqa: E402
+from .measures import ROUND_OFF  # noqa: E402
+from .report import main_errors  # noqa: E402
+
+COLORS = {"nts": "tab:blue", "sts": "tab:orange", "mortar": "tab:green",
+          "penalty": "tab:red", "schwarz": "tab:purple"}
+MARKERS = {"nts": "o", "sts": "s", "mortar": "^", "penalty": "v", "schwarz": "D"}
+LABELS = {
+    "l2": "relative L2 error of the pressure",
+    "a": "|a - a_exact| / a_exact (half-width)",
+    "p0": "|p0 - p0_exact| / p0_exact (peak pressure)",
+    "stress": "max stress error / max |sigma_exact|",
+    "pressure": "pressure: relative L2 difference\nfrom the reference (along s)",
+    "displacement": "displacement: relative L2 difference\nfrom the reference (along s)",
+}
+
+
+def _series(study: Study, method: str, name: str, x: str) -> tuple[np.ndarray, np.ndarray]:
+    """(x, error) of a method's finished runs with an error above round-off."""
+    pts = [(r.h if x == "h" else r.after_mesh, r.errors.get(name)) for r in study.runs
+           if r.method == method and r.ok]
+    pts = [(a, e) for a, e in pts if a and e is not None and e > ROUND_OFF / 100]
+    return np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+
+
+def _rate_text(rate: float | None) -> str:
+    return "no rate (round-off)" if rate is None else f"rate {rate:.2f}"
+
+
+def _figure(study: Study, x: str) -> tuple[plt.Figure, list[plt.Axes], list[str]]:
+    names = main_errors(study)
+    fig, axes = plt.subplots(1, len(names), figsize=(5.6 * len(names), 4.8), squeeze=False)
+    return fig, list(axes[0]), names
+
+
+def _title(study: Study) -> str:
+    ref = study.reference
+    what = (f"reference: finest level of {ref['method']} (self-convergence)"
+            if ref["kind"] == "self" else f"reference: exact ({ref['type'].replace('_', ' ')})")
+    return f"{study.scene}: {what}, {study.ranks} rank{'s' * (study.ranks > 1)}"
+
+
+def plot_convergence(study: Study, path: Path) -> Path:
+    """Error against the contact element size h, one panel per error, rates in the legend."""
+    fig, axes, names = _figure(study, "h")
+    for ax, name in zip(axes, names, strict=True):
+        for m in study.methods:
+            h, e = _series(study, m, name, "h")
+            if not len(h):
+                continue
+            rate = study.rates[m].get(name)
+            ax.loglog(h, e, marker=MARKERS.get(m, "o"), color=COLORS.get(m), lw=1.8, ms=7,
+                      label=f"{m}: {_rate_text(rate)}")
+        ax.set_xlabel("contact element size h (median in the contact zone)", fontsize=11)
+        ax.set_ylabel(LABELS.get(name, name), fontsize=11)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=10, title="fitted error ~ h^rate", title_fontsize=10)
+    fig.suptitle(f"Error against mesh size ({_title(study)})", fontsize=12)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_time(study: Study, path: Path) -> Path:
+    """Error against wall time after meshing, every method on each panel."""
+    fig, axes, names = _figure(study, "time")
+    for ax, name in zip(axes, names, strict=True):
+        for m in study.methods:
+            t, e = _series(study, m, name, "time")
+            if not len(t):
+                continue
+            rate = study.time_rates[m].get(name)
+            ax.loglog(t, e, marker=MARKERS.get(m, "o"), color=COLORS.get(m), lw=1.8, ms=7,
+                      label=f"{m}: " + ("-" if rate is None else f"error ~ t^{rate:.2f}"))
+        ax.set_xlabel("wall time after meshing (s): assembly, search, solves", fontsize=11)
+        ax.set_ylabel(LABELS.get(name, name), fontsize=11)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=10, title="lower left is better", title_fontsize=10)
+    fig.suptitle(f"Accuracy against time ({_title(study)})", fontsize=12)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
