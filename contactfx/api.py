@@ -45,9 +45,9 @@ def use_coarse(predictor: str, scene: Scene, options: Mapping[str, object]) -> b
 
 
 def coarse_prediction(coarse: Scene, method: Method, options: Mapping[str, object],
-                      max_iterations: int = 50) -> InitialSet:
+                      max_iterations: int = 50, basis: str = "standard") -> InitialSet:
     """Solve `coarse` (the same scene, coarser) and turn its contact zone into an InitialSet."""
-    sol = solve_contact(coarse, method, options, ActiveSetOptions(max_iterations))
+    sol = solve_contact(coarse, method, options, ActiveSetOptions(max_iterations), basis=basis)
     return coarse_initial_set(sol)
 
 
@@ -55,12 +55,13 @@ def solve(scene: Scene, method: Method | str = Method.MORTAR, *,
           solver: str | Mapping[str, object] = "mumps", max_iterations: int = 50,
           penalty: float | None = None, schwarz: SchwarzOptions | None = None,
           reference_timing: bool = False, predictor: str = "auto",
-          timers: Timers | None = None) -> Solution:
+          timers: Timers | None = None, basis: str = "standard") -> Solution:
     """Solve the frictionless contact problem of `scene` with `method`.
 
     `predictor` "coarse" starts the active-set loop from a solve of the same scene with mesh
     sizes times COARSE_FACTOR (scenes that can be remeshed), "auto" does so above
-    COARSE_PREDICTOR_DOFS; the converged solution does not depend on it.
+    COARSE_PREDICTOR_DOFS; the converged solution does not depend on it. `basis` "dual"
+    takes mortar's biorthogonal multiplier basis.
     """
     method = Method(method)
     options = SOLVERS[solver] if isinstance(solver, str) else solver
@@ -79,9 +80,9 @@ def solve(scene: Scene, method: Method | str = Method.MORTAR, *,
     if scene.resize is not None and use_coarse(predictor, scene, options):
         with timers("predictor"):
             coarse = scene.resize(COARSE_FACTOR)
-            init = coarse_prediction(coarse, method, options, max_iterations)
+            init = coarse_prediction(coarse, method, options, max_iterations, basis)
     return solve_contact(scene, method, options, aso, timers,
-                         reference_timing=reference_timing, initial_active=init)
+                         reference_timing=reference_timing, initial_active=init, basis=basis)
 
 
 def run_scene(scene: Scene, method: Method | str = Method.MORTAR, *,
@@ -97,7 +98,18 @@ def run_scene(scene: Scene, method: Method | str = Method.MORTAR, *,
         if key in timers.seconds:
             times[key] = timers.seconds[key]
     times["total"] = time.perf_counter() - t_start
-    return sol, summary(sol, times, {"solver": solver if isinstance(solver, str) else "custom"})
+    return sol, summary(sol, times, {"solver": solver if isinstance(solver, str) else "custom",
+                                     "memory": peak_memory(scene.comm)})
+
+
+def peak_memory(comm: MPI.Comm) -> dict[str, float]:
+    """Peak resident memory so far (MB): summed over the ranks, and the largest rank's."""
+    import resource
+
+    # ru_maxrss is in kilobytes on Linux.
+    mine = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    return {"peak_mb": float(comm.allreduce(mine)),
+            "peak_mb_max_rank": float(comm.allreduce(mine, op=MPI.MAX))}
 
 
 def run_case(kind: str, params: BlockParams | HertzParams, method: Method | str,

@@ -158,6 +158,11 @@ def prepare_contact(scene: Scene, method: str, penetration_tol: float, timers: T
         B = petsc_constraint(V, op, order, layout, dirichlet)
     w_all = layout.weights
     g_all = op.gap[order] / w_all
+    if kernel_options:
+        # A dual (sign-changing) weighting averages the gap with negative weights: check
+        # for overlap with the standard, positive weights (geometry, not the multipliers).
+        std = stack(build_pairs(gathered, method, ndofs))[1]  # type: ignore[arg-type]
+        g_all = (std.gap[order] + shift[order]) / std.weights[order]
     h = float(np.median(w_all))
     for p in pairs:
         rows = np.flatnonzero(layout.pair == p.index)

@@ -133,12 +133,13 @@ class MultiplierIteration:
 def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, object] = "mumps",
                   aso: ActiveSetOptions = DEFAULT_OPTIONS,
                   timers: Timers | None = None, reference_timing: bool = False,
-                  initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None
-                  ) -> Solution:
+                  initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None,
+                  basis: str = "standard") -> Solution:
     """Solve the frictionless unilateral contact problem of `scene` with `method`.
 
     `initial_active` (node coordinates -> bool, or an InitialSet) adds nodes to the first
-    active set; only the loop's cost depends on it, never the converged solution.
+    active set; only the loop's cost depends on it, never the converged solution. `basis`
+    "dual" takes mortar's biorthogonal multipliers (D diagonal).
     """
     if method not in IMPLEMENTED:
         raise InputError(f"method '{method.value}' is not implemented yet "
@@ -148,7 +149,10 @@ def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, objec
                          "contactfx.solve (it dispatches every method)")
     options = SOLVERS[solver] if isinstance(solver, str) else solver
     timers = timers or Timers()
-    setup = prepare_contact(scene, method.operator, aso.penetration_tol, timers)
+    if basis != "standard" and method != Method.MORTAR:
+        raise InputError(f"the {basis} multiplier basis applies to the mortar method only")
+    kernel = {"basis": basis} if basis != "standard" else {}
+    setup = prepare_contact(scene, method.operator, aso.penetration_tol, timers, **kernel)
     el, h = setup.elasticity, setup.h
     e_max = max(b.material.E for b in scene.bodies)
     gamma = e_max / h**2 if uses_augmentation(options) else 0.0
@@ -169,4 +173,7 @@ def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, objec
         # The cost floor: one fresh solve of the final system by the same solver.
         _, timers.seconds["reference_solve"] = reference_solve(
             el.K, setup.B, el.f, setup.g, active, options, gamma, nullspace)
-    return setup.solution(method, iteration.u, step.lam, step.gap, active, history, timers)
+    sol = setup.solution(method, iteration.u, step.lam, step.gap, active, history, timers)
+    if basis != "standard":
+        sol.info["basis"] = basis
+    return sol

@@ -18,13 +18,14 @@
 #
 # on **graded** meshes (fine only along the contact zone and at its edge, growing by a fixed
 # slope with the distance) and, for contrast, on **uniform** meshes of the sizes the paper
-# used (8.5k, 35k and 138k elements). We chart error against the element size at the
-# contact and against wall time. `CONTACTFX_QUICK=1` runs a reduced sweep.
+# used (8.5k, 35k and 138k elements). Both series are convergence studies run by
+# `contactfx.study` (the code of `python -m contactfx study hertz`), which also draws the
+# charts of error against the element size and against wall time. `CONTACTFX_QUICK=1` runs
+# a reduced sweep.
 
 # +
 import json
 import os
-import time
 from pathlib import Path
 
 import dolfinx_solver  # noqa: F401
@@ -32,19 +33,26 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
-from contactfx.api import run_case
 from contactfx.hertz import exact_pressure
-from contactfx.scenes import HertzParams, hertz_exact
+from contactfx.scenes import HertzParams, hertz, hertz_exact
+from contactfx.study import (
+    Level,
+    Study,
+    builtin_levels,
+    fit_rate,
+    run_study,
+    size_factors,
+    table_lines,
+    write_outputs,
+)
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 QUICK = os.environ.get("CONTACTFX_QUICK", "0") == "1"
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "hertz"
 METHODS = ["nts", "sts", "mortar"]
-COLORS = {"nts": "tab:blue", "sts": "tab:orange", "mortar": "tab:green",
-          "mortar, uniform": "tab:red"}
 
 
 def say(*args: object) -> None:
@@ -64,11 +72,15 @@ def say(*args: object) -> None:
 # resolution of the pressure edge (like $h_e$). Refining both as $s \propto h_e^{1/2}$ keeps
 # them balanced; the element count then grows only like $1/h_e$.
 #
+# That is how the study refines the built-in Hertz scene: the default `HertzParams()` is
+# the graded mesh with $h_e = 0.005$ cm ($s = 0.1$), and a level with size factor $f$ has
+# $h_e = 0.005 f$, $4 h_e$ on the zone and $s = 0.1 \sqrt f$ (at most 0.3 when coarsening).
+#
 # A uniform mesh has the same size everywhere (slope ~0) and no edge refinement.
 
 # +
 def graded(h_edge: float) -> HertzParams:
-    """Graded mesh with size h_edge at the contact edge."""
+    """Graded mesh with size h_edge at the contact edge (what the study's level f builds)."""
     return HertzParams(refine=4 * h_edge, refine_edge=h_edge,
                        slope=min(0.3, 0.1 * np.sqrt(h_edge / 0.005)))
 
@@ -78,70 +90,79 @@ def uniform(h: float) -> HertzParams:
     return HertzParams(refine=h, refine_edge=0.0, slope=1e-4)
 
 
-GRADED = [0.04, 0.02, 0.01] if QUICK else [0.16, 0.08, 0.04, 0.02, 0.01, 0.005, 0.0025]
+# Graded: h_e = 0.04, 0.02, 0.01 (quick) or 0.16 ... 0.0025 (full), ratio 2.
+H_EDGE = HertzParams().refine_edge
+FACTORS = size_factors(3, 2.0, 0.04 / H_EDGE) if QUICK else size_factors(7, 2.0, 0.16 / H_EDGE)
 UNIFORM = [0.87] if QUICK else [0.87, 0.43, 0.22]
 # The paper's meshes: cylinder + plane elements, and the half-widths it reported (cm).
 PAPER = [(4794 + 3736, 2.0), (20182 + 15240, 1.8), (79458 + 58472, 1.1)]
 
-
-def run(label: str, method: str, h: float, params: HertzParams) -> dict:
-    """Solve one case; return the table row (rank-independent numbers plus timings)."""
-    t0 = time.perf_counter()
-    sol, data = run_case("hertz", params, method)
-    wall = time.perf_counter() - t0
-    hz = data["hertz"]
-    a_fit = hz["a"]
-    lo, hi = hz["a_bracket"]
-    a = a_fit if a_fit is not None else 0.5 * (lo + (hi if hi is not None else lo))
-    row = {
-        "series": label, "method": method, "h": h, "elements": data["elements"],
-        "dofs": data["dofs"], "multipliers": data["multipliers"], "a": a, "a_fit": a_fit,
-        "a_bracket": hz["a_bracket"], "p0": hz["p0"],
-        "a_err": a / hz["a_exact"] - 1, "p0_err": hz["p0"] / hz["p0_exact"] - 1,
-        "l2_error": hz["l2_error"], "iterations": data["iterations"],
-        "solve_time": data["times"]["solve"],
-        "time_after_mesh": data["times"]["total"] - data["times"]["mesh"],
-        "mesh_time": data["times"]["mesh"], "wall": wall,
-        "x": data["interface"]["x"], "pressure": data["interface"]["pressure"],
-    }
-    say(f"{label:16s} {method:6s} h={h:<7g} {row['elements']:7d} el {row['iterations']:2d} its "
-        f"a {100 * row['a_err']:+7.3f}%  p0 {100 * row['p0_err']:+7.3f}%  "
-        f"L2 {100 * row['l2_error']:6.3f}%  solve {row['solve_time']:.3f} s")
-    return row
-
-
-rows = []
-for method in METHODS:
-    for h in GRADED:
-        rows.append(run("graded", method, h, graded(h)))
-for h in UNIFORM:
-    rows.append(run("uniform", "mortar", h, uniform(h)))
+graded_levels = builtin_levels("hertz", HertzParams(), FACTORS, comm=comm)
+assert all(abs(lv.sizes["slope"] - graded(lv.sizes["refine_edge"]).slope) < 1e-12
+           for lv in graded_levels), "the study's levels are not demo's graded() meshes"
+# The paper's uniform sizes are not a geometric sequence: levels given one by one.
+uniform_levels = [Level(k, h, {"refine": h}, lambda h=h: hertz(uniform(h), comm=comm))
+                  for k, h in enumerate(UNIFORM)]
+say("graded meshes:")
+graded_study = run_study(graded_levels, METHODS, comm=comm)
+say("uniform meshes:")
+uniform_study = run_study(uniform_levels, ["mortar"], comm=comm)
 ref = hertz_exact(HertzParams())
 # -
 
-# ## Fitted rates
+# ## Rows of the table
 #
-# The slopes of $\log$(error) against $\log h$ (np.polyfit), on the graded meshes with
-# $h_e \le 0.04$ cm (the coarser ones have only a handful of nodes in contact), and of the
-# $L^2$ error against the time after meshing.
+# Each run of a study carries its JSON summary; the table reads a, p0 and the L2 error from
+# it, and the nominal size: $h_e$ on the graded meshes, the uniform size otherwise.
 
 # +
+def rows_of(study: Study, label: str, size_key: str) -> list[dict]:
+    """Table rows of a study's finished runs (rank-independent numbers plus timings)."""
+    out = []
+    for r in study.runs:
+        assert r.ok, f"{label} {r.method} level {r.level}: {r.message}"
+        hz = r.summary["hertz"]
+        lo, hi = hz["a_bracket"]
+        a = hz["a"] if hz["a"] is not None else 0.5 * (lo + (hi if hi is not None else lo))
+        out.append({
+            "series": label, "method": r.method, "h": study.levels[r.level].sizes[size_key],
+            "h_measured": r.h, "elements": r.elements, "dofs": r.dofs,
+            "multipliers": r.summary["multipliers"], "a": a, "a_fit": hz["a"],
+            "a_bracket": hz["a_bracket"], "p0": hz["p0"], "a_err": a / hz["a_exact"] - 1,
+            "p0_err": hz["p0"] / hz["p0_exact"] - 1, "l2_error": hz["l2_error"],
+            "iterations": r.iterations, "solve_time": r.times["solve"],
+            "time_after_mesh": r.after_mesh, "mesh_time": r.times["mesh"],
+            "x": r.summary["interface"]["x"], "pressure": r.summary["interface"]["pressure"]})
+    return out
+
+
+rows = rows_of(graded_study, "graded", "refine_edge") + rows_of(uniform_study, "uniform",
+                                                                 "refine")
+
+
 def series(method: str, label: str = "graded") -> list[dict]:
     return [r for r in rows if r["method"] == method and r["series"] == label]
 
 
-def rate(xs: list[float], ys: list[float]) -> float:
-    return float(np.polyfit(np.log(xs), np.log(np.abs(ys)), 1)[0])
+# -
 
+# ## Fitted rates
+#
+# The study fits every level (against the measured median contact element size); here we
+# also fit the slopes against $h_e$ on the graded meshes with $h_e \le 0.04$ cm (the coarser
+# ones have only a handful of nodes in contact), with the study's `fit_rate`.
 
+# +
 rates = {}
 for method in METHODS:
-    fine = [r for r in series(method) if r["h"] <= 0.04]
+    fine = [r for r in series(method) if r["h"] <= 0.04 + 1e-12]
+    hs = [r["h"] for r in fine]
     rates[method] = {
-        "l2_vs_h": rate([r["h"] for r in fine], [r["l2_error"] for r in fine]),
-        "a_vs_h": rate([r["h"] for r in fine], [r["a_err"] for r in fine]),
-        "l2_vs_time": rate([r["time_after_mesh"] for r in fine], [r["l2_error"] for r in fine]),
-        "elements_vs_h": rate([r["h"] for r in fine], [r["elements"] for r in fine]),
+        "l2_vs_h": fit_rate(hs, [r["l2_error"] for r in fine]),
+        "a_vs_h": fit_rate(hs, [r["a_err"] for r in fine]),
+        "l2_vs_time": fit_rate([r["time_after_mesh"] for r in fine],
+                               [r["l2_error"] for r in fine]),
+        "elements_vs_h": fit_rate(hs, [r["elements"] for r in fine]),
     }
     say(method, {k: round(v, 2) for k, v in rates[method].items()})
 # Fewest elements of a graded mesh with the half-width within 4 % (the paper needed 138k
@@ -151,10 +172,16 @@ say("graded mortar: fewest elements with |a - a_exact| < 4 %:", within4)
 # -
 
 # ## Table, charts and summary (rank 0)
+#
+# The study writes `study.json`, `study.csv`, `convergence.png` (error against the contact
+# element size, fitted rates in the legend) and `accuracy_vs_time.png`, with the uniform
+# meshes drawn dashed on both charts; the demo adds its table, the paper comparison and
+# the pressure profiles.
 
 # +
 if comm.rank == 0:
-    OUT.mkdir(parents=True, exist_ok=True)
+    written = write_outputs(graded_study, OUT, extra=[("uniform", uniform_study)])
+    say("\n".join(table_lines(graded_study)))
     head = ("| series | method | h at contact (cm) | elements | DOFs | a (cm) | a err | p0 (MPa) "
             "| p0 err | L2 err | AS its | solve (s) | after mesh (s) |")
     lines = [head, "|" + "---|" * 13]
@@ -171,8 +198,7 @@ if comm.rank == 0:
     lines += [f"Paper comparison (exact plane-strain a = {ref['a']:.4f} cm):", "",
               "| paper elements | paper a (cm) | our uniform elements | our a, fit (cm) "
               "| our a bracket (cm) |", "|---|---|---|---|---|"]
-    uni = series("mortar", "uniform")
-    for (n_paper, a_paper), r in zip(PAPER, uni, strict=False):
+    for (n_paper, a_paper), r in zip(PAPER, series("mortar", "uniform"), strict=False):
         fit = "-" if r["a_fit"] is None else f"{r['a_fit']:.3f}"
         lo, hi = r["a_bracket"]
         lines.append(f"| {n_paper} | {a_paper} | {r['elements']} | {fit} | "
@@ -181,54 +207,8 @@ if comm.rank == 0:
     slim = [{k: v for k, v in r.items() if k not in ("x", "pressure")} for r in rows]
     (OUT / "summary.json").write_text(json.dumps(
         {"quick": QUICK, "ranks": comm.size, "exact": ref, "rows": slim, "rates": rates,
-         "elements_within_4pct": within4, "paper": PAPER}, indent=1))
-
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
-    for ax, key, name in zip(axes, ("l2_error", "a_err", "p0_err"),
-                             ("relative L2 error of p", "|a - a_exact| / a_exact",
-                              "|p0 - p0_exact| / p0_exact"), strict=True):
-        for method in METHODS:
-            s = series(method)
-            ax.loglog([r["h"] for r in s], [abs(r[key]) for r in s], "o-",
-                      color=COLORS[method], label=f"{method}, graded")
-        u = series("mortar", "uniform")
-        ax.loglog([r["h"] for r in u], [max(abs(r[key]), 1e-6) for r in u], "s--",
-                  color=COLORS["mortar, uniform"], label="mortar, uniform")
-        hs = np.array([r["h"] for r in series("mortar") if r["h"] <= 0.04])
-        if key == "l2_error":
-            ax.loglog(hs, 0.5 * hs / hs[0] * series("mortar")[2]["l2_error"], "k:",
-                      label="slope 1")
-        ax.set_xlabel("element size at the contact edge h (cm)")
-        ax.set_ylabel(name)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    axes[0].set_title("L2 error: " + ", ".join(f"{m} {rates[m]['l2_vs_h']:.2f}"
-                                                for m in METHODS), fontsize=9)
-    fig.suptitle("Hertz (R = 60 cm, E = 7000 MPa, nu = 0.23, P = 100 MPa cm): error vs h")
-    fig.tight_layout()
-    fig.savefig(OUT / "convergence.png", dpi=110)
-    plt.close(fig)
-
-    fig, ax = plt.subplots(figsize=(7.5, 5))
-    for method in METHODS:
-        s = series(method)
-        ax.loglog([r["time_after_mesh"] for r in s], [r["l2_error"] for r in s], "o-",
-                  color=COLORS[method],
-                  label=f"{method}, graded (rate {rates[method]['l2_vs_time']:.2f})")
-    u = series("mortar", "uniform")
-    ax.loglog([r["time_after_mesh"] for r in u], [r["l2_error"] for r in u], "s--",
-              color=COLORS["mortar, uniform"], label="mortar, uniform")
-    for r in u:
-        ax.annotate(f"{r['elements'] // 1000}k el", (r["time_after_mesh"], r["l2_error"]),
-                    fontsize=8, xytext=(4, 4), textcoords="offset points")
-    ax.set_xlabel("wall time after meshing: assembly + search + active-set solves (s)")
-    ax.set_ylabel("relative L2 error of the contact pressure")
-    ax.set_title(f"Accuracy against time ({comm.size} rank{'s' * (comm.size > 1)})")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(OUT / "accuracy_vs_time.png", dpi=110)
-    plt.close(fig)
+         "study_rates": graded_study.rates, "elements_within_4pct": within4,
+         "paper": PAPER}, indent=1))
 
     fig, (ax, ax2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True,
                                   gridspec_kw={"height_ratios": [2, 1]})
@@ -257,7 +237,8 @@ if comm.rank == 0:
     fig.tight_layout()
     fig.savefig(OUT / "profile.png", dpi=110)
     plt.close(fig)
-    say("wrote", OUT)
+    say("wrote", ", ".join(p.name for p in written), "table.md, summary.json, profile.png to",
+        OUT)
 # -
 
 # ## Checks

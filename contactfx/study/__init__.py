@@ -6,6 +6,7 @@ thin layers over `run_study` and `write_outputs`; docs/study.md says what is mea
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 from .core import Run, Study, run_study
@@ -17,11 +18,15 @@ __all__ = ["Level", "Run", "Study", "builtin_levels", "fit_rate", "hertz_at", "l
            "run_study", "scene_file_levels", "size_factors", "table_lines", "write_outputs"]
 
 
-def write_outputs(study: Study, out: Path) -> list[Path]:
-    """study.json, study.csv, convergence.png and accuracy_vs_time.png in `out` (call on rank 0)."""
+def write_outputs(study: Study, out: Path, extra: Sequence[tuple[str, Study]] = ()
+                  ) -> list[Path]:
+    """study.json, study.csv, convergence.png and accuracy_vs_time.png in `out` (rank 0 only).
+
+    `extra`: (label, study) pairs the charts also draw, dashed (e.g. another mesh family).
+    """
     from .charts import plot_convergence, plot_time
 
     out.mkdir(parents=True, exist_ok=True)
     return [write_json(study, out / "study.json"), write_csv(study, out / "study.csv"),
-            plot_convergence(study, out / "convergence.png"),
-            plot_time(study, out / "accuracy_vs_time.png")]
+            plot_convergence(study, out / "convergence.png", extra),
+            plot_time(study, out / "accuracy_vs_time.png", extra)]

@@ -2,17 +2,18 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from .core import Study  # noqa: E402
-from .measures import ROUND_OFF  # noqa: E402
-from .report import main_errors  # noqa: E402
+from .core import Study
+from .measures import ROUND_OFF
+from .report import main_errors
 
 COLORS = {"nts": "tab:blue", "sts": "tab:orange", "mortar": "tab:green",
           "penalty": "tab:red", "schwarz": "tab:purple"}
@@ -47,50 +48,62 @@ def _figure(study: Study, x: str) -> tuple[plt.Figure, list[plt.Axes], list[str]
 
 def _title(study: Study) -> str:
     ref = study.reference
-    what = (f"reference: finest level of {ref['method']} (self-convergence)"
-            if ref["kind"] == "self" else f"reference: exact ({ref['type'].replace('_', ' ')})")
-    return f"{study.scene}: {what}, {study.ranks} rank{'s' * (study.ranks > 1)}"
+    what = {"hertz": "exact Hertz solution", "uniform_stress": "exact uniform stress"}.get(
+        ref["type"], f"finest level of {ref.get('method')}")
+    return f"{study.scene}, reference: {what}, {study.ranks} rank{'s' * (study.ranks > 1)}"
 
 
-def plot_convergence(study: Study, path: Path) -> Path:
-    """Error against the contact element size h, one panel per error, rates in the legend."""
+def _draw(ax: plt.Axes, study: Study, name: str, x: str, label: str | None = None) -> None:
+    """Every method of `study` on one panel; an extra study (`label`) is drawn dashed."""
+    rates = study.rates if x == "h" else study.time_rates
+    for m in study.methods:
+        xs, e = _series(study, m, name, x)
+        if not len(xs):
+            continue
+        rate = rates[m].get(name)
+        text = _rate_text(rate) if x == "h" else ("-" if rate is None else
+                                                  f"error ~ t^{rate:.2f}")
+        ax.loglog(xs, e, marker=MARKERS.get(m, "o") if label is None else "D",
+                  color=COLORS.get(m), lw=1.8, ms=7, ls="-" if label is None else "--",
+                  mfc=None if label is None else "none",
+                  label=f"{m}{'' if label is None else ', ' + label}: {text}")
+
+
+def _finish(fig: plt.Figure, path: Path, title: str) -> Path:
+    fig.suptitle(title, fontsize=12)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_convergence(study: Study, path: Path, extra: Sequence[tuple[str, Study]] = ()
+                     ) -> Path:
+    """Error against the contact element size h, one panel per error, rates in the legend.
+
+    `extra`: (label, study) pairs drawn dashed on the same panels (another mesh family).
+    """
     fig, axes, names = _figure(study, "h")
     for ax, name in zip(axes, names, strict=True):
-        for m in study.methods:
-            h, e = _series(study, m, name, "h")
-            if not len(h):
-                continue
-            rate = study.rates[m].get(name)
-            ax.loglog(h, e, marker=MARKERS.get(m, "o"), color=COLORS.get(m), lw=1.8, ms=7,
-                      label=f"{m}: {_rate_text(rate)}")
+        _draw(ax, study, name, "h")
+        for label, other in extra:
+            _draw(ax, other, name, "h", label)
         ax.set_xlabel("contact element size h (median in the contact zone)", fontsize=11)
         ax.set_ylabel(LABELS.get(name, name), fontsize=11)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=10, title="fitted error ~ h^rate", title_fontsize=10)
-    fig.suptitle(f"Error against mesh size ({_title(study)})", fontsize=12)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _finish(fig, path, f"Error against mesh size ({_title(study)})")
 
 
-def plot_time(study: Study, path: Path) -> Path:
+def plot_time(study: Study, path: Path, extra: Sequence[tuple[str, Study]] = ()) -> Path:
     """Error against wall time after meshing, every method on each panel."""
     fig, axes, names = _figure(study, "time")
     for ax, name in zip(axes, names, strict=True):
-        for m in study.methods:
-            t, e = _series(study, m, name, "time")
-            if not len(t):
-                continue
-            rate = study.time_rates[m].get(name)
-            ax.loglog(t, e, marker=MARKERS.get(m, "o"), color=COLORS.get(m), lw=1.8, ms=7,
-                      label=f"{m}: " + ("-" if rate is None else f"error ~ t^{rate:.2f}"))
+        _draw(ax, study, name, "time")
+        for label, other in extra:
+            _draw(ax, other, name, "time", label)
         ax.set_xlabel("wall time after meshing (s): assembly, search, solves", fontsize=11)
         ax.set_ylabel(LABELS.get(name, name), fontsize=11)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=10, title="lower left is better", title_fontsize=10)
-    fig.suptitle(f"Accuracy against time ({_title(study)})", fontsize=12)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _finish(fig, path, f"Accuracy against time ({_title(study)})")

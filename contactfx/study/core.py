@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 from mpi4py import MPI
 
 from ..api import run_scene
@@ -113,15 +114,16 @@ class Progress:
         self.default_growth = ratio**2
 
     def growth(self) -> float:
-        """Observed growth of a run's cost per level (geometric mean over methods)."""
-        steps = [self.cost[m, k] / self.cost[m, k - 1] for (m, k) in self.cost
-                 if (m, k - 1) in self.cost and self.cost[m, k - 1] > 0]
+        """Growth of a run's cost per level, from the latest levels (costs grow faster there)."""
+        steps = {k: self.cost[m, k] / self.cost[m, k - 1] for (m, k) in self.cost
+                 if (m, k - 1) in self.cost and self.cost[m, k - 1] > 0}
         if not steps:
             return self.default_growth
-        g = 1.0
-        for s in steps:
-            g *= s
-        return min(max(g ** (1 / len(steps)), 1.0), self.default_growth**2)
+        last = max(steps)
+        recent = [self.cost[m, last] / self.cost[m, last - 1] for m in self.methods
+                  if (m, last) in self.cost and (m, last - 1) in self.cost
+                  and self.cost[m, last - 1] > 0]
+        return min(max(float(np.median(recent)), 1.0), self.default_growth**2)
 
     def estimate(self, method: str, level: int, g: float) -> float:
         """Expected cost of a run not done yet, from the closest done level."""

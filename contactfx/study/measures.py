@@ -106,7 +106,7 @@ class Profiles:
 
 
 def surface_displacement(sol: Solution, side: GatheredSurface) -> np.ndarray:
-    """u (n, 2) at every node of a gathered surface, on all ranks (each node from its owner)."""
+    """The displacement (n, 2) at every node of a gathered surface, on all ranks."""
     imap = sol.elasticity.V.dofmap.index_map
     lo, hi = imap.local_range
     mine = (side.gblock >= lo) & (side.gblock < hi)
