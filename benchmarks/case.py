@@ -1,12 +1,17 @@
-"""One benchmark run: the Hertz scene on the structured mesh, solved once, timings as JSON.
+"""One benchmark run: the Hertz scene (structured or gmsh mesh) solved by each method, as JSON.
 
-Run serially or under mpirun; rank 0 prints one JSON line. Used by benchmarks/run.py, which
-runs every case in a fresh process so that peak memory (max RSS) belongs to that case.
+Run serially or under mpirun; rank 0 prints one `RESULT {json}` line per method. The mesh is
+built once and every method of `--method nts,sts,mortar` is solved on it in turn (with its own
+reference solve), as a user's `python -m contactfx solve hertz ... --reference-timing` with
+the default options would: `contactfx.api.solve` picks the predictor. Used by
+benchmarks/run.py, which runs every case in a fresh process (peak memory, max RSS, is that
+process's: the largest over its methods).
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import resource
 import time
@@ -14,9 +19,8 @@ import time
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 from mpi4py import MPI
 
-from contactfx.api import COARSE_FACTOR, coarse_prediction, use_coarse
+from contactfx.api import solve
 from contactfx.methods import Method
-from contactfx.problem import ActiveSetOptions, solve_contact
 from contactfx.scenes import HertzParams, hertz
 from contactfx.solvers import SOLVERS
 from contactfx.timers import Timers
@@ -35,69 +39,72 @@ def peak_rss_mb() -> float:
 
 
 def main() -> None:
-    """Parse, run, print the JSON record on rank 0."""
+    """Parse, mesh once, solve each method, print one JSON record per method on rank 0."""
     ap = argparse.ArgumentParser()
-    ap.add_argument("--method", default="mortar")
+    ap.add_argument("--method", default="mortar", help="one method or a comma list")
     ap.add_argument("--solver", default="mumps")
+    ap.add_argument("--mesh", default="structured", choices=("structured", "gmsh"))
     ap.add_argument("--refine", type=float, required=True, help="h at the contact (cm)")
+    ap.add_argument("--refine-edge", type=float, default=None,
+                    help="gmsh: h at x = a (cm); default refine / 4")
     ap.add_argument("--h-far", type=float, required=True, help="largest element size (cm)")
     ap.add_argument("--option", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--no-reference", action="store_true")
     ap.add_argument("--predictor", default="auto", choices=("auto", "coarse", "none"),
                     help="first active set from a solve with 8x coarser sizes (timed as "
-                    "'predictor', part of the contact solve); auto: above 200k dofs")
+                    "'predictor', part of the contact solve); auto: the library's default")
     ap.add_argument("--fixed-set", action="store_true",
                     help="no active-set loop: one fresh solve with the Hertz zone x < a active "
                     "(the iterative path's scaling of linear iterations)")
     args = ap.parse_args()
     comm = MPI.COMM_WORLD
-    options = dict(SOLVERS[args.solver])
-    for item in args.option:
-        key, _, value = item.partition("=")
-        options[key] = value
-    timers = Timers()
+    solver: str | dict[str, object] = args.solver
+    if args.option or args.fixed_set:
+        options = dict(SOLVERS[args.solver])
+        for item in args.option:
+            key, _, value = item.partition("=")
+            options[key] = value
+        solver = options
+    edge = args.refine / 4 if args.refine_edge is None else args.refine_edge
+    params = HertzParams(refine=args.refine, h_far=args.h_far, mesh=args.mesh,
+                         **({"refine_edge": edge} if args.mesh == "gmsh" else {}))
     comm.Barrier()
     t0 = time.perf_counter()
-    with timers("mesh"):
-        scene = hertz(HertzParams(refine=args.refine, h_far=args.h_far, mesh="structured"),
-                      comm=comm)
-    if args.fixed_set:
-        record = fixed_set_solve(scene, Method(args.method), options, timers)
+    mesh_timers = Timers()
+    with mesh_timers("mesh"):
+        scene = hertz(params, comm=comm)
+    common = {"solver": args.solver, "ranks": comm.size, "mesh": args.mesh,
+              "refine": args.refine, "h_far": args.h_far,
+              "refine_edge": edge if args.mesh == "gmsh" else None}
+    for method in args.method.split(","):
+        gc.collect()  # the previous method's PETSc objects
+        timers = Timers()
+        timers.seconds["mesh"] = mesh_timers.seconds["mesh"]
+        t_run = time.perf_counter()
+        if args.fixed_set:
+            assert isinstance(solver, dict)
+            record = fixed_set_solve(scene, Method(method), solver, timers)
+        else:
+            sol = solve(scene, method, solver=solver, timers=timers,
+                        reference_timing=not args.no_reference, predictor=args.predictor)
+            V = sol.elasticity.V
+            record = {
+                "predictor": "predictor" in timers.seconds,
+                "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+                "multipliers": int(sol.layout.size), "active_nodes": int(sol.active.sum()),
+                "iterations": sol.iterations,
+                "history": [{k: (float(v) if not isinstance(v, int) else v)
+                             for k, v in h.items()} for h in sol.history],
+                "contact_force_error": abs(float((sol.pressure * sol.layout.weights).sum())
+                                           - scene.params["P"] / 2) / (scene.params["P"] / 2),
+            }
         comm.Barrier()
-        record.update(method=args.method, solver=args.solver, ranks=comm.size,
-                      refine=args.refine, h_far=args.h_far, total=time.perf_counter() - t0,
-                      peak_rss_mb=comm.allreduce(peak_rss_mb()),
-                      times={k: comm.allreduce(v, op=MPI.MAX)
-                             for k, v in timers.seconds.items()})
+        times = {k: comm.allreduce(v, op=MPI.MAX) for k, v in timers.seconds.items()}
+        times["total"] = time.perf_counter() - t_run + times["mesh"]
+        record.update(common, method=method, times=times, since_start=time.perf_counter() - t0,
+                      peak_rss_mb=comm.allreduce(peak_rss_mb()))
         if comm.rank == 0:
             print("RESULT " + json.dumps(record), flush=True)
-        return
-    init = None
-    if use_coarse(args.predictor, scene, options):
-        with timers("predictor"):
-            coarse = scene.resize(COARSE_FACTOR)
-            init = coarse_prediction(coarse, Method(args.method), options)
-    sol = solve_contact(scene, Method(args.method), options, ActiveSetOptions(), timers,
-                        reference_timing=not args.no_reference, initial_active=init)
-    comm.Barrier()
-    total = time.perf_counter() - t0
-    V = sol.elasticity.V
-    rss = comm.allreduce(peak_rss_mb())
-    times = {k: comm.allreduce(v, op=MPI.MAX) for k, v in timers.seconds.items()}
-    times["total"] = total
-    record = {
-        "method": args.method, "solver": args.solver, "ranks": comm.size,
-        "refine": args.refine, "h_far": args.h_far, "predictor": "predictor" in times,
-        "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
-        "multipliers": int(sol.layout.size), "active_nodes": int(sol.active.sum()),
-        "iterations": sol.iterations, "times": times, "peak_rss_mb": rss,
-        "history": [{k: (float(v) if not isinstance(v, int) else v) for k, v in h.items()}
-                    for h in sol.history],
-        "contact_force_error": abs(float((sol.pressure * sol.layout.weights).sum())
-                                   - scene.params["P"] / 2) / (scene.params["P"] / 2),
-    }
-    if comm.rank == 0:
-        print("RESULT " + json.dumps(record), flush=True)
 
 
 def fixed_set_solve(scene, method: Method, options: dict, timers: Timers) -> dict:

@@ -37,6 +37,10 @@ class ActiveSetOptions:
     tolerance: float = 1e-6        # complementarity residual (relative) required at the end
     predictor: bool = True         # probe candidate sets with multi-RHS solves (direct solvers)
     max_probes: int = 2000         # largest candidate set probed
+    # With cheap probe responses (serial MUMPS: selected entries of the inverse), start from
+    # every multiplier row in contact and probe them all: one factorization, the predicted
+    # set by the small complementarity problem, then one solve that only releases rows.
+    start_all: bool = True
 
 
 @dataclass(frozen=True)

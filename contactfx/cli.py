@@ -82,7 +82,9 @@ def _study_parser(sub: Any) -> None:
                     "(default 1: the scene as given; e.g. 8 to start coarser)")
     st.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
     v = s.add_argument_group("linear solver")
-    v.add_argument("--solver", default="mumps", help="mumps | fieldsplit | fieldsplit-gamg")
+    v.add_argument("--solver", default="mumps",
+                   help="mumps | fieldsplit | fieldsplit-gamg | condensed (multipliers "
+                        "eliminated, CG + GAMG; needs --method nts or mortar --basis dual)")
     v.add_argument("--petsc-option", action="append", default=[], metavar="KEY=VALUE",
                    help="extra PETSc option for the saddle-point KSP (no leading dash)")
     o = s.add_argument_group("output")
@@ -106,13 +108,18 @@ def _solve_parser(sub: Any) -> None:
     m.add_argument("--penalty", type=float, default=None, metavar="EPS",
                    help="penalty normal stiffness (pressure = EPS * penetration) for --method "
                    "penalty; default 1e3 * max E / h, h the median contact element size")
+    m.add_argument("--basis", choices=["standard", "dual"], default="standard",
+                   help="mortar multiplier basis: standard (N_j) or dual (biorthogonal, D "
+                        "diagonal: what --solver condensed needs)")
     m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
     m.add_argument("--predictor", choices=["auto", "coarse", "none"], default="auto",
                    help="first active set from a coarser solve of the same scene: auto = above "
                         "200k DOFs, for scenes that can be remeshed (the answer does not "
                         "depend on it)")
     v = s.add_argument_group("linear solver")
-    v.add_argument("--solver", default="mumps", help="mumps | fieldsplit | fieldsplit-gamg")
+    v.add_argument("--solver", default="mumps",
+                   help="mumps | fieldsplit | fieldsplit-gamg | condensed (multipliers "
+                        "eliminated, CG + GAMG; needs --method nts or mortar --basis dual)")
     v.add_argument("--petsc-option", action="append", default=[], metavar="KEY=VALUE",
                    help="extra PETSc option for the saddle-point KSP (no leading dash)")
     v.add_argument("--reference-timing", action="store_true",
@@ -247,7 +254,8 @@ def run(args: argparse.Namespace) -> int:
         scene = build_from_args(args)
     sol, data = run_scene(scene, method, solver=options, t_start=t_start, timers=timers,
                           max_iterations=args.max_iterations, penalty=args.penalty,
-                          reference_timing=args.reference_timing, predictor=args.predictor)
+                          reference_timing=args.reference_timing, predictor=args.predictor,
+                          basis=args.basis)
     data["solver"] = "mumps (each body)" if method == Method.SCHWARZ else args.solver
     if args.out is not None:
         write_fields(sol, args.out)

@@ -7,6 +7,7 @@ complementarity problem on the candidates predicts the converged set (`active_se
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Mapping
 from typing import cast
 
@@ -23,9 +24,10 @@ from .active_set import (
     lcp_active_set,
     run_active_set,
 )
+from .condensed import CondensedSolver, is_condensed, owned_node_dofs
 from .errors import InputError
 from .methods import IMPLEMENTED, Method
-from .nullspace import near_nullspace
+from .nullspace import near_nullspace, rigid_body_modes
 from .prepare import ContactSetup, prepare_contact
 from .saddle import SaddleSolver, reference_solve
 from .scenes import Scene
@@ -45,7 +47,8 @@ class MultiplierIteration:
 
     label = "active set"
 
-    def __init__(self, setup: ContactSetup, solver: SaddleSolver, aso: ActiveSetOptions,
+    def __init__(self, setup: ContactSetup, solver: SaddleSolver | CondensedSolver,
+                 aso: ActiveSetOptions,
                  c: float, direct: bool, given_start: bool) -> None:
         self.setup, self.solver, self.aso, self.c = setup, solver, aso, c
         self.direct, self.given_start = direct, given_start
@@ -62,10 +65,29 @@ class MultiplierIteration:
         return self.probe is not None
 
     def start(self, active: np.ndarray, guess: InitialSet | None) -> np.ndarray:
-        """Add a given first set (and probe its uncertain band) to the touching nodes."""
-        if guess is None:
-            return active
+        """Add a given first set (and probe its uncertain band) to the touching nodes.
+
+        Without one, and when probe responses are cheap (`SaddleSolver.cheap_responses`),
+        every row is put in contact and probed (`ActiveSetOptions.start_all`): a superset of
+        any converged set, so the loop factorizes once and then only releases rows. Rows of
+        a node that several pairs constrain keep their touching status (two such rows may be
+        dependent: the saddle point would be singular).
+        """
         comm = self.setup.scene.comm
+        if guess is None:
+            layout = self.setup.layout
+            size = layout.size
+            if not (self.aso.start_all and self.aso.predictor and self.direct
+                    and self.solver.cheap_responses and 0 < size <= self.aso.max_probes):
+                return active
+            node = np.asarray(layout.gblock)
+            counts = np.unique(node, return_counts=True)
+            shared = np.isin(node, counts[0][counts[1] > 1])[layout.mine]
+            every = active | ~shared
+            self.band = every.copy()
+            self.probe = self.state.global_indices(every)
+            self.given_start = True
+            return every
         x_mine = self.setup.layout.x[self.setup.layout.mine]
         active = active | np.asarray(guess.active(x_mine), dtype=bool)
         if guess.uncertain is not None and self.aso.predictor and self.direct:
@@ -156,9 +178,19 @@ def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, objec
     el, h = setup.elasticity, setup.h
     e_max = max(b.material.E for b in scene.bodies)
     gamma = e_max / h**2 if uses_augmentation(options) else 0.0
+    condensed = is_condensed(options)
+    if condensed and not (method == Method.NTS or (method == Method.MORTAR and basis == "dual")):
+        raise InputError("the condensed solver needs a diagonal D: use --method nts or "
+                         "--method mortar --basis dual")
     # One solver for the whole loop: fixed matrix pattern, reused analysis and factorization.
     nullspace = near_nullspace(el.V, scene) if uses_augmentation(options) else None
-    saddle = SaddleSolver(el.K, setup.B, el.f, options, gamma, nullspace)
+    saddle: SaddleSolver | CondensedSolver
+    if condensed:
+        node_dofs = owned_node_dofs(setup.layout.gblock, setup.layout.mine)
+        saddle = CondensedSolver(el.K, setup.B, el.f, options, node_dofs,
+                                 rigid_body_modes(el.V, scene))
+    else:
+        saddle = SaddleSolver(el.K, setup.B, el.f, options, gamma, nullspace)
     guess = (initial_active if isinstance(initial_active, InitialSet) or initial_active is None
              else InitialSet(initial_active))
     # Probes need the exact inverse: only a factorization of the whole saddle point gives it.
@@ -169,8 +201,16 @@ def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, objec
         step, active, history = run_active_set(setup, iteration, active, aso, timers)
     finally:
         saddle.destroy()
-    if reference_timing:
+    if reference_timing and condensed:
         # The cost floor: one fresh solve of the final system by the same solver.
+        scene.comm.Barrier()
+        t0 = time.perf_counter()
+        fresh = CondensedSolver(el.K, setup.B, el.f, options, node_dofs,
+                                rigid_body_modes(el.V, scene))
+        fresh.solve(setup.g, active)
+        fresh.destroy()
+        timers.seconds["reference_solve"] = time.perf_counter() - t0
+    elif reference_timing:
         _, timers.seconds["reference_solve"] = reference_solve(
             el.K, setup.B, el.f, setup.g, active, options, gamma, nullspace)
     sol = setup.solution(method, iteration.u, step.lam, step.gap, active, history, timers)

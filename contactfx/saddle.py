@@ -6,11 +6,15 @@ off, so every matrix keeps its nonzero pattern and PETSc redoes only the numeric
 keeps its ordering and symbolic analysis). With a direct solver it goes further: a solve whose
 active set differs from the factorized one in a few rows is a low-rank change, which GMRES
 preconditioned by the old factorization solves in a few iterations; it refactors only when
-that would cost more than a new numeric factorization.
+that would cost more than a new numeric factorization. Multiplier responses (probes) come from
+MUMPS' selected entries of the inverse (ICNTL(30)) where that is available: a few
+milliseconds for what costs one back-substitution per column as dense right-hand sides.
 """
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -27,6 +31,41 @@ from .solvers import PrefixedOptions, is_direct, petsc_error_message, reason_nam
 _MAX_RELEASED = 2000
 # Entries per rank of one dense block of probe right-hand sides (8 bytes each).
 _PROBE_ENTRIES = 64_000_000
+# A fresh factorization's single back-substitution is accepted at this relative residual
+# (MUMPS' own accuracy on these saddle points: 1e-11 to 6e-9, the solution then agrees with
+# GMRES to 1e-11); above it GMRES (rtol 1e-13) takes over from that solution.
+_APPLY_RTOL = 1e-9
+# A capacitance (released rows) solve is accepted at this relative residual, else refactored.
+_RELEASED_RTOL = 1e-8
+
+
+@functools.cache
+def _petsc_library() -> ctypes.CDLL | None:
+    """The libpetsc that petsc4py loaded (for MUMPS calls petsc4py does not wrap), or None."""
+    try:
+        with open("/proc/self/maps") as maps:
+            paths = {line.split()[-1] for line in maps if "libpetsc" in line.rsplit("/", 1)[-1]}
+        for path in sorted(paths):
+            lib = ctypes.CDLL(path)
+            if hasattr(lib, "MatMumpsGetInverse") and hasattr(lib, "MatMumpsSetIcntl"):
+                lib.MatMumpsGetInverse.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
+                lib.MatMumpsGetIcntl.argtypes = [ctypes.c_void_p, ctypes.c_int,
+                                                 ctypes.POINTER(ctypes.c_int)]
+                lib.MatMumpsSetIcntl.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+                return lib
+    except OSError:
+        pass
+    return None
+
+
+def selected_inverse_available(options: Mapping[str, object], ranks: int) -> bool:
+    """Whether a solve with `options` on `ranks` ranks gets probe responses cheaply.
+
+    That is MUMPS' LU of the whole saddle point on one rank (see SaddleSolver.cheap_responses).
+    """
+    return (ranks == 1 and options.get("pc_type") == "lu"
+            and options.get("pc_factor_mat_solver_type") == "mumps"
+            and _petsc_library() is not None)
 
 
 @dataclass
@@ -127,6 +166,9 @@ class SaddleSolver:
         self._ksp = PETSc.KSP().create(comm)
         self._ksp.setOptionsPrefix(self._options.prefix)
         self._factored: np.ndarray | None = None
+        # (factorization count, g, solution) of the last direct solve on the factorized set:
+        # the capacitance path's first back-substitution when nothing changed since.
+        self._last: tuple[float, np.ndarray, np.ndarray] | None = None
         # (factorization count, sorted global rows, responses) of the last direct probe solve.
         self._cache: tuple[float, np.ndarray, np.ndarray] | None = None
         self._t_numeric = np.inf
@@ -135,6 +177,16 @@ class SaddleSolver:
         # "auto" weighs a lagged factorization against a new one by their measured costs;
         # "reuse" and "refactor" force one side (tests, benchmarks).
         self.policy = "auto"
+
+    @property
+    def cheap_responses(self) -> bool:
+        """Whether probe responses come from MUMPS' selected inverse entries (serial MUMPS LU).
+
+        petsc4py does not wrap MatMumpsGetInverse; it is called through ctypes. On several
+        ranks it leaves MUMPS' centralized right-hand-side pointer set, and the next solve
+        fails (INFOG(1) = -22): there the probes stay dense multi-right-hand-side solves.
+        """
+        return self.gamma == 0.0 and selected_inverse_available(self.options, self._mpi.size)
 
     def __enter__(self) -> SaddleSolver:
         return self
@@ -255,12 +307,21 @@ class SaddleSolver:
             t1 = time.perf_counter()
             if self.direct:
                 self._x.set(0.0)
-            ksp.solve(self._b, self._x)
+            # A fresh factorization is applied once, as preonly would (GMRES's two
+            # iterations cost three back-substitutions' time); GMRES only if that is inexact.
+            single = refactor and self.reuse and self._apply_once()
+            if not single:
+                ksp.setInitialGuessNonzero(refactor and self.reuse)
+                ksp.solve(self._b, self._x)
+                ksp.setInitialGuessNonzero(False)
             t2 = time.perf_counter()
         except PETSc.Error as err:
             raise SolverError(petsc_error_message(err, "saddle-point solve")) from None
-        reason = cast(int, ksp.getConvergedReason())  # an int; the stub says the enum class
-        its = ksp.getIterationNumber()
+        if single:
+            reason, its = int(PETSc.KSP.ConvergedReason.CONVERGED_ITS), 1
+        else:
+            reason = cast(int, ksp.getConvergedReason())  # an int; the stub: the enum class
+            its = ksp.getIterationNumber()
         if refactor:
             if changed >= 0 or self.stats["factorizations"] > 1:
                 self._t_numeric = t1 - t0
@@ -276,6 +337,9 @@ class SaddleSolver:
         if not ok:
             raise SolverError(f"linear solve ({ksp.getType()}) did not converge: PETSc reason "
                               f"{reason} ({reason_name(reason)}) after {its} iterations")
+        if self.direct and self._factored is not None and np.array_equal(active, self._factored):
+            self._last = (self.stats["factorizations"], np.array(g, copy=True),
+                          self._x.array_r.copy())
         u_sub, l_sub = self._x.getSubVector(self._is_u), self._x.getSubVector(self._is_l)
         u, mu = u_sub.array.copy(), l_sub.array.copy()
         self._x.restoreSubVector(self._is_u, u_sub)
@@ -285,6 +349,20 @@ class SaddleSolver:
         if probes is not None:
             info["probes"] = self._solve_probes(np.asarray(probes, dtype=float), active)
         return SaddleResult(u, mu, its, reason, info)
+
+    def _relative_residual(self, x: PETSc.Vec) -> float:
+        """||b - A x|| / ||b|| for the current operator and right-hand side (collective)."""
+        r = self._b.duplicate()
+        self._A.mult(x, r)
+        r.aypx(-1.0, self._b)
+        rel = r.norm() / max(self._b.norm(), 1e-300)
+        r.destroy()
+        return float(rel) if np.isfinite(rel) else np.inf
+
+    def _apply_once(self) -> bool:
+        """One back-substitution with the fresh factorization into x; True if accurate."""
+        self._ksp.getPC().apply(self._b, self._x)
+        return self._relative_residual(self._x) <= _APPLY_RTOL
 
     def _solve_released(self, g: np.ndarray, active: np.ndarray) -> SaddleResult | None:
         """Exact solve for a subset of the factorized set by a capacitance system (no refactor).
@@ -305,8 +383,13 @@ class SaddleSolver:
         b = self._b.duplicate()
         self._b.copy(b)
         b.array[rows_l] = np.where(factored, -g, 0.0)
+        last = self._last
         try:
-            pc.apply(b, self._x)
+            if (last is not None and last[0] == self.stats["factorizations"]
+                    and np.array_equal(last[1], g)):
+                self._x.array[:] = last[2]  # the factorized set's own solution, kept
+            else:
+                pc.apply(b, self._x)
             mu0 = np.concatenate(self._mpi.allgather(self._x.array_r[rows_l][rel]))
             resp = self._responses(rel_global, rel, factored)
             M = np.concatenate(self._mpi.allgather(resp[rel]))
@@ -318,6 +401,8 @@ class SaddleSolver:
         pc.apply(b, self._x)
         b.destroy()
         self._x.array[rows_l[rel]] = 0.0
+        if self._relative_residual(self._x) > _RELEASED_RTOL:
+            return None  # an ill-conditioned capacitance system: refactor instead
         t1 = time.perf_counter()
         self.stats["reused"] += 1
         u_sub, l_sub = self._x.getSubVector(self._is_u), self._x.getSubVector(self._is_l)
@@ -353,6 +438,77 @@ class SaddleSolver:
         out = np.zeros((len(active), k))
         if k == 0:
             return out
+        selected = self._selected_responses(probes.reshape(len(active), k), active)
+        if selected is not None:
+            out = selected
+        else:
+            self._dense_responses(probes, active, out)
+        if self.direct:
+            # Keep the responses: a later subset of this set is then solved without refactoring.
+            gp = np.where(active[:, None], probes.reshape(len(active), k), 0.0)
+            r0 = self._B.getOwnershipRange()[0]
+            nz = gp != 0.0
+            # A rank may own no multiplier row: argmax of an empty axis is undefined there.
+            first = np.argmax(nz, axis=0) if nz.shape[0] else np.zeros(k, dtype=np.int64)
+            col_row = np.where(nz.any(axis=0), r0 + first, -1)
+            col_row = col_row.astype(np.int64)
+            self._mpi.Allreduce(MPI.IN_PLACE, col_row, op=MPI.MAX)
+            order = np.argsort(col_row)
+            self._cache = (self.stats["factorizations"], col_row[order], out[:, order])
+        return out
+
+    def _selected_responses(self, probes: np.ndarray, active: np.ndarray) -> np.ndarray | None:
+        """The probe responses as selected entries of A^-1 (MUMPS ICNTL(30)), or None.
+
+        Only for unit columns on active rows (what the active-set loop probes): column j's
+        responses are then the entries (i, j) of A^-1 over the active multiplier rows i
+        (inactive rows respond with mu = 0). MUMPS prunes its elimination tree to the paths
+        of these rows: 60 x 60 entries took 0.14 s at 1M dofs, 9.7 s as dense columns.
+        """
+        lib = _petsc_library()
+        if not self.cheap_responses or lib is None:
+            return None
+        nz = probes != 0.0
+        if not (np.all(nz.sum(axis=0) == 1) and np.all(probes[nz] == 1.0)):
+            return None
+        col_rows = np.argmax(nz, axis=0)
+        if not np.all(active[col_rows]):
+            return None
+        req = np.flatnonzero(active)
+        rows_l = self._is_l.getIndices() - self._A.getOwnershipRange()[0]
+        n = self._A.getSize()[0]
+        cols, where = np.unique(rows_l[col_rows], return_inverse=True)
+        wanted = np.sort(rows_l[req])
+        order = np.argsort(rows_l[req])
+        # Row c of the transposed pattern asks for the entries (wanted, c) of A^-1.
+        count = np.zeros(n, dtype=np.int64)
+        count[cols] = len(wanted)
+        indptr = np.concatenate([[0], np.cumsum(count)]).astype(PETSc.IntType)
+        indices = np.tile(wanted, len(cols)).astype(PETSc.IntType)
+        values = np.zeros(len(indices), dtype=PETSc.ScalarType)
+        spT = PETSc.Mat().createAIJ((n, n), csr=(indptr, indices, values),  # type: ignore[arg-type]
+                                    comm=PETSc.COMM_SELF)
+        spT.assemble()
+        sp = PETSc.Mat().createTranspose(spT)
+        F = self._ksp.getPC().getFactorMatrix()
+        saved = {i: ctypes.c_int() for i in (20, 30)}
+        for i, v in saved.items():
+            lib.MatMumpsGetIcntl(F.handle, i, ctypes.byref(v))
+        err = lib.MatMumpsGetInverse(F.handle, sp.handle)
+        for i, v in saved.items():  # back to ordinary solves
+            lib.MatMumpsSetIcntl(F.handle, i, v.value)
+        entries = spT.getValuesCSR()[2].reshape(len(cols), len(wanted)).copy()
+        sp.destroy()
+        spT.destroy()
+        if err != 0 or not np.all(np.isfinite(entries)):
+            return None
+        out = np.zeros((len(active), probes.shape[1]))
+        out[req[order], :] = entries[where].T
+        return out
+
+    def _dense_responses(self, probes: np.ndarray, active: np.ndarray, out: np.ndarray) -> None:
+        """Probe responses by multi-right-hand-side solves with the whole operator, into out."""
+        k = out.shape[1]
         gp = np.where(active[:, None], probes.reshape(len(active), k), 0.0)
         start = self._A.getOwnershipRange()[0]
         rows_u = self._is_u.getIndices() - start
@@ -369,18 +525,6 @@ class SaddleSolver:
                 # The augmented block's right-hand side gamma B^T g, all columns in one product.
                 rhs[rows_u] = self._dense_product(self._BAT, self.gamma * gp[:, cols])
             out[:, cols] = self._apply_inverse(rhs)[rows_l]
-        if self.direct:
-            # Keep the responses: a later subset of this set is then solved without refactoring.
-            r0 = self._B.getOwnershipRange()[0]
-            nz = gp != 0.0
-            # A rank may own no multiplier row: argmax of an empty axis is undefined there.
-            first = np.argmax(nz, axis=0) if nz.shape[0] else np.zeros(k, dtype=np.int64)
-            col_row = np.where(nz.any(axis=0), r0 + first, -1)
-            col_row = col_row.astype(np.int64)
-            self._mpi.Allreduce(MPI.IN_PLACE, col_row, op=MPI.MAX)
-            order = np.argsort(col_row)
-            self._cache = (self.stats["factorizations"], col_row[order], out[:, order])
-        return out
 
     def _dense_product(self, A: PETSc.Mat, local: np.ndarray) -> np.ndarray:
         """Local rows of A @ X for a dense X given by its local rows (one sparse-dense product)."""

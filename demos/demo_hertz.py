@@ -78,11 +78,13 @@ def say(*args: object) -> None:
 #
 # A uniform mesh has the same size everywhere (slope ~0) and no edge refinement.
 
+
 # +
 def graded(h_edge: float) -> HertzParams:
     """Graded mesh with size h_edge at the contact edge (what the study's level f builds)."""
-    return HertzParams(refine=4 * h_edge, refine_edge=h_edge,
-                       slope=min(0.3, 0.1 * np.sqrt(h_edge / 0.005)))
+    return HertzParams(
+        refine=4 * h_edge, refine_edge=h_edge, slope=min(0.3, 0.1 * np.sqrt(h_edge / 0.005))
+    )
 
 
 def uniform(h: float) -> HertzParams:
@@ -98,11 +100,14 @@ UNIFORM = [0.87] if QUICK else [0.87, 0.43, 0.22]
 PAPER = [(4794 + 3736, 2.0), (20182 + 15240, 1.8), (79458 + 58472, 1.1)]
 
 graded_levels = builtin_levels("hertz", HertzParams(), FACTORS, comm=comm)
-assert all(abs(lv.sizes["slope"] - graded(lv.sizes["refine_edge"]).slope) < 1e-12
-           for lv in graded_levels), "the study's levels are not demo's graded() meshes"
+assert all(
+    abs(lv.sizes["slope"] - graded(lv.sizes["refine_edge"]).slope) < 1e-12 for lv in graded_levels
+), "the study's levels are not demo's graded() meshes"
 # The paper's uniform sizes are not a geometric sequence: levels given one by one.
-uniform_levels = [Level(k, h, {"refine": h}, lambda h=h: hertz(uniform(h), comm=comm))
-                  for k, h in enumerate(UNIFORM)]
+uniform_levels = [
+    Level(k, h, {"refine": h}, lambda h=h: hertz(uniform(h), comm=comm))
+    for k, h in enumerate(UNIFORM)
+]
 say("graded meshes:")
 graded_study = run_study(graded_levels, METHODS, comm=comm)
 say("uniform meshes:")
@@ -115,6 +120,7 @@ ref = hertz_exact(HertzParams())
 # Each run of a study carries its JSON summary; the table reads a, p0 and the L2 error from
 # it, and the nominal size: $h_e$ on the graded meshes, the uniform size otherwise.
 
+
 # +
 def rows_of(study: Study, label: str, size_key: str) -> list[dict]:
     """Table rows of a study's finished runs (rank-independent numbers plus timings)."""
@@ -124,20 +130,34 @@ def rows_of(study: Study, label: str, size_key: str) -> list[dict]:
         hz = r.summary["hertz"]
         lo, hi = hz["a_bracket"]
         a = hz["a"] if hz["a"] is not None else 0.5 * (lo + (hi if hi is not None else lo))
-        out.append({
-            "series": label, "method": r.method, "h": study.levels[r.level].sizes[size_key],
-            "h_measured": r.h, "elements": r.elements, "dofs": r.dofs,
-            "multipliers": r.summary["multipliers"], "a": a, "a_fit": hz["a"],
-            "a_bracket": hz["a_bracket"], "p0": hz["p0"], "a_err": a / hz["a_exact"] - 1,
-            "p0_err": hz["p0"] / hz["p0_exact"] - 1, "l2_error": hz["l2_error"],
-            "iterations": r.iterations, "solve_time": r.times["solve"],
-            "time_after_mesh": r.after_mesh, "mesh_time": r.times["mesh"],
-            "x": r.summary["interface"]["x"], "pressure": r.summary["interface"]["pressure"]})
+        out.append(
+            {
+                "series": label,
+                "method": r.method,
+                "h": study.levels[r.level].sizes[size_key],
+                "h_measured": r.h,
+                "elements": r.elements,
+                "dofs": r.dofs,
+                "multipliers": r.summary["multipliers"],
+                "a": a,
+                "a_fit": hz["a"],
+                "a_bracket": hz["a_bracket"],
+                "p0": hz["p0"],
+                "a_err": a / hz["a_exact"] - 1,
+                "p0_err": hz["p0"] / hz["p0_exact"] - 1,
+                "l2_error": hz["l2_error"],
+                "iterations": r.iterations,
+                "solve_time": r.times["solve"],
+                "time_after_mesh": r.after_mesh,
+                "mesh_time": r.times["mesh"],
+                "x": r.summary["interface"]["x"],
+                "pressure": r.summary["interface"]["pressure"],
+            }
+        )
     return out
 
 
-rows = rows_of(graded_study, "graded", "refine_edge") + rows_of(uniform_study, "uniform",
-                                                                 "refine")
+rows = rows_of(graded_study, "graded", "refine_edge") + rows_of(uniform_study, "uniform", "refine")
 
 
 def series(method: str, label: str = "graded") -> list[dict]:
@@ -160,8 +180,7 @@ for method in METHODS:
     rates[method] = {
         "l2_vs_h": fit_rate(hs, [r["l2_error"] for r in fine]),
         "a_vs_h": fit_rate(hs, [r["a_err"] for r in fine]),
-        "l2_vs_time": fit_rate([r["time_after_mesh"] for r in fine],
-                               [r["l2_error"] for r in fine]),
+        "l2_vs_time": fit_rate([r["time_after_mesh"] for r in fine], [r["l2_error"] for r in fine]),
         "elements_vs_h": fit_rate(hs, [r["elements"] for r in fine]),
     }
     say(method, {k: round(v, 2) for k, v in rates[method].items()})
@@ -182,39 +201,72 @@ say("graded mortar: fewest elements with |a - a_exact| < 4 %:", within4)
 if comm.rank == 0:
     written = write_outputs(graded_study, OUT, extra=[("uniform", uniform_study)])
     say("\n".join(table_lines(graded_study)))
-    head = ("| series | method | h at contact (cm) | elements | DOFs | a (cm) | a err | p0 (MPa) "
-            "| p0 err | L2 err | AS its | solve (s) | after mesh (s) |")
+    head = (
+        "| series | method | h at contact (cm) | elements | DOFs | a (cm) | a err | p0 (MPa) "
+        "| p0 err | L2 err | AS its | solve (s) | after mesh (s) |"
+    )
     lines = [head, "|" + "---|" * 13]
     for r in rows:
         lines.append(
             f"| {r['series']} | {r['method']} | {r['h']:g} | {r['elements']} | {r['dofs']} | "
             f"{r['a']:.4f} | {100 * r['a_err']:+.2f}% | {r['p0']:.2f} | "
             f"{100 * r['p0_err']:+.2f}% | {100 * r['l2_error']:.2f}% | {r['iterations']} | "
-            f"{r['solve_time']:.3f} | {r['time_after_mesh']:.3f} |")
-    lines += ["", "Fitted rates (graded, h <= 0.04 cm): "
-              + "; ".join(f"{m}: L2 ~ h^{v['l2_vs_h']:.2f}, |a err| ~ h^{v['a_vs_h']:.2f}, "
-                          f"L2 ~ t^{v['l2_vs_time']:.2f}, elements ~ h^{v['elements_vs_h']:.2f}"
-                          for m, v in rates.items()), ""]
-    lines += [f"Paper comparison (exact plane-strain a = {ref['a']:.4f} cm):", "",
-              "| paper elements | paper a (cm) | our uniform elements | our a, fit (cm) "
-              "| our a bracket (cm) |", "|---|---|---|---|---|"]
+            f"{r['solve_time']:.3f} | {r['time_after_mesh']:.3f} |"
+        )
+    lines += [
+        "",
+        "Fitted rates (graded, h <= 0.04 cm): "
+        + "; ".join(
+            f"{m}: L2 ~ h^{v['l2_vs_h']:.2f}, |a err| ~ h^{v['a_vs_h']:.2f}, "
+            f"L2 ~ t^{v['l2_vs_time']:.2f}, elements ~ h^{v['elements_vs_h']:.2f}"
+            for m, v in rates.items()
+        ),
+        "",
+    ]
+    lines += [
+        f"Paper comparison (exact plane-strain a = {ref['a']:.4f} cm):",
+        "",
+        "| paper elements | paper a (cm) | our uniform elements | our a, fit (cm) "
+        "| our a bracket (cm) |",
+        "|---|---|---|---|---|",
+    ]
     for (n_paper, a_paper), r in zip(PAPER, series("mortar", "uniform"), strict=False):
         fit = "-" if r["a_fit"] is None else f"{r['a_fit']:.3f}"
         lo, hi = r["a_bracket"]
-        lines.append(f"| {n_paper} | {a_paper} | {r['elements']} | {fit} | "
-                     f"[{lo:.3f}, {hi if hi is None else round(hi, 3)}] |")
+        lines.append(
+            f"| {n_paper} | {a_paper} | {r['elements']} | {fit} | "
+            f"[{lo:.3f}, {hi if hi is None else round(hi, 3)}] |"
+        )
     (OUT / "table.md").write_text("\n".join(lines) + "\n")
     slim = [{k: v for k, v in r.items() if k not in ("x", "pressure")} for r in rows]
-    (OUT / "summary.json").write_text(json.dumps(
-        {"quick": QUICK, "ranks": comm.size, "exact": ref, "rows": slim, "rates": rates,
-         "study_rates": graded_study.rates, "elements_within_4pct": within4,
-         "paper": PAPER}, indent=1))
+    (OUT / "summary.json").write_text(
+        json.dumps(
+            {
+                "quick": QUICK,
+                "ranks": comm.size,
+                "exact": ref,
+                "rows": slim,
+                "rates": rates,
+                "study_rates": graded_study.rates,
+                "elements_within_4pct": within4,
+                "paper": PAPER,
+            },
+            indent=1,
+        )
+    )
 
-    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True,
-                                  gridspec_kw={"height_ratios": [2, 1]})
+    fig, (ax, ax2) = plt.subplots(
+        2, 1, figsize=(8, 7), sharex=True, gridspec_kw={"height_ratios": [2, 1]}
+    )
     xs = np.linspace(0, 2.2, 1000)
-    ax.plot(xs, exact_pressure(xs, ref["a"], ref["p0"]), "k-", lw=2.5, alpha=0.4,
-            label="exact (plane strain)")
+    ax.plot(
+        xs,
+        exact_pressure(xs, ref["a"], ref["p0"]),
+        "k-",
+        lw=2.5,
+        alpha=0.4,
+        label="exact (plane strain)",
+    )
     pick = [r for r in rows if r["series"] == "graded" and r["h"] == 0.01]
     pick += series("mortar", "uniform")[:2]
     for r in pick:
@@ -237,8 +289,7 @@ if comm.rank == 0:
     fig.tight_layout()
     fig.savefig(OUT / "profile.png", dpi=110)
     plt.close(fig)
-    say("wrote", ", ".join(p.name for p in written), "table.md, summary.json, profile.png to",
-        OUT)
+    say("wrote", ", ".join(p.name for p in written), "table.md, summary.json, profile.png to", OUT)
 # -
 
 # ## Checks

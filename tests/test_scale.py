@@ -234,7 +234,8 @@ def test_coarse_predictor_same_answer_one_factorization(structured_pair, method)
     from contactfx.problem import coarse_initial_set
 
     fine, coarse = structured_pair
-    plain = solve_contact(fine, method, "mumps")
+    # The plain loop: from the touching nodes (the default now starts from every row).
+    plain = solve_contact(fine, method, "mumps", ActiveSetOptions(start_all=False))
     init = coarse_initial_set(solve_contact(coarse, method, "mumps"))
     sol = solve_contact(fine, method, "mumps", initial_active=init)
     assert np.array_equal(sol.active, plain.active)
@@ -248,6 +249,47 @@ def test_coarse_predictor_same_answer_one_factorization(structured_pair, method)
     assert sol.iterations <= 2
     probes = sum(h["probes"] for h in sol.history)
     assert 0 < probes < int(sol.active.sum()) / 2, probes
+
+
+@pytest.mark.parametrize("method", [Method.MORTAR, Method.NTS, Method.STS])
+def test_start_from_every_row_same_answer_one_factorization(structured_pair, method) -> None:
+    """The default serial MUMPS start (every row in contact, all probed): same answer, one LU.
+
+    Then exactly two solves: the probing one, and one that only releases rows (capacitance).
+    """
+    fine, _ = structured_pair
+    plain = solve_contact(fine, method, "mumps", ActiveSetOptions(start_all=False))
+    sol = solve_contact(fine, method, "mumps")
+    assert np.array_equal(sol.active, plain.active)
+    p_max = np.abs(plain.pressure).max()
+    assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max
+    du = np.abs(sol.u.x.array - plain.u.x.array).max()
+    assert du <= 1e-8 * np.abs(plain.u.x.array).max()
+    hist = sol.history
+    assert [h["factorized"] for h in hist] == [1, 0]
+    assert hist[0]["active"] == sol.layout.size and hist[0]["probes"] == sol.layout.size
+    assert hist[-1]["entered"] == hist[-1]["left"] == 0
+
+
+def test_selected_inverse_responses_equal_dense_solves(hertz_system) -> None:
+    """Probe responses from MUMPS' selected inverse entries equal multi-RHS solves."""
+    el, B, g, x = hertz_system
+    active = x < 1.6
+    rows = np.flatnonzero(active)
+    probes = np.zeros((len(x), len(rows)))
+    probes[rows, np.arange(len(rows))] = 1.0
+    opts = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+    with SaddleSolver(el.K, B, el.f, opts) as solver:
+        assert solver.cheap_responses
+        res = solver.solve(g, active, probes)
+        dense = np.zeros_like(probes)
+        solver._dense_responses(probes, active, dense)
+        selected = res.info["probes"]
+        scale = np.abs(dense).max()
+        assert scale > 0 and np.abs(selected - dense).max() <= 1e-10 * scale
+        # MUMPS is back to ordinary solves afterwards: a released set, then a refactored one.
+        _close(solver.solve(g, x < 1.2), solve_saddle(el.K, B, el.f, g, x < 1.2, opts))
+        _close(solver.solve(g, x < 1.8), solve_saddle(el.K, B, el.f, g, x < 1.8, opts))
 
 
 @pytest.mark.parametrize("guess", ["inside", "far", "nothing"])

@@ -14,12 +14,23 @@ from .levels import Level, builtin_levels, hertz_at, scene_file_levels, size_fac
 from .measures import fit_rate
 from .report import level_lines, table_lines, write_csv, write_json
 
-__all__ = ["Level", "Run", "Study", "builtin_levels", "fit_rate", "hertz_at", "level_lines",
-           "run_study", "scene_file_levels", "size_factors", "table_lines", "write_outputs"]
+__all__ = [
+    "Level",
+    "Run",
+    "Study",
+    "builtin_levels",
+    "fit_rate",
+    "hertz_at",
+    "level_lines",
+    "run_study",
+    "scene_file_levels",
+    "size_factors",
+    "table_lines",
+    "write_outputs",
+]
 
 
-def write_outputs(study: Study, out: Path, extra: Sequence[tuple[str, Study]] = ()
-                  ) -> list[Path]:
+def write_outputs(study: Study, out: Path, extra: Sequence[tuple[str, Study]] = ()) -> list[Path]:
     """study.json, study.csv, convergence.png and accuracy_vs_time.png in `out` (rank 0 only).
 
     `extra`: (label, study) pairs the charts also draw, dashed (e.g. another mesh family).
@@ -27,6 +38,9 @@ def write_outputs(study: Study, out: Path, extra: Sequence[tuple[str, Study]] = 
     from .charts import plot_convergence, plot_time
 
     out.mkdir(parents=True, exist_ok=True)
-    return [write_json(study, out / "study.json"), write_csv(study, out / "study.csv"),
-            plot_convergence(study, out / "convergence.png", extra),
-            plot_time(study, out / "accuracy_vs_time.png", extra)]
+    return [
+        write_json(study, out / "study.json"),
+        write_csv(study, out / "study.csv"),
+        plot_convergence(study, out / "convergence.png", extra),
+        plot_time(study, out / "accuracy_vs_time.png", extra),
+    ]

@@ -21,8 +21,10 @@ def parse_methods(text: str) -> list[str]:
     known = [m.value for m in Method]
     bad = [m for m in names if m not in known]
     if bad or not names:
-        raise InputError(f"--methods: unknown method '{bad[0] if bad else text}' (choose from "
-                         f"{', '.join(known)}, comma-separated)")
+        raise InputError(
+            f"--methods: unknown method '{bad[0] if bad else text}' (choose from "
+            f"{', '.join(known)}, comma-separated)"
+        )
     if len(set(names)) != len(names):
         raise InputError(f"--methods lists a method twice: {text}")
     return names
@@ -34,11 +36,16 @@ def levels_from_args(args: argparse.Namespace, comm: MPI.Comm) -> list[Level]:
 
     factors = size_factors(args.levels, args.ratio, args.size_factor)
     if is_scene_file(args.scene):
-        given = [k for k in (*BLOCK_KEYS, *HERTZ_KEYS, "preset", "mesh", "active")
-                 if getattr(args, k) is not None]
+        given = [
+            k
+            for k in (*BLOCK_KEYS, *HERTZ_KEYS, "preset", "mesh", "active")
+            if getattr(args, k) is not None
+        ]
         if given:
-            raise InputError(f"option --{given[0].replace('_', '-')} applies to the built-in "
-                             "scenes only (a scene file sets everything itself)")
+            raise InputError(
+                f"option --{given[0].replace('_', '-')} applies to the built-in "
+                "scenes only (a scene file sets everything itself)"
+            )
         return scene_file_levels(Path(args.scene), factors, comm)
     return builtin_levels(args.scene, scene_params(args), factors, args.active or 2, comm)
 
@@ -54,19 +61,33 @@ def run_command(args: argparse.Namespace) -> int:
     methods = parse_methods(args.methods)
     options = solver_options(args)
     if "schwarz" in methods and (args.solver != "mumps" or args.petsc_option):
-        raise InputError("schwarz factorizes each body with MUMPS: --solver and --petsc-option "
-                         "do not apply to it")
+        raise InputError(
+            "schwarz factorizes each body with MUMPS: --solver and --petsc-option "
+            "do not apply to it"
+        )
     levels = levels_from_args(args, comm)
     say = print if comm.rank == 0 else (lambda *a, **k: None)
-    say(f"study {args.scene}: {len(methods)} methods x {len(levels)} levels (ratio "
+    say(
+        f"study {args.scene}: {len(methods)} methods x {len(levels)} levels (ratio "
         f"{args.ratio:g}), solver {args.solver}, {comm.size} rank{'s' * (comm.size > 1)}",
-        flush=True)
-    study = run_study(levels, methods, solver=options, ratio=args.ratio,
-                      options={"max_iterations": args.max_iterations}, comm=comm,
-                      say=lambda line: say(line, flush=True),
-                      settings={"scene_arg": args.scene, "ratio": args.ratio,
-                                "size_factor": args.size_factor, "solver": args.solver,
-                                "petsc_options": list(args.petsc_option)})
+        flush=True,
+    )
+    study = run_study(
+        levels,
+        methods,
+        solver=options,
+        ratio=args.ratio,
+        options={"max_iterations": args.max_iterations},
+        comm=comm,
+        say=lambda line: say(line, flush=True),
+        settings={
+            "scene_arg": args.scene,
+            "ratio": args.ratio,
+            "size_factor": args.size_factor,
+            "solver": args.solver,
+            "petsc_options": list(args.petsc_option),
+        },
+    )
     if comm.rank == 0:
         written = write_outputs(study, args.out)
         for line in ["", *level_lines(study), "", *table_lines(study)]:

@@ -13,7 +13,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
 from mpi4py import MPI
 
 from ..api import run_scene
@@ -22,8 +21,17 @@ from ..methods import Method
 from ..scenes import HertzReference, Scene, UniformStress
 from ..timers import Timers
 from .levels import Level
-from .measures import Profiles, contact_size, fit_rate, hertz_errors, patch_errors, profiles
+from .measures import (
+    Profiles,
+    contact_size,
+    fit_rate,
+    fit_rate_to_reference,
+    hertz_errors,
+    patch_errors,
+    profiles,
+)
 from .measures import self_errors as compare_profiles
+from .progress import Progress
 
 # Most accurate first: the self-convergence reference is the finest level of the first of
 # these that the study ran (mortar passes the patch test on non-matching meshes).
@@ -77,7 +85,7 @@ class Study:
 
 
 def reference_kind(scene: Scene) -> str:
-    """"hertz", "patch" (uniform stress) or "self" (no exact solution: the finest level)."""
+    """The kind of reference: hertz, patch (uniform stress) or self (the finest level)."""
     if any(isinstance(r, HertzReference) for r in scene.references):
         return "hertz"
     if any(isinstance(r, UniformStress) for r in scene.references):
@@ -90,98 +98,20 @@ def exact_errors(kind: str, summary: dict[str, Any]) -> dict[str, float | None]:
     return hertz_errors(summary) if kind == "hertz" else patch_errors(summary)
 
 
-def format_seconds(t: float) -> str:
-    """12.3 s, 4 min 05 s, 1 h 02 min."""
-    if t < 60:
-        return f"{t:.1f} s"
-    if t < 3600:
-        return f"{int(t // 60)} min {int(t % 60):02d} s"
-    return f"{int(t // 3600)} h {int(t % 3600 // 60):02d} min"
-
-
-class Progress:
-    """Run i of n, elapsed time and an estimate of what is left, printed on rank 0."""
-
-    def __init__(self, methods: list[str], levels: int, ratio: float,
-                 say: Callable[[str], None]) -> None:
-        self.methods, self.levels, self.say = methods, levels, say
-        self.total = len(methods) * levels
-        self.t0 = time.perf_counter()
-        self.done = 0
-        self.cost: dict[tuple[str, int], float] = {}   # run time after meshing
-        self.mesh: dict[int, float] = {}
-        # Until two levels are seen: 2D meshes have ratio^2 times the elements per level.
-        self.default_growth = ratio**2
-
-    def growth(self) -> float:
-        """Growth of a run's cost per level, from the latest levels (costs grow faster there)."""
-        steps = {k: self.cost[m, k] / self.cost[m, k - 1] for (m, k) in self.cost
-                 if (m, k - 1) in self.cost and self.cost[m, k - 1] > 0}
-        if not steps:
-            return self.default_growth
-        last = max(steps)
-        recent = [self.cost[m, last] / self.cost[m, last - 1] for m in self.methods
-                  if (m, last) in self.cost and (m, last - 1) in self.cost
-                  and self.cost[m, last - 1] > 0]
-        return min(max(float(np.median(recent)), 1.0), self.default_growth**2)
-
-    def estimate(self, method: str, level: int, g: float) -> float:
-        """Expected cost of a run not done yet, from the closest done level."""
-        mine = [k for (m, k) in self.cost if m == method and k < level]
-        if mine:
-            k = max(mine)
-            return self.cost[method, k] * g ** (level - k)
-        same = [t for (m, k), t in self.cost.items() if k == level]
-        if same:
-            return sum(same) / len(same)
-        if self.cost:
-            k = max(k for _, k in self.cost)
-            at = [t for (m, j), t in self.cost.items() if j == k]
-            return sum(at) / len(at) * g ** (level - k)
-        return 0.0
-
-    def left(self, pending: list[tuple[str, int]]) -> float:
-        """Estimated seconds for the pending runs and the levels not meshed yet."""
-        g = self.growth()
-        t = sum(self.estimate(m, k, g) for m, k in pending)
-        if self.mesh:
-            k = max(self.mesh)
-            t += sum(self.mesh[k] * g ** (j - k) for j in {j for _, j in pending} if j > k)
-        return t
-
-    def meshing(self, level: Level) -> None:
-        """Announce a level's meshing (fine levels take a while)."""
-        sizes = ", ".join(f"{k} {v:.4g}" for k, v in level.sizes.items())
-        self.say(f"level {level.index}: meshing ({sizes})")
-
-    def finished(self, run: Run, mesh_time: float | None) -> None:
-        """Record a run and print its line."""
-        self.done += 1
-        if mesh_time is not None:
-            self.mesh[run.level] = mesh_time
-        if run.ok:
-            self.cost[run.method, run.level] = run.after_mesh or 0.0
-        # Runs go level by level, methods in order: the pending ones are the rest of that list.
-        order = [(m, k) for k in range(self.levels) for m in self.methods]
-        pending = order[self.done:]
-        elapsed = time.perf_counter() - self.t0
-        what = (f"{run.dofs} dofs, {run.iterations} its, {run.after_mesh:.2f} s after mesh"
-                + "".join(f", {k} {v:.3g}" for k, v in run.errors.items()
-                          if v is not None and "_pair" not in k)
-                if run.ok else f"FAILED: {run.message}")
-        left = self.left(pending)
-        self.say(f"[run {self.done}/{self.total}] level {run.level} {run.method}: {what} | "
-                 f"elapsed {format_seconds(elapsed)}, ~{format_seconds(left)} left")
-
-
-def solve_one(scene: Scene, method: str, level: Level, mesh_time: float, kind: str,
-              solver: str | dict[str, object], options: dict[str, Any]) -> Run:
+def solve_one(
+    scene: Scene,
+    method: str,
+    level: Level,
+    mesh_time: float,
+    kind: str,
+    solver: str | dict[str, object],
+    options: dict[str, Any],
+) -> Run:
     """Solve one level with one method; a ContactFxError makes a failed Run."""
     run = Run(method, level.index, level.factor)
     t0 = time.perf_counter()
     try:
-        sol, data = run_scene(scene, method, solver=solver, t_start=t0, timers=Timers(),
-                              **options)
+        sol, data = run_scene(scene, method, solver=solver, t_start=t0, timers=Timers(), **options)
     except ContactFxError as err:
         run.status, run.message = "failed", f"{type(err).__name__}: {err}"
         return run
@@ -199,14 +129,20 @@ def solve_one(scene: Scene, method: str, level: Level, mesh_time: float, kind: s
 
 def failed_level(method: str, level: Level, err: ContactFxError) -> Run:
     """The run of a level whose mesh could not be built."""
-    return Run(method, level.index, level.factor, status="failed",
-               message=f"{type(err).__name__} (meshing): {err}")
+    return Run(
+        method,
+        level.index,
+        level.factor,
+        status="failed",
+        message=f"{type(err).__name__} (meshing): {err}",
+    )
 
 
 def self_reference(runs: list[Run], methods: list[str]) -> Run | None:
     """The finest finished run of the most accurate method (mortar first)."""
-    order = [m for m in ACCURACY_ORDER if m in methods] + [m for m in methods
-                                                           if m not in ACCURACY_ORDER]
+    order = [m for m in ACCURACY_ORDER if m in methods] + [
+        m for m in methods if m not in ACCURACY_ORDER
+    ]
     for method in order:
         done = [r for r in runs if r.method == method and r.ok]
         if done:
@@ -217,40 +153,80 @@ def self_reference(runs: list[Run], methods: list[str]) -> Run | None:
 def apply_reference(kind: str, runs: list[Run], methods: list[str]) -> dict[str, Any]:
     """Fill in the self-convergence errors; return the report's `reference` block."""
     if kind == "hertz":
-        return {"kind": "exact", "type": "hertz",
-                "description": "plane-strain Hertz line contact (Johnson 4.2): half-width a, "
-                "peak pressure p0, relative L2 error of the pressure over [0, 1.5 a]"}
+        return {
+            "kind": "exact",
+            "type": "hertz",
+            "description": "plane-strain Hertz line contact (Johnson 4.2): half-width a, "
+            "peak pressure p0, relative L2 error of the pressure over [0, 1.5 a]",
+        }
     if kind == "patch":
-        return {"kind": "exact", "type": "uniform_stress",
-                "description": "uniform stress of the patch test: max error of the stresses "
-                "and pressures relative to the largest exact stress component"}
+        return {
+            "kind": "exact",
+            "type": "uniform_stress",
+            "description": "uniform stress of the patch test: max error of the stresses "
+            "and pressures relative to the largest exact stress component",
+        }
     ref = self_reference(runs, methods)
     if ref is not None:
         for r in runs:
             if r.ok and r is not ref and r.profiles is not None:
                 r.errors = compare_profiles(r.profiles, ref.profiles)  # type: ignore[arg-type]
-    return {"kind": "self", "type": "finest level",
-            "method": ref.method if ref else None, "level": ref.level if ref else None,
-            "description": "no exact solution: the finest level of the most accurate method; "
-            "relative L2 differences in arc length along every contact surface of the "
-            "pressure and of the displacement (both sides)"}
+    return {
+        "kind": "self",
+        "type": "finest level",
+        "method": ref.method if ref else None,
+        "level": ref.level if ref else None,
+        "h": ref.h if ref else None,
+        "rates": "err ~ C (h^r - h_ref^r) fitted over the levels coarser than the reference",
+        "description": "no exact solution: the finest level of the most accurate method; "
+        "relative L2 differences in arc length along every contact surface of the "
+        "pressure and of the displacement (both sides)",
+    }
 
 
-def fit_rates(runs: list[Run], methods: list[str], names: list[str], against: str
-              ) -> dict[str, dict[str, float | None]]:
-    """Fitted slope of each error against h ("h") or the time after meshing ("time")."""
+def fit_rates(
+    runs: list[Run], methods: list[str], names: list[str], against: str, reference: dict[str, Any]
+) -> dict[str, dict[str, float | None]]:
+    """Fitted rate of each error against h ("h") or the time after meshing ("time").
+
+    Against an exact solution: the log-log slope over every finished level. Against the
+    finest level (self-convergence): only the levels coarser than the reference's count
+    (on its own mesh another method differs by the methods, not by the mesh), and the rate
+    in h is that of err ~ C (h^r - h_ref^r) (measures.fit_rate_to_reference).
+    """
+    ref = next(
+        (
+            r
+            for r in runs
+            if (r.method, r.level) == (reference.get("method"), reference.get("level"))
+        ),
+        None,
+    )
     out = {}
     for m in methods:
-        done = [r for r in runs if r.method == m and r.ok]
+        done = [r for r in runs if r.method == m and r.ok and (ref is None or r.level < ref.level)]
         xs = [r.h if against == "h" else r.after_mesh for r in done]
-        out[m] = {n: fit_rate(xs, [r.errors.get(n) for r in done]) for n in names}  # type: ignore[arg-type]
+        out[m] = {}
+        for n in names:
+            errs = [r.errors.get(n) for r in done]
+            if ref is not None and against == "h" and ref.h is not None:
+                out[m][n] = fit_rate_to_reference(xs, errs, ref.h)  # type: ignore[arg-type]
+            else:
+                out[m][n] = fit_rate(xs, errs)  # type: ignore[arg-type]
     return out
 
 
-def run_study(levels: list[Level], methods: list[str], *, solver: str | dict[str, object]
-              = "mumps", ratio: float = 2.0, options: dict[str, Any] | None = None,
-              comm: MPI.Comm = MPI.COMM_WORLD, say: Callable[[str], None] | None = None,
-              settings: dict[str, Any] | None = None) -> Study:
+def run_study(
+    levels: list[Level],
+    methods: list[str],
+    *,
+    solver: str | dict[str, object] = "mumps",
+    ratio: float = 2.0,
+    options: dict[str, Any] | None = None,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    say: Callable[[str], None] | None = None,
+    settings: dict[str, Any] | None = None,
+) -> Study:
     """Run every method on every level (coarsest first) and measure them against the reference.
 
     `options` go to run_scene (max_iterations, penalty, ...); `say` prints progress (rank 0).
@@ -278,6 +254,16 @@ def run_study(levels: list[Level], methods: list[str], *, solver: str | dict[str
         del scene
     reference = apply_reference(kind or "self", runs, methods)
     names = list(dict.fromkeys(n for r in runs for n in r.errors))
-    return Study(name, methods, levels, runs, reference, names,
-                 fit_rates(runs, methods, names, "h"), fit_rates(runs, methods, names, "time"),
-                 time.perf_counter() - progress.t0, comm.size, dict(settings or {}))
+    return Study(
+        name,
+        methods,
+        levels,
+        runs,
+        reference,
+        names,
+        fit_rates(runs, methods, names, "h", reference),
+        fit_rates(runs, methods, names, "time", reference),
+        time.perf_counter() - progress.t0,
+        comm.size,
+        dict(settings or {}),
+    )

@@ -21,7 +21,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..scenes import BlockParams, HertzParams, Scene, build_scene, load_scene_file
+from ..scenes import BlockParams, HertzParams, Scene, build_scene, load_scene_file, validate
 
 # Coarsest grading slope that coarsening applies (demo_hertz.py's graded() caps it there:
 # steeper gradings make poorly shaped quads around the contact zone).
@@ -56,14 +56,24 @@ def hertz_at(params: HertzParams, f: float) -> HertzParams:
         slope = min(slope, max(SLOPE_CAP, params.slope))
     # h_far = 0 means R / 6, a cap that the slope leaves inactive; a given far size is a
     # bulk size like the slope's and follows it.
-    return replace(params, refine=params.refine * f, refine_edge=params.refine_edge * f,
-                   slope=slope, h_far=params.h_far * math.sqrt(f))
+    return replace(
+        params,
+        refine=params.refine * f,
+        refine_edge=params.refine_edge * f,
+        slope=slope,
+        h_far=params.h_far * math.sqrt(f),
+    )
 
 
 def blocks_at(params: BlockParams, f: float) -> BlockParams:
     """The block meshes with sizes times f and gradings g**f (same profile, 1/f the elements)."""
-    return replace(params, size1=params.size1 * f, size2=params.size2 * f,
-                   grading1=params.grading1**f, grading2=params.grading2**f)
+    return replace(
+        params,
+        size1=params.size1 * f,
+        size2=params.size2 * f,
+        grading1=params.grading1**f,
+        grading2=params.grading2**f,
+    )
 
 
 def builtin_sizes(params: HertzParams | BlockParams) -> dict[str, float]:
@@ -75,15 +85,26 @@ def builtin_sizes(params: HertzParams | BlockParams) -> dict[str, float]:
     return {k: float(getattr(params, k)) for k in keys}
 
 
-def builtin_levels(kind: str, params: HertzParams | BlockParams, factors: list[float],
-                   active: int = 2, comm: MPI.Comm = MPI.COMM_WORLD) -> list[Level]:
-    """Levels of a built-in scene ("hertz" or "blocks") from its coarsest parameters."""
+def builtin_levels(
+    kind: str,
+    params: HertzParams | BlockParams,
+    factors: list[float],
+    active: int = 2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> list[Level]:
+    """Levels of a built-in scene ("hertz" or "blocks") from its parameters (factor 1)."""
+    # Bad input is the user's, reported before anything runs; a level that its factor
+    # makes too coarse fails on its own and the study goes on.
+    validate(params)
     at = hertz_at if isinstance(params, HertzParams) else blocks_at
     out = []
     for k, f in enumerate(factors):
         p = at(params, f)  # type: ignore[arg-type]
-        out.append(Level(k, f, builtin_sizes(p),
-                         lambda p=p: build_scene(kind, p, active=active, comm=comm)))
+        out.append(
+            Level(
+                k, f, builtin_sizes(p), lambda p=p: build_scene(kind, p, active=active, comm=comm)
+            )
+        )
     return out
 
 
@@ -93,15 +114,19 @@ def check_refinable(path: Path) -> None:
 
     mesh = parse_scene_file(path)[0]
     if mesh.suffix.lower() != ".geo":
-        raise InputError(f"scene {path.name}: its mesh {mesh.name} is a {mesh.suffix} file, "
-                         "which cannot be refined; a study needs a .geo mesh (gmsh remeshes "
-                         "it at every level)")
+        raise InputError(
+            f"scene {path.name}: its mesh {mesh.name} is a {mesh.suffix} file, "
+            "which cannot be refined; a study needs a .geo mesh (gmsh remeshes "
+            "it at every level)"
+        )
 
 
-def scene_file_levels(path: Path, factors: list[float],
-                      comm: MPI.Comm = MPI.COMM_WORLD) -> list[Level]:
+def scene_file_levels(
+    path: Path, factors: list[float], comm: MPI.Comm = MPI.COMM_WORLD
+) -> list[Level]:
     """Levels of a scene file whose mesh is a .geo: gmsh's MeshSizeFactor per level."""
     check_refinable(path)
-    return [Level(k, f, {"size_factor": f},
-                  lambda f=f: load_scene_file(path, comm, size_factor=f))
-            for k, f in enumerate(factors)]
+    return [
+        Level(k, f, {"size_factor": f}, lambda f=f: load_scene_file(path, comm, size_factor=f))
+        for k, f in enumerate(factors)
+    ]

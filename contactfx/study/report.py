@@ -7,7 +7,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from .core import Run, Study, format_seconds
+from .core import Run, Study
+from .measures import ROUND_OFF
+from .progress import format_seconds
 
 TIME_KEYS = ("mesh", "assemble", "search", "contact", "solve", "predictor", "total")
 
@@ -19,23 +21,41 @@ def main_errors(study: Study) -> list[str]:
 
 def run_json(run: Run, study: Study) -> dict[str, Any]:
     """One run's entry of study.json."""
-    return {"method": run.method, "level": run.level, "factor": run.factor,
-            "sizes": study.levels[run.level].sizes, "status": run.status,
-            "message": run.message, "dofs": run.dofs, "elements": run.elements, "h": run.h,
-            "iterations": run.iterations, "times": run.times, "after_mesh": run.after_mesh,
-            "errors": run.errors}
+    return {
+        "method": run.method,
+        "level": run.level,
+        "factor": run.factor,
+        "sizes": study.levels[run.level].sizes,
+        "status": run.status,
+        "message": run.message,
+        "dofs": run.dofs,
+        "elements": run.elements,
+        "h": run.h,
+        "iterations": run.iterations,
+        "times": run.times,
+        "after_mesh": run.after_mesh,
+        "errors": run.errors,
+    }
 
 
 def study_json(study: Study) -> dict[str, Any]:
     """The whole study as JSON-ready data."""
-    return {"scene": study.scene, "ranks": study.ranks, "methods": study.methods,
-            **study.settings, "wall": study.wall,
-            "levels": [{"level": lv.index, "factor": lv.factor, "sizes": lv.sizes}
-                       for lv in study.levels],
-            "reference": study.reference, "error_names": study.error_names,
-            "runs": [run_json(r, study) for r in study.runs],
-            "rates": study.rates, "time_rates": study.time_rates,
-            "h": "median length of the active-surface elements carrying pressure"}
+    return {
+        "scene": study.scene,
+        "ranks": study.ranks,
+        "methods": study.methods,
+        **study.settings,
+        "wall": study.wall,
+        "levels": [
+            {"level": lv.index, "factor": lv.factor, "sizes": lv.sizes} for lv in study.levels
+        ],
+        "reference": study.reference,
+        "error_names": study.error_names,
+        "runs": [run_json(r, study) for r in study.runs],
+        "rates": study.rates,
+        "time_rates": study.time_rates,
+        "h": "median length of the active-surface elements carrying pressure",
+    }
 
 
 def write_json(study: Study, path: Path) -> Path:
@@ -47,19 +67,43 @@ def write_json(study: Study, path: Path) -> Path:
 def write_csv(study: Study, path: Path) -> Path:
     """Write study.csv: one row per run, sizes, times and every error as columns."""
     size_keys = list(dict.fromkeys(k for lv in study.levels for k in lv.sizes))
-    head = ["method", "level", "factor", *size_keys, "status", "h", "dofs", "elements",
-            "iterations", *(f"time_{k}" for k in TIME_KEYS), "time_after_mesh",
-            *study.error_names, "message"]
+    head = [
+        "method",
+        "level",
+        "factor",
+        *size_keys,
+        "status",
+        "h",
+        "dofs",
+        "elements",
+        "iterations",
+        *(f"time_{k}" for k in TIME_KEYS),
+        "time_after_mesh",
+        *study.error_names,
+        "message",
+    ]
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(head)
         for r in study.runs:
             sizes = study.levels[r.level].sizes
-            w.writerow([r.method, r.level, r.factor, *(sizes.get(k, "") for k in size_keys),
-                        r.status, _cell(r.h), _cell(r.dofs), _cell(r.elements),
-                        _cell(r.iterations), *(_cell(r.times.get(k)) for k in TIME_KEYS),
-                        _cell(r.after_mesh), *(_cell(r.errors.get(n)) for n in study.error_names),
-                        r.message or ""])
+            w.writerow(
+                [
+                    r.method,
+                    r.level,
+                    r.factor,
+                    *(sizes.get(k, "") for k in size_keys),
+                    r.status,
+                    _cell(r.h),
+                    _cell(r.dofs),
+                    _cell(r.elements),
+                    _cell(r.iterations),
+                    *(_cell(r.times.get(k)) for k in TIME_KEYS),
+                    _cell(r.after_mesh),
+                    *(_cell(r.errors.get(n)) for n in study.error_names),
+                    r.message or "",
+                ]
+            )
     return path
 
 
@@ -74,18 +118,32 @@ def _num(v: float | None, fmt: str = ".3e") -> str:
 def is_reference(study: Study, run: Run) -> bool:
     """Whether `run` is the self-convergence reference (it has no error of its own)."""
     ref = study.reference
-    return ref["kind"] == "self" and (ref.get("method"), ref.get("level")) == (run.method,
-                                                                                run.level)
+    return ref["kind"] == "self" and (ref.get("method"), ref.get("level")) == (
+        run.method,
+        run.level,
+    )
 
 
 def _error_cell(study: Study, run: Run, name: str) -> str:
     return "reference" if is_reference(study, run) else _num(run.errors.get(name))
 
 
+def _rate_cell(study: Study, method: str, name: str, rate: float | None) -> str:
+    """The rate, or why there is none."""
+    if rate is not None:
+        return f"{rate:.2f}"
+    errs = [r.errors.get(name) for r in study.runs if r.method == method and r.ok]
+    errs = [e for e in errs if e is not None]
+    return "none (exact to round-off)" if errs and max(errs) <= ROUND_OFF else "n/a"
+
+
 def level_lines(study: Study) -> list[str]:
     """Which sizes each level used."""
-    return [f"level {lv.index}: factor {lv.factor:.4g}: "
-            + ", ".join(f"{k} {v:.4g}" for k, v in lv.sizes.items()) for lv in study.levels]
+    return [
+        f"level {lv.index}: factor {lv.factor:.4g}: "
+        + ", ".join(f"{k} {v:.4g}" for k, v in lv.sizes.items())
+        for lv in study.levels
+    ]
 
 
 def table_lines(study: Study) -> list[str]:
@@ -95,9 +153,18 @@ def table_lines(study: Study) -> list[str]:
     rows = []
     for r in study.runs:
         if r.ok:
-            rows.append([r.method, str(r.level), _num(r.h, ".4g"), str(r.elements),
-                         str(r.dofs), str(r.iterations), f"{r.after_mesh:.3f}",
-                         *(_error_cell(study, r, n) for n in names)])
+            rows.append(
+                [
+                    r.method,
+                    str(r.level),
+                    _num(r.h, ".4g"),
+                    str(r.elements),
+                    str(r.dofs),
+                    str(r.iterations),
+                    f"{r.after_mesh:.3f}",
+                    *(_error_cell(study, r, n) for n in names),
+                ]
+            )
         else:
             rows.append([r.method, str(r.level), "FAILED", *[""] * (len(head) - 3)])
     width = [max(len(head[i]), *(len(row[i]) for row in rows)) for i in range(len(head))]
@@ -105,13 +172,26 @@ def table_lines(study: Study) -> list[str]:
     lines = [fmt.format(*head), fmt.format(*("-" * w for w in width))]
     lines += [fmt.format(*row) for row in rows]
     lines += [f"failed: {r.method} level {r.level}: {r.message}" for r in study.runs if not r.ok]
-    lines.append(f"reference: {study.reference['description']}"
-                 + (f" ({study.reference['method']}, level {study.reference['level']})"
-                    if study.reference["kind"] == "self" else ""))
+    if study.reference["kind"] == "self" and len(study.methods) > 1:
+        lines.append(
+            "(on the reference's level the other methods' numbers are their differences "
+            "from it on the same mesh: not in the fits or charts)"
+        )
+    lines.append(
+        f"reference: {study.reference['description']}"
+        + (
+            f" ({study.reference['method']}, level {study.reference['level']})"
+            if study.reference["kind"] == "self"
+            else ""
+        )
+    )
     for m, rates in study.rates.items():
-        lines.append(f"fitted rates in h, {m}: " + ", ".join(
-            f"{n} {_num(v, '.2f') if v is not None else 'n/a'}" for n, v in rates.items()
-            if n in names))
-    lines.append(f"study: {len(study.runs)} runs on {study.ranks} rank"
-                 f"{'s' * (study.ranks > 1)} in {format_seconds(study.wall)}")
+        lines.append(
+            f"fitted rates in h, {m}: "
+            + ", ".join(f"{n} {_rate_cell(study, m, n, v)}" for n, v in rates.items() if n in names)
+        )
+    lines.append(
+        f"study: {len(study.runs)} runs on {study.ranks} rank"
+        f"{'s' * (study.ranks > 1)} in {format_seconds(study.wall)}"
+    )
     return lines

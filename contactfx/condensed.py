@@ -1,0 +1,216 @@
+"""The condensed solver: the active multipliers eliminated, CG + GAMG on the displacements.
+
+With a diagonal D (NTS, or mortar with the dual basis) each active row j of B touches one
+active node's own dofs only, so one of them, the pivot p(j) (the component with the largest
+coefficient c_j), is given by the constraint: u_p = -(g_j + sum_{k != p} B_jk u_k) / c_j.
+Writing u = T v + t (T the identity except on pivot rows, t = -g_j / c_j there) turns the
+saddle point into the symmetric positive definite displacement system
+
+    (T^T K T + P) v = T^T (f - K t),    P = diag(K_pp) on the pivots (v_p is free: set 0),
+
+and the multipliers follow from the pivot rows of equilibrium, mu_j = (f - K u)_p / c_j. The
+active set changes T, so each active-set step rebuilds T^T K T (one PtAP) and GAMG; the last
+displacement is the initial guess. Near-nullspace: each body's rigid modes, zero on pivots.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from petsc4py import PETSc
+
+from .errors import InputError, SolverError
+from .saddle import SaddleResult
+from .solvers import PrefixedOptions, petsc_error_message, reason_name
+
+# Entries of B on another active node's dofs larger than this (relative to the row's pivot)
+# mean D is not diagonal: the elimination would couple the pivots.
+_DIAGONAL_TOL = 1e-10
+
+
+def is_condensed(options: Mapping[str, object]) -> bool:
+    """True for the options of the condensed solver."""
+    return bool(options.get("contactfx_condensed", False))
+
+
+class CondensedSolver:
+    """Solve K u + B^T mu = f, B_A u = -g_A by elimination; same interface as SaddleSolver."""
+
+    def __init__(self, K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, options: Mapping[str, object],
+                 node_dofs: np.ndarray, modes: list[PETSc.Vec] | None = None) -> None:
+        """`node_dofs` (m, 2): global dofs of each owned row's active node."""
+        self._K, self._B, self._f = K, B, f
+        self._comm = K.getComm()
+        self._mpi = self._comm.tompi4py()
+        self._node_dofs = np.asarray(node_dofs, dtype=np.int64).reshape(-1, 2)
+        self._indptr, self._cols, self._vals = B.getValuesCSR()
+        self._modes = modes or []
+        self._options = PrefixedOptions({k: v for k, v in options.items()
+                                         if k != "contactfx_condensed"})
+        self._ksp = PETSc.KSP().create(self._comm)
+        self._ksp.setOptionsPrefix(self._options.prefix)
+        self._u = f.duplicate()
+        self._u.set(0.0)
+        self._diag = K.getDiagonal()
+        self._r0, self._r1 = K.getOwnershipRange()
+        self.stats = {"factorizations": 0.0, "reused": 0.0, "setup_time": 0.0}
+        self._built_for: np.ndarray | None = None  # the pivots the multigrid was built with
+        self.reuse = True
+
+    def destroy(self) -> None:
+        """Free the PETSc objects and remove this solver's options."""
+        self._options.remove()
+        for obj in (self._ksp, self._u, self._diag):
+            obj.destroy()
+
+    def _pivots(self, active: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(owned active rows, their pivot dofs, the pivot coefficients)."""
+        rows = np.flatnonzero(active)
+        piv = np.zeros(len(rows), dtype=np.int64)
+        coef = np.zeros(len(rows))
+        for i, j in enumerate(rows):
+            lo, hi = self._indptr[j], self._indptr[j + 1]
+            cols, vals = self._cols[lo:hi], self._vals[lo:hi]
+            own = np.isin(cols, self._node_dofs[j])
+            if not own.any() or np.abs(vals[own]).max() == 0.0:
+                raise InputError("the condensed solver cannot eliminate a contact row whose "
+                                 "active node is fully prescribed: use --solver mumps")
+            k = np.flatnonzero(own)[int(np.argmax(np.abs(vals[own])))]
+            piv[i], coef[i] = cols[k], vals[k]
+        # Every active node's dofs, from all ranks: a row touching another one means that D
+        # is not diagonal.
+        others = np.concatenate(self._mpi.allgather(self._node_dofs[rows].ravel()))
+        for i, j in enumerate(rows):
+            lo, hi = self._indptr[j], self._indptr[j + 1]
+            cols, vals = self._cols[lo:hi], self._vals[lo:hi]
+            foreign = np.isin(cols, others) & ~np.isin(cols, self._node_dofs[j])
+            if foreign.any() and np.abs(vals[foreign]).max() > _DIAGONAL_TOL * abs(coef[i]):
+                raise InputError("the condensed solver needs a diagonal D (one active node per "
+                                 "constraint row): use --method nts, or mortar with --basis "
+                                 "dual (on a flat passive surface), or --solver mumps")
+        return rows, piv, coef
+
+    def _transform(self, rows: np.ndarray, piv: np.ndarray, coef: np.ndarray) -> PETSc.Mat:
+        """T: the identity, except row p(j) = -B_j / c_j off the pivot (0 on it)."""
+        n = self._r1 - self._r0
+        nglob = self._K.getSize()[0]
+        local = piv - self._r0
+        extra: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        for i, j in enumerate(rows):
+            lo, hi = self._indptr[j], self._indptr[j + 1]
+            cols, vals = self._cols[lo:hi], self._vals[lo:hi]
+            keep = (cols != piv[i]) & (vals != 0.0)
+            order = np.argsort(cols[keep])
+            extra[int(local[i])] = (cols[keep][order], -vals[keep][order] / coef[i])
+        counts = np.ones(n, dtype=np.int64)
+        for r, (c, _) in extra.items():
+            counts[r] = len(c)
+        indptr = np.concatenate([[0], np.cumsum(counts)])
+        cols = np.arange(self._r0, self._r1, dtype=np.int64).repeat(counts)
+        vals = np.ones(indptr[-1])
+        for r, (c, v) in extra.items():
+            cols[indptr[r]:indptr[r + 1]] = c
+            vals[indptr[r]:indptr[r + 1]] = v
+        T = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)),
+                                  csr=(indptr.astype(PETSc.IntType), cols.astype(PETSc.IntType),
+                                       vals.astype(PETSc.ScalarType)), comm=self._comm)
+        T.assemble()
+        return T
+
+    def solve(self, g: np.ndarray, active: np.ndarray,
+              probes: np.ndarray | None = None) -> SaddleResult:
+        """Displacements and multipliers (owned parts) with `active` rows in contact."""
+        if probes is not None:
+            raise InputError("the condensed solver has no probes (it is not a factorization)")
+        import time
+
+        t0 = time.perf_counter()
+        rows, piv, coef = self._pivots(np.asarray(active, dtype=bool))
+        T = self._transform(rows, piv, coef)
+        A = self._K.ptap(T)
+        d = A.createVecLeft()
+        d.set(0.0)
+        d.setValues(piv.astype(PETSc.IntType), self._diag.getValues(piv.astype(PETSc.IntType)),
+                    addv=PETSc.InsertMode.ADD_VALUES)
+        d.assemble()
+        # T^T K T has no entries on the pivot rows: give them the diagonal of K.
+        A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        A.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+        A.assemble()
+        t = self._f.duplicate()
+        t.set(0.0)
+        t.setValues(piv.astype(PETSc.IntType), -np.asarray(g)[rows] / coef)
+        t.assemble()
+        r = self._f.duplicate()
+        self._K.mult(t, r)
+        r.aypx(-1.0, self._f)          # f - K t
+        b = self._f.duplicate()
+        T.multTranspose(r, b)
+        v = self._u.copy()             # warm start: the last displacement, pivots free
+        v.setValues(piv.astype(PETSc.IntType), np.zeros(len(piv)))
+        v.assemble()
+        ksp = self._ksp
+        # A few pivots more or less change T^T K T by a low-rank term: the multigrid built
+        # for the previous set still preconditions it well (CG needs a few more iterations
+        # instead of a new setup, which costs several solves' worth).
+        prev = self._built_for
+        reuse = (self.reuse and prev is not None
+                 and self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
+                 <= 0.2 * max(self._mpi.allreduce(len(piv)), 1))
+        if not reuse and self._modes:
+            A.setNearNullSpace(self._near_nullspace(piv))
+        try:
+            ksp.getPC().setReusePreconditioner(reuse)
+            ksp.setOperators(A)
+            ksp.setInitialGuessNonzero(True)
+            if not reuse:
+                ksp.setFromOptions()
+                ksp.setUp()
+                self._built_for = piv.copy()
+            t1 = time.perf_counter()
+            ksp.solve(b, v)
+        except PETSc.Error as err:
+            raise SolverError(petsc_error_message(err, "condensed solve")) from None
+        reason, its = int(ksp.getConvergedReason()), ksp.getIterationNumber()
+        if reason <= 0 or not np.isfinite(v.norm()):
+            raise SolverError(f"condensed solve ({ksp.getType()}) did not converge: PETSc "
+                              f"reason {reason} ({reason_name(reason)}) after {its} iterations")
+        T.mult(v, self._u)
+        self._u.axpy(1.0, t)
+        self._K.mult(self._u, r)
+        r.aypx(-1.0, self._f)          # f - K u: the contact force on the pivots
+        mu = np.zeros(len(active))
+        mu[rows] = r.getValues(piv.astype(PETSc.IntType)) / coef
+        u = self._u.array.copy()
+        t2 = time.perf_counter()
+        for obj in (T, A, d, t, r, b, v):
+            obj.destroy()
+        self.stats["reused" if reuse else "factorizations"] += 1
+        self.stats["setup_time"] += t1 - t0
+        return SaddleResult(u, mu, its, reason, {"refactored": not reuse, "setup": t1 - t0,
+                                                 "solve": t2 - t1})
+
+    def _near_nullspace(self, piv: np.ndarray) -> PETSc.NullSpace:
+        """The rigid-body modes with the (decoupled) pivot entries removed, orthonormal."""
+        modes = []
+        for m in self._modes:
+            w = m.copy()
+            w.setValues(piv.astype(PETSc.IntType), np.zeros(len(piv)))
+            w.assemble()
+            modes.append(w)
+        for _ in range(2):
+            for i, w in enumerate(modes):
+                for q in modes[:i]:
+                    w.axpy(-w.dot(q), q)
+                w.normalize()
+        nsp = PETSc.NullSpace().create(vectors=modes, comm=self._comm)
+        for w in modes:
+            w.destroy()
+        return nsp
+
+
+def owned_node_dofs(layout_gblock: np.ndarray, mine: np.ndarray) -> np.ndarray:
+    """(m, 2) global dofs (x, y) of the active node of each owned multiplier row."""
+    g = np.asarray(layout_gblock)[mine].astype(np.int64)
+    return np.column_stack([2 * g, 2 * g + 1])

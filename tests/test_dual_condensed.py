@@ -1,0 +1,122 @@
+"""Dual mortar in the full pipeline, and the condensed solver (multipliers eliminated).
+
+References: the exact uniform stress of the patch tests, plane-strain Hertz, and MUMPS on the
+saddle point (an independent solver of the same discrete equations).
+"""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import ROOT
+from mpi4py import MPI
+
+from contactfx import load_scene_file, run_scene, solve
+from contactfx.errors import InputError
+from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
+
+SCENES = ROOT / "tests" / "scenes"
+
+
+@pytest.mark.parametrize("name", ["inclined_patch.toml", "inclined_patch_b1.toml"])
+def test_dual_mortar_inclined_patch_test(name: str) -> None:
+    """Dual mortar passes the inclined patch test (either side active) to 1e-8."""
+    _, data = run_scene(load_scene_file(SCENES / name), "mortar", basis="dual")
+    assert data["patch"]["max"] < 1e-8, data["patch"]
+    assert data["basis"] == "dual"
+
+
+@pytest.mark.parametrize("active", [1, 2])
+def test_dual_mortar_straight_patch_test(active: int) -> None:
+    """S4 (graded non-matching, E ratio 10): sigma_yy = -p to 1e-8 with the dual basis."""
+    scene = build_scene("blocks", BLOCK_SCENES["S4"], active=active, comm=MPI.COMM_SELF)
+    _, data = run_scene(scene, "mortar", basis="dual")
+    assert data["patch"]["max"] < 1e-8
+
+
+def test_dual_hertz_within_ten_percent_of_standard() -> None:
+    """Hertz errors (a, p0, L2) of the dual basis stay within 10 % of the standard basis'.
+
+    Relative to the exact values the two differ by less than 0.1 % here; the 10 % band of the
+    issue is on the errors themselves, checked as |err_dual| <= 1.1 |err_std| + 1e-4."""
+    scene = build_scene("hertz", HertzParams(), comm=MPI.COMM_SELF)
+    out = {b: run_scene(scene, "mortar", basis=b)[1]["hertz"] for b in ("standard", "dual")}
+    for key, exact in (("a", "a_exact"), ("p0", "p0_exact")):
+        errs = {b: abs(h[key] / h[exact] - 1) for b, h in out.items()}
+        assert errs["dual"] <= 1.1 * errs["standard"] + 1e-4, (key, errs)
+    assert out["dual"]["l2_error"] <= 1.1 * out["standard"]["l2_error"]
+
+
+@pytest.fixture(scope="module")
+def small_hertz():
+    """A structured Hertz mesh (about 50k DOFs) for solver comparisons."""
+    return hertz(HertzParams(refine=0.08, h_far=0.8, mesh="structured"), comm=MPI.COMM_SELF)
+
+
+@pytest.mark.parametrize(("method", "basis"), [("nts", "standard"), ("mortar", "dual")])
+def test_condensed_equals_mumps(small_hertz, method: str, basis: str) -> None:
+    """Eliminating the multipliers gives MUMPS' saddle-point answer: same set, 1e-6."""
+    ref = solve(small_hertz, method, basis=basis, solver="mumps")
+    sol = solve(small_hertz, method, basis=basis, solver="condensed")
+    assert np.array_equal(sol.active, ref.active)
+    assert np.abs(sol.pressure - ref.pressure).max() <= 1e-6 * np.abs(ref.pressure).max()
+    du = np.abs(sol.u.x.array - ref.u.x.array).max()
+    assert du <= 1e-6 * np.abs(ref.u.x.array).max()
+    assert all(h["linear_iterations"] > 0 for h in sol.history)  # CG really ran
+
+
+@pytest.mark.parametrize(("method", "basis"), [("mortar", "standard"), ("sts", "standard")])
+def test_condensed_refuses_a_non_diagonal_d(small_hertz, method: str, basis: str) -> None:
+    """Standard mortar and STS couple neighbouring active nodes: a clear error."""
+    with pytest.raises(InputError, match="needs a diagonal D"):
+        solve(small_hertz, method, basis=basis, solver="condensed")
+
+
+def test_condensed_refuses_a_curved_passive_surface_with_dual() -> None:
+    """Dual mortar on a curved passive surface leaves off-diagonal normal terms: refused."""
+    scene = load_scene_file(SCENES / "two_cylinders.toml", MPI.COMM_SELF)
+    with pytest.raises(InputError, match="needs a diagonal D"):
+        solve(scene, "mortar", basis="dual", solver="condensed")
+
+
+def test_basis_and_solver_errors() -> None:
+    """The dual basis is a mortar option; Schwarz takes no solver option."""
+    scene = build_scene("blocks", BLOCK_SCENES["S1"], comm=MPI.COMM_SELF)
+    with pytest.raises(InputError, match="mortar method only"):
+        solve(scene, "nts", basis="dual")
+    with pytest.raises(InputError, match="schwarz factorizes"):
+        solve(scene, "schwarz", solver="fieldsplit")
+    with pytest.raises(InputError, match="unknown solver"):
+        solve(scene, "mortar", solver="cholmod")
+
+
+MPI_SCRIPT = textwrap.dedent("""
+    import sys
+    import numpy as np
+    from mpi4py import MPI
+    from contactfx import solve
+    from contactfx.scenes import HertzParams, hertz
+    scene = hertz(HertzParams(refine=0.08, h_far=0.8, mesh="structured"))
+    sol = solve(scene, "nts", solver="condensed")
+    if MPI.COMM_WORLD.rank == 0:
+        np.savez(sys.argv[1], p=sol.pressure, x=sol.layout.x, act=sol.active)
+""")
+
+
+@pytest.mark.mpi
+def test_condensed_two_ranks_equal_serial(tmp_path: Path, mpi_script) -> None:
+    """1 and 2 ranks agree to the CG tolerance (rtol 1e-9 on the residual: 1e-6 here)."""
+    script = tmp_path / "run.py"
+    script.write_text(MPI_SCRIPT)
+    res = {}
+    for ranks in (1, 2):
+        out = tmp_path / f"r{ranks}.npz"
+        mpi_script(script, str(out), ranks=ranks)
+        res[ranks] = np.load(out)
+    order = [np.lexsort(res[r]["x"].T[::-1]) for r in (1, 2)]
+    p1, p2 = res[1]["p"][order[0]], res[2]["p"][order[1]]
+    assert np.array_equal(res[1]["act"][order[0]], res[2]["act"][order[1]])
+    assert np.abs(p2 - p1).max() <= 1e-6 * np.abs(p1).max()
