@@ -85,8 +85,15 @@ def main() -> None:
             assert isinstance(solver, dict)
             record = fixed_set_solve(scene, Method(method), solver, timers)
         else:
-            sol = solve(scene, method, solver=solver, timers=timers,
-                        reference_timing=not args.no_reference, predictor=args.predictor)
+            try:
+                sol = solve(scene, method, solver=solver, timers=timers,
+                            reference_timing=not args.no_reference, predictor=args.predictor)
+            except Exception as err:  # one method's failure must not hide the others
+                if comm.rank == 0:
+                    print("RESULT " + json.dumps({**common, "method": method,
+                                                  "error": f"{type(err).__name__}: {err}"}),
+                          flush=True)
+                continue
             V = sol.elasticity.V
             record = {
                 "predictor": "predictor" in timers.seconds,

@@ -151,6 +151,7 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
     """Scene parameters from the paper's defaults, a preset, and the options given."""
     from .scenes import BLOCK_SCENES
 
+    base: BlockParams | HertzParams
     if args.scene == "blocks":
         base, keys = BLOCK_SCENES[args.preset or "S1"], BLOCK_KEYS
     elif args.scene == "hertz":

@@ -16,6 +16,7 @@ displacement is the initial guess. Near-nullspace: each body's rigid modes, zero
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any, cast
 
 import numpy as np
 from petsc4py import PETSc
@@ -24,6 +25,7 @@ from .errors import InputError, SolverError
 from .saddle import SaddleResult
 from .solvers import PrefixedOptions, petsc_error_message, reason_name
 
+_ADD = cast(Any, PETSc.InsertMode.ADD_VALUES)
 # Entries of B on another active node's dofs larger than this (relative to the row's pivot)
 # mean D is not diagonal: the elimination would couple the pivots.
 _DIAGONAL_TOL = 1e-10
@@ -57,6 +59,11 @@ class CondensedSolver:
         self.stats = {"factorizations": 0.0, "reused": 0.0, "setup_time": 0.0}
         self._built_for: np.ndarray | None = None  # the pivots the multigrid was built with
         self.reuse = True
+
+    @property
+    def cheap_responses(self) -> bool:
+        """No probe responses: the condensed solver has no factorization to reuse."""
+        return False
 
     def destroy(self) -> None:
         """Free the PETSc objects and remove this solver's options."""
@@ -112,9 +119,9 @@ class CondensedSolver:
         for r, (c, v) in extra.items():
             cols[indptr[r]:indptr[r + 1]] = c
             vals[indptr[r]:indptr[r + 1]] = v
-        T = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)),
-                                  csr=(indptr.astype(PETSc.IntType), cols.astype(PETSc.IntType),
-                                       vals.astype(PETSc.ScalarType)), comm=self._comm)
+        csr: Any = (indptr.astype(PETSc.IntType), cols.astype(PETSc.IntType),
+                    vals.astype(PETSc.ScalarType))
+        T = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)), csr=csr, comm=self._comm)
         T.assemble()
         return T
 
@@ -127,20 +134,21 @@ class CondensedSolver:
 
         t0 = time.perf_counter()
         rows, piv, coef = self._pivots(np.asarray(active, dtype=bool))
+        # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
+        ip: Any = piv.astype(PETSc.IntType)
         T = self._transform(rows, piv, coef)
         A = self._K.ptap(T)
         d = A.createVecLeft()
         d.set(0.0)
-        d.setValues(piv.astype(PETSc.IntType), self._diag.getValues(piv.astype(PETSc.IntType)),
-                    addv=PETSc.InsertMode.ADD_VALUES)
+        d.setValues(ip, cast(Any, self._diag.getValues(ip)), addv=_ADD)
         d.assemble()
         # T^T K T has no entries on the pivot rows: give them the diagonal of K.
-        A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        A.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+        A.setOption(cast(Any, PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR), False)
+        A.setDiagonal(d, addv=_ADD)
         A.assemble()
         t = self._f.duplicate()
         t.set(0.0)
-        t.setValues(piv.astype(PETSc.IntType), -np.asarray(g)[rows] / coef)
+        t.setValues(ip, cast(Any, -np.asarray(g)[rows] / coef))
         t.assemble()
         r = self._f.duplicate()
         self._K.mult(t, r)
@@ -148,7 +156,7 @@ class CondensedSolver:
         b = self._f.duplicate()
         T.multTranspose(r, b)
         v = self._u.copy()             # warm start: the last displacement, pivots free
-        v.setValues(piv.astype(PETSc.IntType), np.zeros(len(piv)))
+        v.setValues(ip, cast(Any, np.zeros(len(piv))))
         v.assemble()
         ksp = self._ksp
         # A few pivots more or less change T^T K T by a low-rank term: the multigrid built
@@ -172,7 +180,7 @@ class CondensedSolver:
             ksp.solve(b, v)
         except PETSc.Error as err:
             raise SolverError(petsc_error_message(err, "condensed solve")) from None
-        reason, its = int(ksp.getConvergedReason()), ksp.getIterationNumber()
+        reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
         if reason <= 0 or not np.isfinite(v.norm()):
             raise SolverError(f"condensed solve ({ksp.getType()}) did not converge: PETSc "
                               f"reason {reason} ({reason_name(reason)}) after {its} iterations")
@@ -181,7 +189,7 @@ class CondensedSolver:
         self._K.mult(self._u, r)
         r.aypx(-1.0, self._f)          # f - K u: the contact force on the pivots
         mu = np.zeros(len(active))
-        mu[rows] = r.getValues(piv.astype(PETSc.IntType)) / coef
+        mu[rows] = r.getValues(ip) / coef
         u = self._u.array.copy()
         t2 = time.perf_counter()
         for obj in (T, A, d, t, r, b, v):
@@ -196,7 +204,7 @@ class CondensedSolver:
         modes = []
         for m in self._modes:
             w = m.copy()
-            w.setValues(piv.astype(PETSc.IntType), np.zeros(len(piv)))
+            w.setValues(cast(Any, piv.astype(PETSc.IntType)), cast(Any, np.zeros(len(piv))))
             w.assemble()
             modes.append(w)
         for _ in range(2):

@@ -161,7 +161,7 @@ def prepare_contact(scene: Scene, method: str, penetration_tol: float, timers: T
     if kernel_options:
         # A dual (sign-changing) weighting averages the gap with negative weights: check
         # for overlap with the standard, positive weights (geometry, not the multipliers).
-        std = stack(build_pairs(gathered, method, ndofs))[1]  # type: ignore[arg-type]
+        std = stack(build_pairs(gathered, method, ndofs))[1]
         g_all = (std.gap[order] + shift[order]) / std.weights[order]
     h = float(np.median(w_all))
     for p in pairs:

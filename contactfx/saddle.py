@@ -355,7 +355,8 @@ class SaddleSolver:
         r = self._b.duplicate()
         self._A.mult(x, r)
         r.aypx(-1.0, self._b)
-        rel = r.norm() / max(self._b.norm(), 1e-300)
+        # norm() of the default (2-) norm is a float; the stub also allows a pair.
+        rel = cast(float, r.norm()) / max(cast(float, self._b.norm()), 1e-300)
         r.destroy()
         return float(rel) if np.isfinite(rel) else np.inf
 

@@ -37,7 +37,7 @@ from contactfx.postprocess import body_stress_deviation
 from contactfx.scenes import BLOCK_SCENES
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "blocks"

@@ -30,7 +30,7 @@ from mpi4py import MPI
 from contactfx import load_scene_file, run_scene
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "own_scene"

@@ -43,7 +43,7 @@ from contactfx.scenes import BLOCK_SCENES
 from contactfx.schwarz import SchwarzOptions
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 QUICK = os.environ.get("CONTACTFX_QUICK") == "1"

@@ -41,7 +41,7 @@ from contactfx.problem import solve_contact
 from contactfx.scenes import BLOCK_SCENES, build_scene
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 QUICK = os.environ.get("CONTACTFX_QUICK") == "1"

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from contactfx.contact import Surface
+from contactfx.methods import Method
 
 ROOT = Path(__file__).resolve().parents[1]
 MPIRUN = str(Path(sys.executable).parent / "mpirun")
@@ -35,6 +36,16 @@ def run_mpi_script(script: Path, *args: str, ranks: int = 2,
                           timeout=timeout)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return proc
+
+
+# The multiplier methods (one saddle-point discretization each): most tests run all three.
+MULTIPLIER_METHODS = (Method.NTS, Method.STS, Method.MORTAR)
+
+
+@pytest.fixture(params=MULTIPLIER_METHODS, ids=[m.value for m in MULTIPLIER_METHODS])
+def multiplier_method(request: pytest.FixtureRequest) -> str:
+    """Each multiplier method in turn (its name, as the API and the CLI take it)."""
+    return str(request.param.value)
 
 
 @pytest.fixture

@@ -4,34 +4,33 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from conftest import MULTIPLIER_METHODS
 
 from contactfx.api import run_case
 from contactfx.metrics import patch_errors
 from contactfx.postprocess import body_stress_deviation
 from contactfx.scenes import BLOCK_SCENES
 
-METHODS = ["nts", "sts", "mortar"]
+METHODS = [m.value for m in MULTIPLIER_METHODS]
 S4 = BLOCK_SCENES["S4"]
 P = S4.p
 
 
-@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("active", [1, 2])
-def test_patch_test_matching_meshes(method: str, active: int) -> None:
+def test_patch_test_matching_meshes(multiplier_method: str, active: int) -> None:
     """Equal widths and matching uniform meshes: every method gives sigma_yy = -p exactly."""
     params = replace(S4, size1=0.125, size2=0.125, grading1=1.0, grading2=1.0)
-    sol, data = run_case("blocks", params, method, active=active)
+    sol, data = run_case("blocks", params, multiplier_method, active=active)
     dev = body_stress_deviation(sol, -P)
     assert dev["body1"] < 1e-8 and dev["body2"] < 1e-8
     assert patch_errors(data["interface"], P)["pressure"] < 1e-8
 
 
 @pytest.mark.parametrize("scene", list(BLOCK_SCENES))
-@pytest.mark.parametrize("method", METHODS)
-def test_contact_force_equals_load(scene: str, method: str) -> None:
+def test_contact_force_equals_load(scene: str, multiplier_method: str) -> None:
     """The top block is held only by contact, so the contact force is the whole load p*l2/2."""
     params = BLOCK_SCENES[scene]
-    _, data = run_case("blocks", params, method)
+    _, data = run_case("blocks", params, multiplier_method)
     assert data["contact_force"] == pytest.approx(params.p * params.l2 / 2, rel=1e-10)
     assert data["iterations"] == 1
 

@@ -136,7 +136,7 @@ def test_triangle_mesh_is_refused() -> None:
 def test_surfaces_not_facing(solve) -> None:
     # The top (load) face of B2 tagged as its contact face: its normal points away from B1.
     scene = coarse_scene()
-    with pytest.raises(GeometryError, match="do not face each other.*angle of 0 degrees"):
+    with pytest.raises(GeometryError, match=r"do not face each other.*angle of 0 degrees"):
         solve(with_groups(scene, contact2=scene.groups.by_name["load"]))
 
 
@@ -176,7 +176,7 @@ def test_body_pulled_off_is_singular(method: str) -> None:
 def test_no_support_at_all(solve) -> None:
     scene = coarse_scene()
     with pytest.raises(SingularSystemError,
-                       match="body 'body1' can still move freely.*translation along y"):
+                       match=r"body 'body1' can still move freely.*translation along y"):
         solve(with_groups(scene, support=(1, 9999)))
 
 
@@ -192,7 +192,7 @@ def test_linear_solve_not_converging_reports_reason() -> None:
 
 @pytest.mark.parametrize("method", ["mortar", "penalty"])
 def test_petsc_error_becomes_solver_error(method: str) -> None:
-    with pytest.raises(SolverError, match="PETSc error 86 .*Unable to find requested KSP type"):
+    with pytest.raises(SolverError, match=r"PETSc error 86 .*Unable to find requested KSP type"):
         run_case("blocks", COARSE, method, solver={"ksp_type": "bogus"}, comm=MPI.COMM_SELF)
 
 
@@ -201,12 +201,13 @@ def test_penalty_refuses_fieldsplit() -> None:
         run_case("blocks", COARSE, "penalty", solver="fieldsplit", comm=MPI.COMM_SELF)
 
 
-@pytest.mark.parametrize("method", ["mortar", "penalty"])
-def test_active_set_iteration_limit(method: str) -> None:
+# Serial mortar with MUMPS converges in two steps (every row probed first), penalty in more.
+@pytest.mark.parametrize(("method", "limit"), [("mortar", 1), ("penalty", 2)])
+def test_active_set_iteration_limit(method: str, limit: int) -> None:
     from contactfx.scenes import HertzParams
 
-    with pytest.raises(ActiveSetError, match="did not converge in 2 iterations"):
-        run_case("hertz", HertzParams(refine=0.1), method, max_iterations=2,
+    with pytest.raises(ActiveSetError, match=f"did not converge in {limit} iterations"):
+        run_case("hertz", HertzParams(refine=0.1), method, max_iterations=limit,
                  comm=MPI.COMM_SELF)
 
 
@@ -231,28 +232,26 @@ S4 = ["blocks", "--preset", "S4", "--size1", "0.5", "--size2", "0.6"]
 
 
 @pytest.mark.parametrize(("args", "words"), [
-    (S4 + ["--nu1", "0.5"], "Poisson ratio must lie in (-1, 0.5) (got nu = 0.5)"),
-    (S4 + ["--nu2", "-1"], "Poisson ratio"),
-    (S4 + ["--E2", "0"], "Young's modulus must be > 0"),
-    (S4 + ["--size1", "0"], "size1 must be a positive number"),
+    ([*S4, "--nu1", "0.5"], "Poisson ratio must lie in (-1, 0.5) (got nu = 0.5)"),
+    ([*S4, "--nu2", "-1"], "Poisson ratio"),
+    ([*S4, "--E2", "0"], "Young's modulus must be > 0"),
+    ([*S4, "--size1", "0"], "size1 must be a positive number"),
     (["cube"], "unknown scene 'cube'"),
-    (S4 + ["--p", "-50"], "body 'body2' is not held"),
-    (S4 + ["--method", "penalty", "--p", "-50"], "body 'body2' is not held"),
-    (S4 + ["--petsc-option", "ksp_type=gmres", "--petsc-option", "pc_type=none",
-           "--petsc-option", "ksp_max_it=5"], "PETSc reason -3 (DIVERGED_MAX_IT)"),
-    (S4 + ["--solver", "fieldsplit", "--petsc-option", "ksp_max_it=1",
-           "--petsc-option", "fieldsplit_lambda_ksp_max_it=1"], "did not converge: PETSc reason"),
-    (S4 + ["--petsc-option", "pc_type=bogus"], "PETSc error 86"),
-    (S4 + ["--method", "penalty", "--penalty", "-1"], "penalty parameter must be a positive"),
-    (S4 + ["--penalty", "1e6"], "--penalty applies to --method penalty only"),
-    (["hertz", "--refine", "0.1", "--max-iterations", "2"], "did not converge in 2 iterations"),
+    ([*S4, "--p", "-50"], "body 'body2' is not held"),
+    ([*S4, "--method", "penalty", "--p", "-50"], "body 'body2' is not held"),
+    ([*S4, "--petsc-option", "ksp_type=gmres", "--petsc-option", "pc_type=none", "--petsc-option", "ksp_max_it=5"], "PETSc reason -3 (DIVERGED_MAX_IT)"),
+    ([*S4, "--solver", "fieldsplit", "--petsc-option", "ksp_max_it=1", "--petsc-option", "fieldsplit_lambda_ksp_max_it=1"], "did not converge: PETSc reason"),
+    ([*S4, "--petsc-option", "pc_type=bogus"], "PETSc error 86"),
+    ([*S4, "--method", "penalty", "--penalty", "-1"], "penalty parameter must be a positive"),
+    ([*S4, "--penalty", "1e6"], "--penalty applies to --method penalty only"),
+    (["hertz", "--refine", "0.1", "--max-iterations", "1"], "did not converge in 1 iterations"),
 ])
 def test_cli_one_line_no_json(tmp_path: Path, args: list[str], words: str) -> None:
     assert_clean_failure(tmp_path, args, words)
 
 
 def test_cli_failure_under_mpi(tmp_path: Path) -> None:
-    line = assert_clean_failure(tmp_path, S4 + ["--p", "-50"], "body 'body2' is not held", mpi=2)
+    line = assert_clean_failure(tmp_path, [*S4, "--p", "-50"], "body 'body2' is not held", mpi=2)
     assert "SingularSystemError" not in line
 
 

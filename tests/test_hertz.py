@@ -15,7 +15,6 @@ from contactfx.hertz import exact_pressure, fit_half_width, l2_error
 from contactfx.problem import lcp_active_set
 from contactfx.scenes import BlockParams, HertzParams, hertz_exact
 
-METHODS = ("nts", "sts", "mortar")
 # Coarse graded meshes: (size at the contact edge, slope), slope ~ sqrt(h) as in the demo.
 LEVELS = [(0.04, 0.283), (0.02, 0.2), (0.01, 0.141)]
 
@@ -24,10 +23,21 @@ def _graded(h: float, slope: float) -> HertzParams:
     return HertzParams(refine=4 * h, refine_edge=h, slope=slope)
 
 
+_LEVELS_CACHE: dict[str, list[dict]] = {}
+
+
+def levels_of(method: str) -> list[dict]:
+    """Hertz summaries of `method` on three graded meshes (coarse to fine), computed once."""
+    if method not in _LEVELS_CACHE:
+        _LEVELS_CACHE[method] = [run_case("hertz", _graded(h, s), method, comm=MPI.COMM_SELF)[1]
+                                 for h, s in LEVELS]
+    return _LEVELS_CACHE[method]
+
+
 @pytest.fixture(scope="module")
 def mortar_levels() -> list[dict]:
     """Hertz summaries of mortar on three graded meshes (coarse to fine)."""
-    return [run_case("hertz", _graded(h, s), "mortar", comm=MPI.COMM_SELF)[1] for h, s in LEVELS]
+    return levels_of("mortar")
 
 
 def test_exact_formulas_against_johnson() -> None:
@@ -70,17 +80,27 @@ def test_profile_matches_exact_on_coarse_graded_mesh(mortar_levels: list[dict]) 
     assert data["contact_force"] == pytest.approx(50.0, rel=1e-8)
 
 
-def test_mortar_l2_rate(mortar_levels: list[dict]) -> None:
-    # Measured 1.00 on these meshes; the sqrt edge limits the pressure to first order.
+def test_l2_rate(multiplier_method: str) -> None:
+    """Fitted rate of the L2 pressure error in the edge element size, in [0.6, 1.3].
+
+    Why this band: the exact pressure has a square-root edge at x = a. A piecewise-linear
+    pressure misses it by O(sqrt(h)) over the one element that straddles the edge, an L2
+    contribution of O(h); the smooth part converges like h^2. So the asymptotic rate is 1,
+    and no honest discretization beats it by much before the edge dominates (the upper bound
+    1.3 leaves room for pre-asymptotic levels). NTS's lumped, collocated pressure adds an
+    O(h) oscillation of its own on non-matching meshes, which slows the pre-asymptotic rate
+    (measured on these meshes: nts 0.71, sts 0.93, mortar 0.93). A method stuck at a plateau
+    (e.g. only the zone refined, rate 0.14 in tests/test_study.py) fails the lower bound.
+    """
     hs = [h for h, _ in LEVELS]
-    errs = [d["hertz"]["l2_error"] for d in mortar_levels]
+    errs = [d["hertz"]["l2_error"] for d in levels_of(multiplier_method)]
+    assert np.all(np.diff(errs) < 0), errs
     rate = np.polyfit(np.log(hs), np.log(errs), 1)[0]
-    assert 0.85 <= rate <= 1.5, rate
+    assert 0.6 <= rate <= 1.3, rate
 
 
-@pytest.mark.parametrize("method", METHODS)
-def test_active_set_iterations_bounded(method: str) -> None:
-    sol, data = run_case("hertz", _graded(0.02, 0.2), method, comm=MPI.COMM_SELF)
+def test_active_set_iterations_bounded(multiplier_method: str) -> None:
+    sol, data = run_case("hertz", _graded(0.02, 0.2), multiplier_method, comm=MPI.COMM_SELF)
     assert data["iterations"] <= 4
     hist = data["active_set"]
     assert hist[-1]["entered"] == hist[-1]["left"] == 0

@@ -83,6 +83,7 @@ def test_three_bodies_two_pairs_balance_and_hertz() -> None:
 def test_every_method_on_the_three_body_scene(method: str) -> None:
     """All methods run on several pairs at once and carry the load through both pairs."""
     _, data = run_scene(load_scene_file(THREE_BODIES), method)
+    assert len(data["contacts"]) == 2
     for c in data["contacts"]:
         assert abs(c["force"][1]) == pytest.approx(50.0, rel=1e-7)
         assert c["active_nodes"] > 5

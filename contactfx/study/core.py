@@ -202,7 +202,7 @@ def fit_rates(
         ),
         None,
     )
-    out = {}
+    out: dict[str, dict[str, float | None]] = {}
     for m in methods:
         done = [r for r in runs if r.method == m and r.ok and (ref is None or r.level < ref.level)]
         xs = [r.h if against == "h" else r.after_mesh for r in done]

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 
 from mpi4py import MPI
@@ -102,7 +103,7 @@ def builtin_levels(
         p = at(params, f)  # type: ignore[arg-type]
         out.append(
             Level(
-                k, f, builtin_sizes(p), lambda p=p: build_scene(kind, p, active=active, comm=comm)
+                k, f, builtin_sizes(p), partial(build_scene, kind, p, active=active, comm=comm)
             )
         )
     return out
@@ -127,6 +128,6 @@ def scene_file_levels(
     """Levels of a scene file whose mesh is a .geo: gmsh's MeshSizeFactor per level."""
     check_refinable(path)
     return [
-        Level(k, f, {"size_factor": f}, lambda f=f: load_scene_file(path, comm, size_factor=f))
+        Level(k, f, {"size_factor": f}, partial(load_scene_file, path, comm, size_factor=f))
         for k, f in enumerate(factors)
     ]

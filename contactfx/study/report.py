@@ -132,8 +132,8 @@ def _rate_cell(study: Study, method: str, name: str, rate: float | None) -> str:
     """The rate, or why there is none."""
     if rate is not None:
         return f"{rate:.2f}"
-    errs = [r.errors.get(name) for r in study.runs if r.method == method and r.ok]
-    errs = [e for e in errs if e is not None]
+    found = [r.errors.get(name) for r in study.runs if r.method == method and r.ok]
+    errs = [e for e in found if e is not None]
     return "none (exact to round-off)" if errs and max(errs) <= ROUND_OFF else "n/a"
 
 
