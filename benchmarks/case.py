@@ -44,6 +44,7 @@ def main() -> None:
     ap.add_argument("--method", default="mortar", help="one method or a comma list")
     ap.add_argument("--solver", default="mumps")
     ap.add_argument("--mesh", default="structured", choices=("structured", "gmsh"))
+    ap.add_argument("--basis", default="standard", help="mortar's multiplier basis")
     ap.add_argument("--refine", type=float, required=True, help="h at the contact (cm)")
     ap.add_argument("--refine-edge", type=float, default=None,
                     help="gmsh: h at x = a (cm); default refine / 4")
@@ -73,7 +74,7 @@ def main() -> None:
     mesh_timers = Timers()
     with mesh_timers("mesh"):
         scene = hertz(params, comm=comm)
-    common = {"solver": args.solver, "ranks": comm.size, "mesh": args.mesh,
+    common = {"solver": args.solver, "ranks": comm.size, "mesh": args.mesh, "basis": args.basis,
               "refine": args.refine, "h_far": args.h_far,
               "refine_edge": edge if args.mesh == "gmsh" else None}
     for method in args.method.split(","):
@@ -86,7 +87,8 @@ def main() -> None:
             record = fixed_set_solve(scene, Method(method), solver, timers)
         else:
             try:
-                sol = solve(scene, method, solver=solver, timers=timers,
+                basis = args.basis if method == "mortar" else "standard"
+                sol = solve(scene, method, solver=solver, timers=timers, basis=basis,
                             reference_timing=not args.no_reference, predictor=args.predictor)
             except Exception as err:  # one method's failure must not hide the others
                 if comm.rank == 0:

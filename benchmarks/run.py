@@ -43,7 +43,9 @@ SIZES = (20e3, 40e3, 80e3, 150e3, 300e3, 600e3, 1.2e6, 2e6)
 QUICK_SIZES = (20e3, 60e3)
 METHODS = ("nts", "sts", "mortar")
 MESHERS = ("structured", "gmsh")
-# Repeats (medians) up to this many dofs; one run above (the large cases dominate the time).
+# Repeats (medians): 5 up to SMALL_DOFS (0.1-1 s solves, the noisiest), 3 up to CHEAP_DOFS,
+# one run above (the large cases dominate the time).
+SMALL_DOFS = 100e3
 CHEAP_DOFS = 350e3
 TARGET = 1.5
 START, END = "<!-- bench:start -->", "<!-- bench:end -->"
@@ -68,10 +70,12 @@ def refine_for(dofs: float, mesh: str = "structured") -> float:
 
 
 def run_case(mesh: str, methods: tuple[str, ...], solver: str, h0: float, ranks: int,
-             fixed: bool = False, timeout: float = 1800) -> list[dict[str, Any]]:
+             fixed: bool = False, timeout: float = 1800, basis: str = "standard"
+             ) -> list[dict[str, Any]]:
     """Run benchmarks/case.py once (all `methods` on one mesh); return one record per method."""
     cmd = [PY, str(HERE / "case.py"), "--mesh", mesh, "--method", ",".join(methods),
-           "--solver", solver, "--refine", str(h0), "--h-far", str(H_RATIO * h0)]
+           "--solver", solver, "--refine", str(h0), "--h-far", str(H_RATIO * h0),
+           "--basis", basis]
     if mesh == "gmsh":
         cmd += ["--refine-edge", str(round(h0 / EDGE_RATIO, 8))]
     if fixed:
@@ -161,11 +165,12 @@ def plan(quick: bool, solvers: list[str], ranks: list[int], sizes: tuple[float, 
          ) -> list[tuple[str, str, float, int, int]]:
     """(mesh, solver, target dofs, ranks, repeats) of every case, small sizes first."""
     cases = []
-    for n in (QUICK_SIZES if quick else sizes):
+    for n in (QUICK_SIZES if quick and sizes == SIZES else sizes):
         for mesh in MESHERS:
             for solver in solvers:
                 for r in ranks:
-                    cases.append((mesh, solver, n, r, 1 if quick or n > CHEAP_DOFS else 3))
+                    repeats = 5 if n <= SMALL_DOFS else 3 if n <= CHEAP_DOFS else 1
+                    cases.append((mesh, solver, n, r, 1 if quick else repeats))
     return cases
 
 
@@ -276,10 +281,10 @@ def write_readme(rows: list[dict[str, Any]], meta: dict[str, Any], figures: list
             "one) + all active-set solves; reference = one fresh solve (setup, analysis, "
             "factorization, solve) of the final system by the same solver, in the same "
             "process; ratio = contact solve / reference, median of the repeats (range in "
-            "brackets: 3 runs up to 350k dofs, 1 above); step times = the active-set steps' "
-            "solve times; MB/100k dofs = the process's peak RSS (three methods solved in turn "
-            "on one mesh). Meshes: `--refine H --h-far 10H` and `--refine-edge H/4` (gmsh) or "
-            "`--mesh structured`.\n\n"
+            "brackets: 5 runs up to 100k dofs, 3 up to 350k, 1 above); step times = the "
+            "active-set steps' solve times; MB/100k dofs = the process's peak RSS (three "
+            "methods solved in turn on one mesh). Meshes: `--refine H --h-far 10H` and "
+            "`--refine-edge H/4` (gmsh) or `--mesh structured`.\n\n"
             "Ratio extremes:\n\n" + extremes(rows) + "\nAll rows:\n\n" + table(rows) + "\n"
             + "".join(f"![{f}]({f})\n" for f in figures))
     if START not in text:
@@ -328,6 +333,10 @@ def main() -> None:
                     help="comma-separated solvers, each run over the whole sweep (default "
                     "mumps; e.g. mumps,condensed)")
     ap.add_argument("--ranks", default="1", help="comma-separated rank counts (default 1)")
+    ap.add_argument("--methods", default=",".join(METHODS),
+                    help="comma-separated methods (default nts,sts,mortar)")
+    ap.add_argument("--basis", default="standard", help="mortar's multiplier basis "
+                    "(standard or dual; e.g. with --solvers condensed --methods nts,mortar)")
     ap.add_argument("--sizes", default=None,
                     help="comma-separated target dofs (default the 8 sizes 20k ... 2M)")
     ap.add_argument("--replot", action="store_true",
@@ -344,20 +353,22 @@ def main() -> None:
         write_readme(data["summary"], data["meta"], charts(data["summary"]))
         return
     solvers = args.solvers.split(",")
+    methods = tuple(args.methods.split(","))
     ranks = [int(r) for r in args.ranks.split(",")]
     sizes = tuple(float(s) for s in args.sizes.split(",")) if args.sizes else SIZES
     meta: dict[str, Any] = {
         "date": time.strftime("%Y-%m-%d %H:%M"),
         "machine": platform.processor() or platform.machine(), "cpus": os.cpu_count(),
         "quick": args.quick, "load_before": os.getloadavg()[0], "h_ratio": H_RATIO,
-        "edge_ratio": EDGE_RATIO, "solvers": solvers, "ranks": ranks}
+        "edge_ratio": EDGE_RATIO, "solvers": solvers, "ranks": ranks, "methods": methods,
+        "basis": args.basis}
     t_start = time.perf_counter()
     refine: dict[tuple[float, str], float] = {}
     runs: list[dict[str, Any]] = []
     for mesh, solver, dofs, nranks, repeats in plan(args.quick, solvers, ranks, sizes):
         h0 = refine.setdefault((dofs, mesh), refine_for(dofs, mesh))
         for _ in range(repeats):
-            recs = run_case(mesh, METHODS, solver, h0, nranks)
+            recs = run_case(mesh, methods, solver, h0, nranks, basis=args.basis)
             runs += recs
             for rec in recs:
                 status = rec.get("error") or (
