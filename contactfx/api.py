@@ -77,7 +77,8 @@ def solve(scene: Scene, method: Method | str = Method.MORTAR, *,
     method = Method(method)
     if basis != "standard" and method != Method.MORTAR:
         raise InputError(f"the {basis} multiplier basis applies to the mortar method only")
-    if method == Method.SCHWARZ and solver != "mumps":
+    if method == Method.SCHWARZ and (solver if isinstance(solver, str) else dict(solver)) not in (
+            "mumps", dict(SOLVERS["mumps"])):
         raise InputError("schwarz factorizes each body with MUMPS: the solver option does "
                          "not apply to it")
     if isinstance(solver, str) and solver not in SOLVERS:
