@@ -39,8 +39,15 @@ def is_condensed(options: Mapping[str, object]) -> bool:
 class CondensedSolver:
     """Solve K u + B^T mu = f, B_A u = -g_A by elimination; same interface as SaddleSolver."""
 
-    def __init__(self, K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, options: Mapping[str, object],
-                 node_dofs: np.ndarray, modes: list[PETSc.Vec] | None = None) -> None:
+    def __init__(
+        self,
+        K: PETSc.Mat,
+        B: PETSc.Mat,
+        f: PETSc.Vec,
+        options: Mapping[str, object],
+        node_dofs: np.ndarray,
+        modes: list[PETSc.Vec] | None = None,
+    ) -> None:
         """`node_dofs` (m, 2): global dofs of each owned row's active node."""
         self._K, self._B, self._f = K, B, f
         self._comm = K.getComm()
@@ -48,8 +55,9 @@ class CondensedSolver:
         self._node_dofs = np.asarray(node_dofs, dtype=np.int64).reshape(-1, 2)
         self._indptr, self._cols, self._vals = B.getValuesCSR()
         self._modes = modes or []
-        self._options = PrefixedOptions({k: v for k, v in options.items()
-                                         if k != "contactfx_condensed"})
+        self._options = PrefixedOptions(
+            {k: v for k, v in options.items() if k != "contactfx_condensed"}
+        )
         self._ksp = PETSc.KSP().create(self._comm)
         self._ksp.setOptionsPrefix(self._options.prefix)
         self._u = f.duplicate()
@@ -81,8 +89,10 @@ class CondensedSolver:
             cols, vals = self._cols[lo:hi], self._vals[lo:hi]
             own = np.isin(cols, self._node_dofs[j])
             if not own.any() or np.abs(vals[own]).max() == 0.0:
-                raise InputError("the condensed solver cannot eliminate a contact row whose "
-                                 "active node is fully prescribed: use --solver mumps")
+                raise InputError(
+                    "the condensed solver cannot eliminate a contact row whose "
+                    "active node is fully prescribed: use --solver mumps"
+                )
             k = np.flatnonzero(own)[int(np.argmax(np.abs(vals[own])))]
             piv[i], coef[i] = cols[k], vals[k]
         # Every active node's dofs, from all ranks: a row touching another one means that D
@@ -93,9 +103,11 @@ class CondensedSolver:
             cols, vals = self._cols[lo:hi], self._vals[lo:hi]
             foreign = np.isin(cols, others) & ~np.isin(cols, self._node_dofs[j])
             if foreign.any() and np.abs(vals[foreign]).max() > _DIAGONAL_TOL * abs(coef[i]):
-                raise InputError("the condensed solver needs a diagonal D (one active node per "
-                                 "constraint row): use --method nts, or mortar with --basis "
-                                 "dual (on a flat passive surface), or --solver mumps")
+                raise InputError(
+                    "the condensed solver needs a diagonal D (one active node per "
+                    "constraint row): use --method nts, or mortar with --basis "
+                    "dual (on a flat passive surface), or --solver mumps"
+                )
         return rows, piv, coef
 
     def _transform(self, rows: np.ndarray, piv: np.ndarray, coef: np.ndarray) -> PETSc.Mat:
@@ -117,16 +129,20 @@ class CondensedSolver:
         cols = np.arange(self._r0, self._r1, dtype=np.int64).repeat(counts)
         vals = np.ones(indptr[-1])
         for r, (c, v) in extra.items():
-            cols[indptr[r]:indptr[r + 1]] = c
-            vals[indptr[r]:indptr[r + 1]] = v
-        csr: Any = (indptr.astype(PETSc.IntType), cols.astype(PETSc.IntType),
-                    vals.astype(PETSc.ScalarType))
+            cols[indptr[r] : indptr[r + 1]] = c
+            vals[indptr[r] : indptr[r + 1]] = v
+        csr: Any = (
+            indptr.astype(PETSc.IntType),
+            cols.astype(PETSc.IntType),
+            vals.astype(PETSc.ScalarType),
+        )
         T = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)), csr=csr, comm=self._comm)
         T.assemble()
         return T
 
-    def solve(self, g: np.ndarray, active: np.ndarray,
-              probes: np.ndarray | None = None) -> SaddleResult:
+    def solve(
+        self, g: np.ndarray, active: np.ndarray, probes: np.ndarray | None = None
+    ) -> SaddleResult:
         """Displacements and multipliers (owned parts) with `active` rows in contact."""
         if probes is not None:
             raise InputError("the condensed solver has no probes (it is not a factorization)")
@@ -152,10 +168,10 @@ class CondensedSolver:
         t.assemble()
         r = self._f.duplicate()
         self._K.mult(t, r)
-        r.aypx(-1.0, self._f)          # f - K t
+        r.aypx(-1.0, self._f)  # f - K t
         b = self._f.duplicate()
         T.multTranspose(r, b)
-        v = self._u.copy()             # warm start: the last displacement, pivots free
+        v = self._u.copy()  # warm start: the last displacement, pivots free
         v.setValues(ip, cast(Any, np.zeros(len(piv))))
         v.assemble()
         ksp = self._ksp
@@ -163,9 +179,12 @@ class CondensedSolver:
         # for the previous set still preconditions it well (CG needs a few more iterations
         # instead of a new setup, which costs several solves' worth).
         prev = self._built_for
-        reuse = (self.reuse and prev is not None
-                 and self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
-                 <= 0.2 * max(self._mpi.allreduce(len(piv)), 1))
+        reuse = (
+            self.reuse
+            and prev is not None
+            and self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
+            <= 0.2 * max(self._mpi.allreduce(len(piv)), 1)
+        )
         if not reuse and self._modes:
             A.setNearNullSpace(self._near_nullspace(piv))
         try:
@@ -182,12 +201,14 @@ class CondensedSolver:
             raise SolverError(petsc_error_message(err, "condensed solve")) from None
         reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
         if reason <= 0 or not np.isfinite(v.norm()):
-            raise SolverError(f"condensed solve ({ksp.getType()}) did not converge: PETSc "
-                              f"reason {reason} ({reason_name(reason)}) after {its} iterations")
+            raise SolverError(
+                f"condensed solve ({ksp.getType()}) did not converge: PETSc "
+                f"reason {reason} ({reason_name(reason)}) after {its} iterations"
+            )
         T.mult(v, self._u)
         self._u.axpy(1.0, t)
         self._K.mult(self._u, r)
-        r.aypx(-1.0, self._f)          # f - K u: the contact force on the pivots
+        r.aypx(-1.0, self._f)  # f - K u: the contact force on the pivots
         mu = np.zeros(len(active))
         mu[rows] = r.getValues(ip) / coef
         u = self._u.array.copy()
@@ -196,8 +217,9 @@ class CondensedSolver:
             obj.destroy()
         self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
-        return SaddleResult(u, mu, its, reason, {"refactored": not reuse, "setup": t1 - t0,
-                                                 "solve": t2 - t1})
+        return SaddleResult(
+            u, mu, its, reason, {"refactored": not reuse, "setup": t1 - t0, "solve": t2 - t1}
+        )
 
     def _near_nullspace(self, piv: np.ndarray) -> PETSc.NullSpace:
         """The rigid-body modes with the (decoupled) pivot entries removed, orthonormal."""

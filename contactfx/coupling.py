@@ -17,12 +17,12 @@ from .surfaces import GatheredSurface
 class Multipliers:
     """The multiplier (active-surface node) layout: global order, and the rows this rank owns."""
 
-    x: np.ndarray        # (n, 2) coordinates of every multiplier node, global order
+    x: np.ndarray  # (n, 2) coordinates of every multiplier node, global order
     weights: np.ndarray  # (n,) int N_j dGamma over the overlap
-    mine: np.ndarray     # indices (into the global order) of the rows owned here
-    offset: int          # global index of this rank's first row
-    gblock: np.ndarray   # (n,) global dof block of each node
-    pair: np.ndarray     # (n,) contact pair of each multiplier
+    mine: np.ndarray  # indices (into the global order) of the rows owned here
+    offset: int  # global index of this rank's first row
+    gblock: np.ndarray  # (n,) global dof block of each node
+    pair: np.ndarray  # (n,) contact pair of each multiplier
 
     @property
     def size(self) -> int:
@@ -43,8 +43,7 @@ def global_dirichlet_dofs(V: fem.FunctionSpace, bc_dofs: np.ndarray) -> np.ndarr
     return np.unique(np.concatenate(V.mesh.comm.allgather(mine)))
 
 
-def constrained_rows(op: ContactOperator, dirichlet: np.ndarray, rtol: float = 1e-10
-                     ) -> np.ndarray:
+def constrained_rows(op: ContactOperator, dirichlet: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
     """Rows of `op` that constrain a free dof.
 
     A row on prescribed dofs only is data, not a constraint: its multiplier would make the
@@ -64,9 +63,13 @@ def constrained_rows(op: ContactOperator, dirichlet: np.ndarray, rtol: float = 1
     return free > rtol * whole
 
 
-def multiplier_layout(comm: MPI.Comm, active: GatheredSurface, op: ContactOperator,
-                      pair: np.ndarray | None = None, usable: np.ndarray | None = None
-                      ) -> tuple[Multipliers, np.ndarray]:
+def multiplier_layout(
+    comm: MPI.Comm,
+    active: GatheredSurface,
+    op: ContactOperator,
+    pair: np.ndarray | None = None,
+    usable: np.ndarray | None = None,
+) -> tuple[Multipliers, np.ndarray]:
     """Order constrained nodes by (owner rank, pair, global node): each rank's rows contiguous.
 
     `pair` (one entry per row of `op`) tells which contact pair a row belongs to when the
@@ -82,12 +85,16 @@ def multiplier_layout(comm: MPI.Comm, active: GatheredSurface, op: ContactOperat
     mine = np.flatnonzero(owner == comm.rank)
     offset = int(np.count_nonzero(owner < comm.rank))
     x = active.surface.x[order]
-    return Multipliers(x, op.weights[order], mine, offset, active.gblock[order],
-                       pair[order]), order
+    return Multipliers(x, op.weights[order], mine, offset, active.gblock[order], pair[order]), order
 
 
-def petsc_constraint(V: fem.FunctionSpace, op: ContactOperator, order: np.ndarray,
-                     layout: Multipliers, dirichlet: np.ndarray) -> PETSc.Mat:
+def petsc_constraint(
+    V: fem.FunctionSpace,
+    op: ContactOperator,
+    order: np.ndarray,
+    layout: Multipliers,
+    dirichlet: np.ndarray,
+) -> PETSc.Mat:
     """Build this rank's rows of B (global columns), with Dirichlet columns removed."""
     imap = V.dofmap.index_map
     bs = V.dofmap.index_map_bs
@@ -102,8 +109,11 @@ def petsc_constraint(V: fem.FunctionSpace, op: ContactOperator, order: np.ndarra
     m = rows.shape[0]
     B = PETSc.Mat().createAIJ(
         size=((m, layout.size), (n_local, n_global)),
-        csr=(rows.indptr.astype(PETSc.IntType), rows.indices.astype(PETSc.IntType),
-             rows.data.astype(PETSc.ScalarType)),
+        csr=(
+            rows.indptr.astype(PETSc.IntType),
+            rows.indices.astype(PETSc.IntType),
+            rows.data.astype(PETSc.ScalarType),
+        ),
         comm=V.mesh.comm,
     )
     B.assemble()

@@ -109,9 +109,14 @@ def assemble_elasticity(scene: Scene) -> Elasticity:
     f = dolfinx.fem.petsc.assemble_vector(L)
     dolfinx.fem.petsc.apply_lifting(f, [a], bcs=[bcs])
     # The stub types the mode values as int but the parameters as the enum classes.
-    f.ghostUpdate(addv=cast(PETSc.InsertMode, PETSc.InsertMode.ADD),
-                  mode=cast(PETSc.ScatterMode, PETSc.ScatterMode.REVERSE))
+    f.ghostUpdate(
+        addv=cast(PETSc.InsertMode, PETSc.InsertMode.ADD),
+        mode=cast(PETSc.ScatterMode, PETSc.ScatterMode.REVERSE),
+    )
     dolfinx.fem.petsc.set_bc(f, bcs)
-    bc_dofs = (np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs])) if bcs
-               else np.zeros(0, dtype=np.int32))
+    bc_dofs = (
+        np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs]))
+        if bcs
+        else np.zeros(0, dtype=np.int32)
+    )
     return Elasticity(V, K, f, bcs, bc_dofs, E, nu)

@@ -29,8 +29,14 @@ def fit_half_width(x: np.ndarray, p: np.ndarray) -> float | None:
     return float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else None
 
 
-def l2_error(x: np.ndarray, p: np.ndarray, a: float, p0: float, samples: int = 40001,
-             both_sides: bool = False) -> float:
+def l2_error(
+    x: np.ndarray,
+    p: np.ndarray,
+    a: float,
+    p0: float,
+    samples: int = 40001,
+    both_sides: bool = False,
+) -> float:
     """Relative L2 error over [0, 1.5 a] (or [-1.5 a, 1.5 a]) of the piecewise-linear pressure."""
     xs = np.linspace(-1.5 * a if both_sides else 0.0, 1.5 * a, samples)
     ph = np.interp(xs, x, p, left=0.0, right=0.0)
@@ -47,8 +53,9 @@ def reference_values(scene: Scene, ref: HertzReference) -> dict[str, float]:
     return {"E_star": e_star, "a": a, "p0": 2 * ref.P / (math.pi * a)}
 
 
-def centre_distance(sol: Solution, ref: HertzReference) -> tuple[np.ndarray, np.ndarray,
-                                                                 np.ndarray]:
+def centre_distance(
+    sol: Solution, ref: HertzReference
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(r, pressure, active) of the pair's multipliers, r signed along the centre's tangent."""
     pd = sol.pairs[ref.pair]
     rows = sol.rows_of(ref.pair)

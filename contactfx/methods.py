@@ -18,5 +18,6 @@ class Method(StrEnum):
         return {"penalty": "mortar", "schwarz": "mortar"}.get(self.value, self.value)
 
 
-IMPLEMENTED: frozenset[Method] = frozenset({Method.NTS, Method.STS, Method.MORTAR,
-                                             Method.PENALTY, Method.SCHWARZ})
+IMPLEMENTED: frozenset[Method] = frozenset(
+    {Method.NTS, Method.STS, Method.MORTAR, Method.PENALTY, Method.SCHWARZ}
+)

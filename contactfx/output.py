@@ -50,8 +50,10 @@ def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
     itf = data["interface"]
     x = np.asarray(itf["x"])
     fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
-    for key, style, label in (("sigma_yy_1", "-", "sigma_yy body 1"),
-                              ("sigma_yy_2", "--", "sigma_yy body 2")):
+    for key, style, label in (
+        ("sigma_yy_1", "-", "sigma_yy body 1"),
+        ("sigma_yy_2", "--", "sigma_yy body 2"),
+    ):
         vals = np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
         ax.plot(x, vals, style, label=label)
     ax.plot(x, -np.asarray(itf["pressure"]), ":", label="-pressure (multipliers)")
@@ -59,8 +61,14 @@ def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
         # Zoom on the contact zone and show the exact plane-strain Hertz profile.
         a, p0 = data["hertz"]["a_exact"], data["hertz"]["p0_exact"]
         xs = np.linspace(0.0, 2.0 * a, 400)
-        ax.plot(xs, -p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0.0, None)), "k-", lw=0.8,
-                alpha=0.6, label="-pressure, exact 2D Hertz")
+        ax.plot(
+            xs,
+            -p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0.0, None)),
+            "k-",
+            lw=0.8,
+            alpha=0.6,
+            label="-pressure, exact 2D Hertz",
+        )
         ax.set_xlim(0.0, 2.0 * a)
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("MPa")
@@ -82,8 +90,15 @@ def write_contact_surfaces(data: dict[str, Any], outdir: Path) -> list[Path]:
         itf = c["interface"]
         pts = np.column_stack([itf["x"], itf["y"], np.zeros(len(itf["x"]))])
         line = pyvista.lines_from_points(pts) if len(pts) > 1 else pyvista.PolyData(pts)
-        for key in ("s", "pressure", "gap", "sigma_nn_active", "sigma_nn_passive",
-                    "sigma_nt_active", "sigma_nt_passive"):
+        for key in (
+            "s",
+            "pressure",
+            "gap",
+            "sigma_nn_active",
+            "sigma_nn_passive",
+            "sigma_nt_active",
+            "sigma_nt_passive",
+        ):
             line.point_data[key] = np.array([np.nan if v is None else v for v in itf[key]])
         line.point_data["active"] = np.asarray(itf["active"], dtype=np.int8)
         path = outdir / f"contact{k}_{c['active']}.vtp"
@@ -106,23 +121,33 @@ def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
         return np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
 
     s = arr("s")
-    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True, layout="constrained",
-                                 height_ratios=(3, 1.3))
+    fig, (ax, bx) = plt.subplots(
+        2, 1, figsize=(7, 5.5), sharex=True, layout="constrained", height_ratios=(3, 1.3)
+    )
     ax.plot(s, arr("pressure"), "k.-", ms=3, lw=1, label="pressure (multipliers)")
     ax.plot(s, -arr("sigma_nn_active"), "-", label=f"-sigma_nn {c['active_body']} (active)")
     ax.plot(s, -arr("sigma_nn_passive"), "--", label=f"-sigma_nn {c['passive_body']} (passive)")
     bx.plot(s, arr("sigma_nt_active"), "-", label="active")
     bx.plot(s, arr("sigma_nt_passive"), "--", label="passive")
-    hertz = [h for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else [])
-             if h.get("pair") == k]
+    hertz = [
+        h
+        for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else [])
+        if h.get("pair") == k
+    ]
     if hertz:
         # The exact profile against the distance from the centre, placed at the computed peak.
         h = hertz[0]
         a, p0 = h["a_exact"], h["p0_exact"]
         sc = float(s[int(np.nanargmax(arr("pressure")))])
         xs = np.linspace(-a, a, 400)
-        ax.plot(sc + xs, p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0, None)), "r-", lw=0.8,
-                alpha=0.7, label="exact Hertz (placed at the peak)")
+        ax.plot(
+            sc + xs,
+            p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0, None)),
+            "r-",
+            lw=0.8,
+            alpha=0.7,
+            label="exact Hertz (placed at the peak)",
+        )
         ax.set_xlim(sc - 2.0 * a, sc + 2.0 * a)
     active = np.asarray(itf["active"], dtype=bool)
     if active.any():

@@ -29,7 +29,7 @@ class PairData:
     active: GatheredSurface
     passive: GatheredSurface
     operator: ContactOperator
-    first_row: int   # first row of this pair in the stacked operator
+    first_row: int  # first row of this pair in the stacked operator
 
     @property
     def label(self) -> str:
@@ -37,19 +37,30 @@ class PairData:
         return f" of pair {self.index} ({self.pair.active} on {self.pair.passive})"
 
 
-def gather_pairs(scene: Scene, V: fem.FunctionSpace) -> list[tuple[ContactPair, Body, Body,
-                                                                   GatheredSurface,
-                                                                   GatheredSurface]]:
+def gather_pairs(
+    scene: Scene, V: fem.FunctionSpace
+) -> list[tuple[ContactPair, Body, Body, GatheredSurface, GatheredSurface]]:
     """Both gathered surfaces and bodies of every pair, in the scene's order."""
     out = []
     for pair in scene.contacts:
-        out.append((pair, scene.body_of_curve(pair.active), scene.body_of_curve(pair.passive),
-                    gather_surface(scene, V, pair.active), gather_surface(scene, V, pair.passive)))
+        out.append(
+            (
+                pair,
+                scene.body_of_curve(pair.active),
+                scene.body_of_curve(pair.passive),
+                gather_surface(scene, V, pair.active),
+                gather_surface(scene, V, pair.passive),
+            )
+        )
     return out
 
 
-def build_pairs(gathered: list[tuple[ContactPair, Body, Body, GatheredSurface, GatheredSurface]],
-                method: str, ndofs: int, **kernel_options: object) -> list[PairData]:
+def build_pairs(
+    gathered: list[tuple[ContactPair, Body, Body, GatheredSurface, GatheredSurface]],
+    method: str,
+    ndofs: int,
+    **kernel_options: object,
+) -> list[PairData]:
     """The contact operator of `method` on every pair."""
     pairs, row = [], 0
     for k, (pair, ab, pb, sa, sp_) in enumerate(gathered):
@@ -64,21 +75,30 @@ def union_surface(parts: list[GatheredSurface]) -> GatheredSurface:
     if len(parts) == 1:
         return parts[0]
     offsets = np.cumsum([0] + [p.surface.n_nodes for p in parts[:-1]])
-    surface = Surface(x=np.vstack([p.surface.x for p in parts]),
-                      segments=np.vstack([p.surface.segments + o
-                                          for p, o in zip(parts, offsets, strict=True)]),
-                      normals=np.vstack([p.surface.normals for p in parts]),
-                      dofs=np.vstack([p.surface.dofs for p in parts]))
-    return GatheredSurface(surface, np.concatenate([p.owner for p in parts]),
-                           np.concatenate([p.gblock for p in parts]))
+    surface = Surface(
+        x=np.vstack([p.surface.x for p in parts]),
+        segments=np.vstack([p.surface.segments + o for p, o in zip(parts, offsets, strict=True)]),
+        normals=np.vstack([p.surface.normals for p in parts]),
+        dofs=np.vstack([p.surface.dofs for p in parts]),
+    )
+    return GatheredSurface(
+        surface, np.concatenate([p.owner for p in parts]), np.concatenate([p.gblock for p in parts])
+    )
 
 
 def stack(pairs: list[PairData]) -> tuple[GatheredSurface, ContactOperator, np.ndarray]:
     """The union of the active surfaces, the stacked operator and each row's pair index."""
     ops = [p.operator for p in pairs]
-    op = ops[0] if len(ops) == 1 else ContactOperator(
-        B=sp.vstack([o.B for o in ops]).tocsr(), gap=np.concatenate([o.gap for o in ops]),
-        weights=np.concatenate([o.weights for o in ops]))
-    pair_of_row = np.concatenate([np.full(p.active.surface.n_nodes, p.index, dtype=np.int64)
-                                  for p in pairs])
+    op = (
+        ops[0]
+        if len(ops) == 1
+        else ContactOperator(
+            B=sp.vstack([o.B for o in ops]).tocsr(),
+            gap=np.concatenate([o.gap for o in ops]),
+            weights=np.concatenate([o.weights for o in ops]),
+        )
+    )
+    pair_of_row = np.concatenate(
+        [np.full(p.active.surface.n_nodes, p.index, dtype=np.int64) for p in pairs]
+    )
     return union_surface([p.active for p in pairs]), op, pair_of_row

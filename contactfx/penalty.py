@@ -38,9 +38,16 @@ def default_penalty(scene: Scene, h: float) -> float:
     return DEFAULT_FACTOR * max(b.material.E for b in scene.bodies) / h
 
 
-def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.ndarray,
-           options: Mapping[str, object], condition: bool, check: bool = True
-           ) -> tuple[np.ndarray, dict[str, float]]:
+def _solve(
+    K: PETSc.Mat,
+    B: PETSc.Mat,
+    f: PETSc.Vec,
+    g: np.ndarray,
+    coef: np.ndarray,
+    options: Mapping[str, object],
+    condition: bool,
+    check: bool = True,
+) -> tuple[np.ndarray, dict[str, float]]:
     """Solve (K + B^T diag(coef) B) u = f - B^T diag(coef) g; coef = eps / w on active rows."""
     d = B.createVecLeft()
     d.array[:] = np.sqrt(coef)
@@ -50,8 +57,9 @@ def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.nda
     BA.transpose(BAT)
     A = BAT.matMult(BA)
     # The stub types the Structure values as int but the parameter as Structure.
-    A.axpy(1.0, K, structure=cast(PETSc.Mat.Structure,
-                                  PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN))
+    A.axpy(
+        1.0, K, structure=cast(PETSc.Mat.Structure, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    )
     rhs = f.copy()
     d.array[:] = -coef * g
     tmp = rhs.duplicate()
@@ -84,8 +92,10 @@ def _solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, coef: np.nda
             obj.destroy()
     info["converged"] = float(ok)
     if check and not ok:
-        raise SolverError(f"linear solve ({ksp_type}) did not converge: PETSc reason {reason} "
-                          f"({reason_name(reason)}) after {its} iterations")
+        raise SolverError(
+            f"linear solve ({ksp_type}) did not converge: PETSc reason {reason} "
+            f"({reason_name(reason)}) after {its} iterations"
+        )
     info["linear_iterations"] = its
     return u, info
 
@@ -96,8 +106,9 @@ class PenaltyIteration:
     label = "penalty active set"
     probing = False
 
-    def __init__(self, setup: ContactSetup, eps: float, options: Mapping[str, object],
-                 condition: bool) -> None:
+    def __init__(
+        self, setup: ContactSetup, eps: float, options: Mapping[str, object], condition: bool
+    ) -> None:
         self.setup, self.eps, self.options, self.condition = setup, eps, options, condition
         self.u = fem.Function(setup.elasticity.V, name="u")
 
@@ -105,33 +116,52 @@ class PenaltyIteration:
         """One penalty solve with `active` penalized."""
         setup, el = self.setup, self.setup.elasticity
         comm = setup.scene.comm
-        x, info = _solve(el.K, setup.B, el.f, setup.g,
-                         np.where(active, self.eps / setup.w, 0.0), self.options, self.condition)
+        x, info = _solve(
+            el.K,
+            setup.B,
+            el.f,
+            setup.g,
+            np.where(active, self.eps / setup.w, 0.0),
+            self.options,
+            self.condition,
+        )
         self.u.x.petsc_vec.array[:] = x
         self.u.x.scatter_forward()
         gap = setup.normalized_gap(self.u)
         pen = max(comm.allreduce(float(np.max(-gap, initial=0.0)), op=MPI.MAX), 0.0)
-        text = (f"max penetration {pen:.3e}, {int(info['linear_iterations'])} linear its, ")
+        text = f"max penetration {pen:.3e}, {int(info['linear_iterations'])} linear its, "
         # A penalty enforces g >= 0 only approximately: a node is in contact when its gap is
         # negative (penetration); there is no complementarity residual to check.
-        return Step(-self.eps * gap, gap, gap < 0.0, 0.0,
-                    {"penetration": pen, "penalty": self.eps, **info}, text)
+        return Step(
+            -self.eps * gap,
+            gap,
+            gap < 0.0,
+            0.0,
+            {"penetration": pen, "penalty": self.eps, **info},
+            text,
+        )
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
         """Always the plain update."""
         return None
 
 
-def solve_penalty(scene: Scene, penalty: float | None = None,
-                  solver: str | Mapping[str, object] = "mumps",
-                  aso: ActiveSetOptions | None = None, timers: Timers | None = None,
-                  condition: bool = False) -> Solution:
+def solve_penalty(
+    scene: Scene,
+    penalty: float | None = None,
+    solver: str | Mapping[str, object] = "mumps",
+    aso: ActiveSetOptions | None = None,
+    timers: Timers | None = None,
+    condition: bool = False,
+) -> Solution:
     """Solve the unilateral contact of `scene` by the penalty method on the mortar gap."""
     options = dict(SOLVERS[solver] if isinstance(solver, str) else solver)
     aso = aso or ActiveSetOptions()
     if uses_augmentation(options):
-        raise InputError("the penalty method has no multiplier block: use the mumps solver or "
-                         "single-field PETSc options, not a fieldsplit")
+        raise InputError(
+            "the penalty method has no multiplier block: use the mumps solver or "
+            "single-field PETSc options, not a fieldsplit"
+        )
     timers = timers or Timers()
     setup = prepare_contact(scene, Method.PENALTY.operator, aso.penetration_tol, timers)
     eps = default_penalty(scene, setup.h) if penalty is None else float(penalty)
@@ -140,8 +170,7 @@ def solve_penalty(scene: Scene, penalty: float | None = None,
     iteration = PenaltyIteration(setup, eps, options, condition)
     active = setup.initial_active(aso.penetration_tol * setup.h)
     step, active, history = run_active_set(setup, iteration, active, aso, timers)
-    return setup.solution(Method.PENALTY, iteration.u, step.lam, step.gap, active, history,
-                          timers)
+    return setup.solution(Method.PENALTY, iteration.u, step.lam, step.gap, active, history, timers)
 
 
 def penetration(sol: Solution) -> float:
@@ -149,21 +178,36 @@ def penetration(sol: Solution) -> float:
     return float(max(-sol.gap.min(initial=0.0), 0.0))
 
 
-def condition_estimate(sol: Solution, eps: float, max_it: int = 20000,
-                       rtol: float = 1e-10) -> dict[str, float]:
+def condition_estimate(
+    sol: Solution, eps: float, max_it: int = 20000, rtol: float = 1e-10
+) -> dict[str, float]:
     """CG + Jacobi on the converged penalty matrix: Lanczos condition estimate and iterations."""
     el = sol.elasticity
     V = el.V
-    B = petsc_constraint(V, sol.operator, sol.order, sol.layout,
-                         global_dirichlet_dofs(V, el.bc_dofs))
+    B = petsc_constraint(
+        V, sol.operator, sol.order, sol.layout, global_dirichlet_dofs(V, el.bc_dofs)
+    )
     mine = sol.layout.mine
     w, g = sol.layout.weights[mine], sol.operator.gap[sol.order][mine]
-    options = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": rtol, "ksp_max_it": max_it,
-               "ksp_norm_type": "unpreconditioned"}
+    options = {
+        "ksp_type": "cg",
+        "pc_type": "jacobi",
+        "ksp_rtol": rtol,
+        "ksp_max_it": max_it,
+        "ksp_norm_type": "unpreconditioned",
+    }
     try:
         # If CG stops at max_it the Lanczos estimate so far is a lower bound ("converged" 0).
-        _, info = _solve(el.K, B, el.f, g, np.where(sol.active[mine], eps / w, 0.0), options,
-                         condition=True, check=False)
+        _, info = _solve(
+            el.K,
+            B,
+            el.f,
+            g,
+            np.where(sol.active[mine], eps / w, 0.0),
+            options,
+            condition=True,
+            check=False,
+        )
     finally:
         B.destroy()
     return info

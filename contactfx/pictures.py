@@ -33,9 +33,18 @@ def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | N
     plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)  # type: ignore[arg-type]
     for col, (name, label) in enumerate((("u_y", "u_y (cm)"), ("sigma_yy", "sigma_yy (MPa)"))):
         plotter.subplot(0, col)
-        plotter.add_mesh(warped, scalars=name, cmap="turbo", show_edges=False,
-                         scalar_bar_args={"title": label, "vertical": True,
-                                          "position_x": 0.86, "position_y": 0.15})
+        plotter.add_mesh(
+            warped,
+            scalars=name,
+            cmap="turbo",
+            show_edges=False,
+            scalar_bar_args={
+                "title": label,
+                "vertical": True,
+                "position_x": 0.86,
+                "position_y": 0.15,
+            },
+        )
         plotter.add_text(f"{label}, deformation x{scale:g}", font_size=10)
         plotter.view_xy()  # type: ignore[call-arg]  # pyvista's functools.wraps confuses mypy
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -35,8 +35,9 @@ def nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np.
     f2v = msh.topology.connectivity(tdim - 1, 0).array.reshape(-1, 2)[facets]
     f2c = msh.topology.connectivity(tdim - 1, tdim)
     cells = f2c.array[f2c.offsets[facets]].astype(np.int32)
-    values = expr.eval(msh, cells).reshape(len(cells), 4, 2, 2) if len(cells) else \
-        np.zeros((0, 4, 2, 2))
+    values = (
+        expr.eval(msh, cells).reshape(len(cells), 4, 2, 2) if len(cells) else np.zeros((0, 4, 2, 2))
+    )
     c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)[cells]
     xv = vertex_coordinates(msh)
     v2b = vertex_to_block(el.V)
@@ -53,8 +54,10 @@ def nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np.
     gv = np.concatenate(comm.allgather(np.concatenate(vals)))
     uniq, first, inv = np.unique(gnode, return_index=True, return_inverse=True)
     count = np.bincount(inv.ravel())
-    avg = np.stack([np.bincount(inv.ravel(), weights=gv[:, i, j]) / count
-                    for i in range(2) for j in range(2)], axis=1).reshape(-1, 2, 2)
+    avg = np.stack(
+        [np.bincount(inv.ravel(), weights=gv[:, i, j]) / count for i in range(2) for j in range(2)],
+        axis=1,
+    ).reshape(-1, 2, 2)
     return uniq, gx[first], avg
 
 
@@ -69,8 +72,10 @@ def arc_length(surface: Surface) -> tuple[np.ndarray, np.ndarray]:
     seg = surface.segments
     s = np.full(surface.n_nodes, np.nan)
     t = np.zeros((surface.n_nodes, 2))
-    runs = [ch.order[st:st + ln] for st, ln in
-            sorted({(int(a), int(b)) for a, b in zip(ch.start, ch.length, strict=True)})]
+    runs = [
+        ch.order[st : st + ln]
+        for st, ln in sorted({(int(a), int(b)) for a, b in zip(ch.start, ch.length, strict=True)})
+    ]
     walks = []
     for run in runs:
         # Node sequence along the run, from the first segment's free end.
@@ -135,9 +140,17 @@ def pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     nn_a, nt_a = _resolve(sa, n, t)
     nn_p, nt_p = _resolve(sp, n, t)
     order = np.argsort(s_all[node], kind="stable")
-    cols = {"x": x[:, 0], "y": x[:, 1], "s": s_all[node], "pressure": sol.pressure[rows],
-            "gap": sol.gap[rows], "sigma_nn_active": nn_a, "sigma_nn_passive": nn_p,
-            "sigma_nt_active": nt_a, "sigma_nt_passive": nt_p}
+    cols = {
+        "x": x[:, 0],
+        "y": x[:, 1],
+        "s": s_all[node],
+        "pressure": sol.pressure[rows],
+        "gap": sol.gap[rows],
+        "sigma_nn_active": nn_a,
+        "sigma_nn_passive": nn_p,
+        "sigma_nt_active": nt_a,
+        "sigma_nt_passive": nt_p,
+    }
     out: dict[str, Any] = {key: _none_if_nan(np.asarray(v)[order]) for key, v in cols.items()}
     out["active"] = [bool(a) for a in sol.active[rows][order]]
     return out
@@ -160,17 +173,26 @@ def contacts_summary(sol: Solution) -> list[dict[str, Any]]:
     for k, pd in enumerate(sol.pairs):
         fa, fp = pair_forces(sol, k)
         rows = sol.rows_of(k)
-        out.append({"active": pd.pair.active, "passive": pd.pair.passive,
-                    "active_body": pd.active_body.name, "passive_body": pd.passive_body.name,
-                    "force": fa.tolist(), "force_passive": fp.tolist(),
-                    "balance": float(np.linalg.norm(fa + fp) / max(np.linalg.norm(fa), 1e-300)),
-                    "multipliers": len(rows), "active_nodes": int(sol.active[rows].sum()),
-                    "interface": pair_interface(sol, k)})
+        out.append(
+            {
+                "active": pd.pair.active,
+                "passive": pd.pair.passive,
+                "active_body": pd.active_body.name,
+                "passive_body": pd.passive_body.name,
+                "force": fa.tolist(),
+                "force_passive": fp.tolist(),
+                "balance": float(np.linalg.norm(fa + fp) / max(np.linalg.norm(fa), 1e-300)),
+                "multipliers": len(rows),
+                "active_nodes": int(sol.active[rows].sum()),
+                "interface": pair_interface(sol, k),
+            }
+        )
     return out
 
 
-def surface_stress(sol: Solution, group: str, component: tuple[int, int] = (1, 1)
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def surface_stress(
+    sol: Solution, group: str, component: tuple[int, int] = (1, 1)
+) -> tuple[np.ndarray, np.ndarray]:
     """(x, sigma_ij) at the nodes of curve group `group`, sorted by x (horizontal lines)."""
     _, x, sig = nodal_stress(sol, group)
     order = np.argsort(x[:, 0], kind="stable")
@@ -186,8 +208,10 @@ def cartesian_interface(sol: Solution) -> dict[str, list[float | None]]:
     x = np.asarray(itf["x"], dtype=float)
     order = np.argsort(x, kind="stable")
     pd = sol.pairs[0]
-    out: dict[str, list[float | None]] = {"x": x[order].tolist(),
-                                          "pressure": [itf["pressure"][i] for i in order]}
+    out: dict[str, list[float | None]] = {
+        "x": x[order].tolist(),
+        "pressure": [itf["pressure"][i] for i in order],
+    }
     rows = sol.rows_of(0)
     node = np.searchsorted(pd.active.gblock, sol.layout.gblock[rows])
     xm = pd.active.surface.x[node]
@@ -236,20 +260,21 @@ def _body_vertex_stress(sol: Solution) -> dict[str, np.ndarray]:
     for body in scene.bodies:
         cells = scene.cell_tags.find(scene.body_tag(body))
         cells = cells[cells < nloc].astype(np.int32)
-        out[body.name] = (expr.eval(msh, cells).reshape(-1, 2, 2) if cells.size
-                          else np.zeros((0, 2, 2)))
+        out[body.name] = (
+            expr.eval(msh, cells).reshape(-1, 2, 2) if cells.size else np.zeros((0, 2, 2))
+        )
     return out
 
 
-def body_stress_deviation(sol: Solution, target: float, component: tuple[int, int] = (1, 1)
-                          ) -> dict[str, float]:
+def body_stress_deviation(
+    sol: Solution, target: float, component: tuple[int, int] = (1, 1)
+) -> dict[str, float]:
     """Max |sigma_ij / target - 1| over every cell vertex of each body (the patch-test measure)."""
     comm = sol.scene.comm
     out = {}
     for name, vals in _body_vertex_stress(sol).items():
         v = vals[:, component[0], component[1]]
-        out[name] = comm.allreduce(float(np.max(np.abs(v / target - 1.0), initial=0.0)),
-                                   op=MPI.MAX)
+        out[name] = comm.allreduce(float(np.max(np.abs(v / target - 1.0), initial=0.0)), op=MPI.MAX)
     return out
 
 
@@ -263,8 +288,10 @@ def uniform_stress_errors(sol: Solution, ref: np.ndarray) -> dict[str, Any]:
     """Patch test against a uniform stress: max errors relative to the largest |ref_ij|."""
     comm = sol.scene.comm
     scale = float(np.abs(ref).max())
-    bodies = {name: comm.allreduce(float(np.max(np.abs(v - ref), initial=0.0)), op=MPI.MAX)
-              / scale for name, v in _body_vertex_stress(sol).items()}
+    bodies = {
+        name: comm.allreduce(float(np.max(np.abs(v - ref), initial=0.0)), op=MPI.MAX) / scale
+        for name, v in _body_vertex_stress(sol).items()
+    }
     pairs = []
     for k, pd in enumerate(sol.pairs):
         itf = pair_interface(sol, k)
@@ -275,9 +302,22 @@ def uniform_stress_errors(sol: Solution, ref: np.ndarray) -> dict[str, Any]:
         order = np.argsort(arc_length(pd.active.surface)[0][node], kind="stable")
         nn, nt = _resolve(np.broadcast_to(ref, (len(n), 2, 2)), n[order], t[order])
 
-        pairs.append({"pressure": _max_error(itf["pressure"], -nn, scale),
-                      **{key: _max_error(itf[key], exact, scale)
-                         for key, exact in (("sigma_nn_active", nn), ("sigma_nn_passive", nn),
-                                            ("sigma_nt_active", nt), ("sigma_nt_passive", nt))}})
-    return {"bodies": bodies, "pairs": pairs,
-            "max": max([*bodies.values(), *(v for p in pairs for v in p.values())])}
+        pairs.append(
+            {
+                "pressure": _max_error(itf["pressure"], -nn, scale),
+                **{
+                    key: _max_error(itf[key], exact, scale)
+                    for key, exact in (
+                        ("sigma_nn_active", nn),
+                        ("sigma_nn_passive", nn),
+                        ("sigma_nt_active", nt),
+                        ("sigma_nt_passive", nt),
+                    )
+                },
+            }
+        )
+    return {
+        "bodies": bodies,
+        "pairs": pairs,
+        "max": max([*bodies.values(), *(v for p in pairs for v in p.values())]),
+    }

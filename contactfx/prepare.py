@@ -41,13 +41,13 @@ class ContactSetup:
     scene: Scene
     elasticity: Elasticity
     pairs: list[PairData]
-    operator: ContactOperator      # stacked over the pairs
+    operator: ContactOperator  # stacked over the pairs
     layout: Multipliers
     order: np.ndarray
     B: PETSc.Mat
-    g: np.ndarray              # weighted gaps of the rows owned here
-    w: np.ndarray              # weights of the rows owned here
-    h: float                   # median contact weight (about the contact element size)
+    g: np.ndarray  # weighted gaps of the rows owned here
+    w: np.ndarray  # weights of the rows owned here
+    h: float  # median contact weight (about the contact element size)
     needs_contact: list[Body]  # bodies whose supports alone leave a rigid mode free
 
     def normalized_gap(self, u: fem.Function) -> np.ndarray:
@@ -79,23 +79,43 @@ class ContactSetup:
         if n_active == 0 and self.needs_contact:
             raise SingularSystemError(
                 f"body '{self.needs_contact[0].name}' is not held by its supports alone and no "
-                "node is in contact (empty active set): the load pulls the bodies apart")
+                "node is in contact (empty active set): the load pulls the bodies apart"
+            )
 
-    def solution(self, method: Method, u: fem.Function, pressure: np.ndarray, gap: np.ndarray,
-                 active: np.ndarray, history: list[dict[str, float]], timers: Timers
-                 ) -> Solution:
+    def solution(
+        self,
+        method: Method,
+        u: fem.Function,
+        pressure: np.ndarray,
+        gap: np.ndarray,
+        active: np.ndarray,
+        history: list[dict[str, float]],
+        timers: Timers,
+    ) -> Solution:
         """Gather the owned rows into a Solution (and free B)."""
         comm = self.scene.comm
         self.B.destroy()
-        return Solution(self.scene, method, self.elasticity, u, self.layout,
-                        pressure=gather_all(comm, np.where(active, pressure, 0.0)),
-                        gap=gather_all(comm, gap), active=gather_all(comm, active),
-                        operator=self.operator, order=self.order, pairs=self.pairs,
-                        iterations=len(history), history=history, timers=timers)
+        return Solution(
+            self.scene,
+            method,
+            self.elasticity,
+            u,
+            self.layout,
+            pressure=gather_all(comm, np.where(active, pressure, 0.0)),
+            gap=gather_all(comm, gap),
+            active=gather_all(comm, active),
+            operator=self.operator,
+            order=self.order,
+            pairs=self.pairs,
+            iterations=len(history),
+            history=history,
+            timers=timers,
+        )
 
 
-def assemble_and_gather(scene: Scene, timers: Timers) -> tuple[Elasticity, int, list[
-        tuple[ContactPair, Body, Body, GatheredSurface, GatheredSurface]]]:
+def assemble_and_gather(
+    scene: Scene, timers: Timers
+) -> tuple[Elasticity, int, list[tuple[ContactPair, Body, Body, GatheredSurface, GatheredSurface]]]:
     """Assemble K and f, and gather both surfaces of every contact pair."""
     with timers("assemble"):
         el = assemble_elasticity(scene)
@@ -106,8 +126,9 @@ def assemble_and_gather(scene: Scene, timers: Timers) -> tuple[Elasticity, int, 
     return el, ndofs, gathered
 
 
-def prescribed_gap_shift(scene: Scene, el: Elasticity, op: ContactOperator,
-                         surface_dofs: np.ndarray) -> np.ndarray:
+def prescribed_gap_shift(
+    scene: Scene, el: Elasticity, op: ContactOperator, surface_dofs: np.ndarray
+) -> np.ndarray:
     """B[:, D] u_D: the weighted gap that nonzero prescribed displacements add.
 
     B's Dirichlet columns are removed (K has identity rows there), so a prescribed value on a
@@ -127,13 +148,15 @@ def prescribed_gap_shift(scene: Scene, el: Elasticity, op: ContactOperator,
     vals = np.zeros(len(dofs))
     vals[mine] = ub.x.array[2 * blocks[mine] + dofs[mine] % 2]
     V.mesh.comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.SUM)
-    ud = sp.csc_matrix((vals, (dofs, np.zeros(len(dofs), dtype=np.int64))),
-                       shape=(op.B.shape[1], 1))
+    ud = sp.csc_matrix(
+        (vals, (dofs, np.zeros(len(dofs), dtype=np.int64))), shape=(op.B.shape[1], 1)
+    )
     return np.asarray((op.B @ ud).todense()).ravel()
 
 
-def prepare_contact(scene: Scene, method: str, penetration_tol: float, timers: Timers,
-                    **kernel_options: object) -> ContactSetup:
+def prepare_contact(
+    scene: Scene, method: str, penetration_tol: float, timers: Timers, **kernel_options: object
+) -> ContactSetup:
     """Assemble K and f, build every pair's operator and B, and check the geometry."""
     comm = scene.comm
     el, ndofs, gathered = assemble_and_gather(scene, timers)
@@ -143,18 +166,25 @@ def prepare_contact(scene: Scene, method: str, penetration_tol: float, timers: T
         for p in pairs:
             tol = 1e-12 * max(float(p.operator.weights.max(initial=0.0)), 1e-300)
             if not np.any(p.operator.weights > tol):
-                raise GeometryError(f"contact pair {p.index}: the active surface "
-                                    f"'{p.pair.active}' does not overlap the passive surface "
-                                    f"'{p.pair.passive}'")
+                raise GeometryError(
+                    f"contact pair {p.index}: the active surface "
+                    f"'{p.pair.active}' does not overlap the passive surface "
+                    f"'{p.pair.passive}'"
+                )
             check_facing(p.active.surface, p.passive.surface, p.operator, p.label)
         active_union, op, pair_of_row = stack(pairs)
-        shift = prescribed_gap_shift(scene, el, op, np.vstack([active_union.surface.dofs]
-                                                       + [p.passive.surface.dofs for p in pairs]))
+        shift = prescribed_gap_shift(
+            scene,
+            el,
+            op,
+            np.vstack([active_union.surface.dofs] + [p.passive.surface.dofs for p in pairs]),
+        )
         if np.any(shift):
             op = ContactOperator(op.B, op.gap + shift, op.weights)
         dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
-        layout, order = multiplier_layout(comm, active_union, op, pair_of_row,
-                                          constrained_rows(op, dirichlet))
+        layout, order = multiplier_layout(
+            comm, active_union, op, pair_of_row, constrained_rows(op, dirichlet)
+        )
         B = petsc_constraint(V, op, order, layout, dirichlet)
     w_all = layout.weights
     g_all = op.gap[order] / w_all
@@ -168,12 +198,16 @@ def prepare_contact(scene: Scene, method: str, penetration_tol: float, timers: T
         rows = np.flatnonzero(layout.pair == p.index)
         j = rows[int(np.argmin(g_all[rows]))]
         if g_all[j] < -penetration_tol * h:
-            raise GeometryError(f"bodies '{p.active_body.name}' and '{p.passive_body.name}' "
-                                f"overlap: initial penetration {-g_all[j]:.3e} at ("
-                                f"{layout.x[j, 0]:.4g}, {layout.x[j, 1]:.4g}) exceeds the "
-                                f"tolerance {penetration_tol * h:.1e}")
-    needs_contact = check_held(scene, V, el.bc_dofs,
-                               [(p.active_body, p.passive_body, p.active) for p in pairs])
+            raise GeometryError(
+                f"bodies '{p.active_body.name}' and '{p.passive_body.name}' "
+                f"overlap: initial penetration {-g_all[j]:.3e} at ("
+                f"{layout.x[j, 0]:.4g}, {layout.x[j, 1]:.4g}) exceeds the "
+                f"tolerance {penetration_tol * h:.1e}"
+            )
+    needs_contact = check_held(
+        scene, V, el.bc_dofs, [(p.active_body, p.passive_body, p.active) for p in pairs]
+    )
     mine = layout.mine
-    return ContactSetup(scene, el, pairs, op, layout, order, B, op.gap[order][mine],
-                        w_all[mine], h, needs_contact)
+    return ContactSetup(
+        scene, el, pairs, op, layout, order, B, op.gap[order][mine], w_all[mine], h, needs_contact
+    )

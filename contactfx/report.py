@@ -14,8 +14,7 @@ from .solution import Solution
 
 def reference_results(sol: Solution) -> dict[str, Any]:
     """Errors against each analytic reference the scene carries (keys `hertz`, `patch`)."""
-    hertz = [hertz_summary(sol, r) for r in sol.scene.references
-             if isinstance(r, HertzReference)]
+    hertz = [hertz_summary(sol, r) for r in sol.scene.references if isinstance(r, HertzReference)]
     out: dict[str, Any] = {}
     if hertz:
         out["hertz"] = hertz[0]
@@ -23,13 +22,16 @@ def reference_results(sol: Solution) -> dict[str, Any]:
             out["hertz_pairs"] = hertz
     for r in sol.scene.references:
         if isinstance(r, UniformStress):
-            out["patch"] = {"sigma": [list(row) for row in r.sigma],
-                            **uniform_stress_errors(sol, np.asarray(r.sigma, dtype=float))}
+            out["patch"] = {
+                "sigma": [list(row) for row in r.sigma],
+                **uniform_stress_errors(sol, np.asarray(r.sigma, dtype=float)),
+            }
     return out
 
 
-def summary(sol: Solution, times: dict[str, float], extra: dict[str, Any] | None = None
-            ) -> dict[str, Any]:
+def summary(
+    sol: Solution, times: dict[str, float], extra: dict[str, Any] | None = None
+) -> dict[str, Any]:
     """The JSON-ready summary of a run (schema in README)."""
     scene = sol.scene
     V = sol.elasticity.V

@@ -49,11 +49,11 @@ _FLAT_TOL = 1e-10
 class SchwarzOptions:
     """Controls of the Dirichlet-Neumann iteration."""
 
-    relaxation: float = 0.5   # fixed relaxation, and the first step of Aitken's
-    aitken: bool = True       # Aitken's dynamic relaxation after the first iteration
-    tol: float = 1e-8         # relative change of interface displacement and traction
+    relaxation: float = 0.5  # fixed relaxation, and the first step of Aitken's
+    aitken: bool = True  # Aitken's dynamic relaxation after the first iteration
+    tol: float = 1e-8  # relative change of interface displacement and traction
     max_iterations: int = 100
-    divergence: float = 1e8   # stop early once the residual grew by this factor
+    divergence: float = 1e8  # stop early once the residual grew by this factor
 
 
 class _BodySolver:
@@ -138,8 +138,10 @@ def _check_flat(s1: GatheredSurface, s2: GatheredSurface) -> None:
     for gs, sg in ((s1, sign), (s2, -sign)):
         ny = gs.surface.normals[:, 1]
         if sg == 0.0 or np.any(np.abs(sg * ny - 1.0) > _FLAT_TOL):
-            raise InputError("schwarz supports one straight horizontal contact line in full "
-                             "contact (it iterates on u_y): use nts, sts or mortar here")
+            raise InputError(
+                "schwarz supports one straight horizontal contact line in full "
+                "contact (it iterates on u_y): use nts, sts or mortar here"
+            )
 
 
 def _norm(D: sp.csr_matrix, v: np.ndarray) -> float:
@@ -154,17 +156,20 @@ def _failed(history: list[dict[str, float | None]], message: str) -> Convergence
     return err
 
 
-def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
-                  timers: Timers | None = None) -> Solution:
+def solve_schwarz(
+    scene: Scene, options: SchwarzOptions = SchwarzOptions(), timers: Timers | None = None
+) -> Solution:
     """Solve a two-body full-contact scene by the relaxed Dirichlet-Neumann iteration.
 
     Body N (held by its supports) takes Neumann data, body D (held only by the contact)
     Dirichlet data; the contact line must be straight, horizontal and closed everywhere.
     """
     if len(scene.bodies) != 2 or len(scene.contacts) != 1:
-        raise InputError(f"schwarz supports two bodies with one contact pair (this scene has "
-                         f"{len(scene.bodies)} bodies and {len(scene.contacts)} pairs): use "
-                         "nts, sts or mortar")
+        raise InputError(
+            f"schwarz supports two bodies with one contact pair (this scene has "
+            f"{len(scene.bodies)} bodies and {len(scene.contacts)} pairs): use "
+            "nts, sts or mortar"
+        )
     if not 0.0 < options.relaxation <= 2.0:
         raise InputError(f"relaxation must lie in (0, 2] (got {options.relaxation})")
     timers = timers or Timers()
@@ -174,9 +179,11 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
     pair, body_a, body_p, surf_act, surf_pas = gathered[0]
     loose = check_held(scene, V, el.bc_dofs, [(body_a, body_p, surf_act)])
     if len(loose) != 1:
-        raise InputError("schwarz needs one body held by its supports and one held only by "
-                         f"the contact ({'both are' if loose else 'neither is'} free): use "
-                         "nts, sts or mortar")
+        raise InputError(
+            "schwarz needs one body held by its supports and one held only by "
+            f"the contact ({'both are' if loose else 'neither is'} free): use "
+            "nts, sts or mortar"
+        )
     dirichlet_body = loose[0]
     # surf1/surf2: the Neumann and the Dirichlet body's contact surfaces.
     if dirichlet_body == body_a:
@@ -190,8 +197,9 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         D_all, M_all = mortar_matrices(surf2.surface, surf1.surface)
         keep = np.flatnonzero(op2.weights > 1e-12 * max(float(op2.weights.max(initial=0)), 1e-300))
         if keep.size == 0:
-            raise GeometryError(f"the contact surfaces '{pair.active}' and '{pair.passive}' do "
-                                "not overlap")
+            raise GeometryError(
+                f"the contact surfaces '{pair.active}' and '{pair.passive}' do not overlap"
+            )
         D = D_all[keep][:, keep].tocsc()
         M = M_all[keep].tocsr()
         D_lu = spla.splu(D)
@@ -199,8 +207,10 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         wgap = D @ y2[keep] - M @ y1
         h = float(np.median(op2.weights[keep]))
         if np.max(np.abs(wgap / op2.weights[keep])) > 1e-6 * h:
-            raise InputError("schwarz supports full-contact scenes only: the bodies do not "
-                             "touch along the whole contact line (non-zero initial gap)")
+            raise InputError(
+                "schwarz supports full-contact scenes only: the bodies do not "
+                "touch along the whole contact line (non-zero initial gap)"
+            )
         # The reported multipliers live on the pair's active body, as for the other methods.
         if dirichlet_body == body_a:
             surf_a, op = surf2, op2
@@ -212,9 +222,11 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
     nodes1, nodes2 = _OwnedNodes(surf1, V), _OwnedNodes(surf2, V)
     dofs = [body_dofs(el, scene, b) for b in bodies]
     if comm.allreduce(int(np.intersect1d(dofs[0], dofs[1]).size)):
-        raise MeshError(f"bodies '{bodies[0].name}' and '{bodies[1].name}' share nodes: contact "
-                        "needs duplicated interface nodes")
-    pos_d, dof_d = nodes2.dofs(keep)          # B2 Dirichlet dofs (u_y), owned here
+        raise MeshError(
+            f"bodies '{bodies[0].name}' and '{bodies[1].name}' share nodes: contact "
+            "needs duplicated interface nodes"
+        )
+    pos_d, dof_d = nodes2.dofs(keep)  # B2 Dirichlet dofs (u_y), owned here
     pos_n, dof_n = nodes1.dofs(np.arange(nodes1.n))  # B1 Neumann dofs (f_y), owned here
 
     u = fem.Function(V, name="u")
@@ -234,7 +246,7 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         tmp.restoreSubVector(iss[1], sub)
         solver1 = _BodySolver(el.K, iss[0], None)
         solver2 = _BodySolver(el.K, iss[1], rows2)
-    d = np.zeros(keep.size)          # B2's interface u_y, the iterated quantity
+    d = np.zeros(keep.size)  # B2's interface u_y, the iterated quantity
     lam_prev = None
     r_prev, omega = None, options.relaxation
     r_first = None
@@ -263,32 +275,52 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
             target = D_lu.solve(M @ u1 - wgap)
             r = target - d
             e_u = _norm(D, r) / max(_norm(D, target), 1e-300)
-            e_t = (np.inf if lam_prev is None else
-                   _norm(D, lam - lam_prev) / max(_norm(D, lam), 1e-300))
+            e_t = (
+                np.inf
+                if lam_prev is None
+                else _norm(D, lam - lam_prev) / max(_norm(D, lam), 1e-300)
+            )
             if it > 1 and options.aitken:
                 dr = r - r_prev
                 omega = -omega * float(r_prev @ (D @ dr)) / max(float(dr @ (D @ dr)), 1e-300)
-            history.append({"iteration": it, "residual": e_u,
-                            "traction_change": None if lam_prev is None else e_t,
-                            "relaxation": omega, "solve_time": time.perf_counter() - t0})
+            history.append(
+                {
+                    "iteration": it,
+                    "residual": e_u,
+                    "traction_change": None if lam_prev is None else e_t,
+                    "relaxation": omega,
+                    "solve_time": time.perf_counter() - t0,
+                }
+            )
             if comm.rank == 0:
-                log.info("schwarz %3d: interface residual %.3e, traction change %.3e, "
-                         "relaxation %.4f", it, e_u, e_t, omega)
+                log.info(
+                    "schwarz %3d: interface residual %.3e, traction change %.3e, relaxation %.4f",
+                    it,
+                    e_u,
+                    e_t,
+                    omega,
+                )
             r_abs = _norm(D, r)
             r_first = r_first or max(r_abs, 1e-300)
             if max(e_u, e_t) < options.tol:
                 break
             if not np.isfinite(r_abs) or r_abs > options.divergence * r_first:
-                raise _failed(history, f"schwarz iteration diverged at iteration {it}: "
-                              f"interface residual grew by {r_abs / r_first:.1e} (relaxation "
-                              f"{omega:.3g}, Aitken {'on' if options.aitken else 'off'})")
+                raise _failed(
+                    history,
+                    f"schwarz iteration diverged at iteration {it}: "
+                    f"interface residual grew by {r_abs / r_first:.1e} (relaxation "
+                    f"{omega:.3g}, Aitken {'on' if options.aitken else 'off'})",
+                )
             d = d + omega * r
             r_prev, lam_prev = r, lam
         else:
-            raise _failed(history, f"schwarz iteration did not converge in "
-                          f"{options.max_iterations} iterations: interface residual {e_u:.2e}, "
-                          f"traction change {e_t:.2e} > tol {options.tol:.0e} (relaxation "
-                          f"{omega:.3g}, Aitken {'on' if options.aitken else 'off'})")
+            raise _failed(
+                history,
+                f"schwarz iteration did not converge in "
+                f"{options.max_iterations} iterations: interface residual {e_u:.2e}, "
+                f"traction change {e_t:.2e} > tol {options.tol:.0e} (relaxation "
+                f"{omega:.3g}, Aitken {'on' if options.aitken else 'off'})",
+            )
     finally:
         solver1.destroy()
         solver2.destroy()
@@ -296,8 +328,11 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
             obj.destroy()
     u.x.scatter_forward()
     if comm.rank == 0:
-        log.info("schwarz converged in %d iterations, %.3f s", len(history),
-                 time.perf_counter() - t_solve)
+        log.info(
+            "schwarz converged in %d iterations, %.3f s",
+            len(history),
+            time.perf_counter() - t_solve,
+        )
 
     lam2 = np.zeros(surf2.surface.n_nodes)
     lam2[keep] = lam
@@ -310,8 +345,11 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
         pressure = spla.spsolve(Da[order][:, order].tocsc(), force[order])
         pressure = np.atleast_1d(pressure)
     if np.any(pressure < -1e-8 * np.abs(pressure).max(initial=0.0)) and comm.rank == 0:
-        log.warning("schwarz: tensile contact traction (min %.3g MPa): the full-contact "
-                    "assumption does not hold for this scene", pressure.min())
+        log.warning(
+            "schwarz: tensile contact traction (min %.3g MPa): the full-contact "
+            "assumption does not hold for this scene",
+            pressure.min(),
+        )
     # Gap at the solution through the reported operator (both components of both surfaces).
     ufull = np.zeros(ndofs)
     for gs, nodes in ((surf1, nodes1), (surf2, nodes2)):
@@ -319,8 +357,25 @@ def solve_schwarz(scene: Scene, options: SchwarzOptions = SchwarzOptions(),
             ufull[gs.surface.dofs[:, comp]] = nodes.read(u.x.array, comp)
     gap = (op.gap + op.B @ ufull)[order] / layout.weights
     pd = PairData(0, pair, body_a, body_p, surf_act, surf_pas, op, 0)
-    return Solution(scene, Method.SCHWARZ, el, u, layout, pressure=pressure, gap=gap,
-                    active=np.ones(layout.size, dtype=bool), operator=op, order=order,
-                    pairs=[pd], iterations=len(history), history=history, timers=timers,
-                    info={"schwarz": {"dirichlet_body": dirichlet_body.name,
-                                      "solver": "mumps (each body factorized once)"}})
+    return Solution(
+        scene,
+        Method.SCHWARZ,
+        el,
+        u,
+        layout,
+        pressure=pressure,
+        gap=gap,
+        active=np.ones(layout.size, dtype=bool),
+        operator=op,
+        order=order,
+        pairs=[pd],
+        iterations=len(history),
+        history=history,
+        timers=timers,
+        info={
+            "schwarz": {
+                "dirichlet_body": dirichlet_body.name,
+                "solver": "mumps (each body factorized once)",
+            }
+        },
+    )

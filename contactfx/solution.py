@@ -26,11 +26,11 @@ class Solution:
     elasticity: Elasticity
     u: fem.Function
     layout: Multipliers
-    pressure: np.ndarray       # (n,) contact traction per multiplier node, compression > 0
-    gap: np.ndarray            # (n,) normalized gap (weighted gap / weight) at the solution
-    active: np.ndarray         # (n,) bool, converged active set
+    pressure: np.ndarray  # (n,) contact traction per multiplier node, compression > 0
+    gap: np.ndarray  # (n,) normalized gap (weighted gap / weight) at the solution
+    active: np.ndarray  # (n,) bool, converged active set
     operator: ContactOperator  # stacked over the pairs (rows: active-surface nodes)
-    order: np.ndarray          # layout row i is row order[i] of `operator`
+    order: np.ndarray  # layout row i is row order[i] of `operator`
     pairs: list[PairData]
     iterations: int
     # One record per iteration; Schwarz records hold None where a value is undefined.

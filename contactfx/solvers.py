@@ -85,7 +85,8 @@ _PRESETS["condensed"] = {
 
 # Read-only: a caller that wants to change a preset copies it (dict(SOLVERS[name])).
 SOLVERS: Mapping[str, Mapping[str, object]] = MappingProxyType(
-    {name: MappingProxyType(opts) for name, opts in _PRESETS.items()})
+    {name: MappingProxyType(opts) for name, opts in _PRESETS.items()}
+)
 
 _counter = itertools.count()
 

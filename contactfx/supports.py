@@ -42,8 +42,9 @@ def _modes(x: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
     return out
 
 
-def _body_frames(scene: Scene, V: fem.FunctionSpace) -> tuple[list[np.ndarray],
-                                                               np.ndarray, np.ndarray]:
+def _body_frames(
+    scene: Scene, V: fem.FunctionSpace
+) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
     """Owned blocks of each body, and each body's centroid and size (global)."""
     comm = scene.comm
     nloc = V.dofmap.index_map.size_local
@@ -55,10 +56,12 @@ def _body_frames(scene: Scene, V: fem.FunctionSpace) -> tuple[list[np.ndarray],
         owned.append(b)
         n = comm.allreduce(len(b))
         c = np.array([comm.allreduce(float(x[b, d].sum())) for d in (0, 1)]) / max(n, 1)
-        lo = np.array([comm.allreduce(float(x[b, d].min(initial=np.inf)), op=_min())
-                       for d in (0, 1)])
-        hi = np.array([comm.allreduce(float(x[b, d].max(initial=-np.inf)), op=_max())
-                       for d in (0, 1)])
+        lo = np.array(
+            [comm.allreduce(float(x[b, d].min(initial=np.inf)), op=_min()) for d in (0, 1)]
+        )
+        hi = np.array(
+            [comm.allreduce(float(x[b, d].max(initial=-np.inf)), op=_max()) for d in (0, 1)]
+        )
         centres.append(c)
         sizes.append(max(float(np.max(hi - lo)), 1e-300))
     return owned, np.array(centres), np.array(sizes)
@@ -76,9 +79,14 @@ def _max() -> MPI.Op:
     return MPI.MAX
 
 
-def _dirichlet_rows(scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray,
-                    owned: list[np.ndarray], centres: np.ndarray, sizes: np.ndarray
-                    ) -> np.ndarray:
+def _dirichlet_rows(
+    scene: Scene,
+    V: fem.FunctionSpace,
+    bc_dofs: np.ndarray,
+    owned: list[np.ndarray],
+    centres: np.ndarray,
+    sizes: np.ndarray,
+) -> np.ndarray:
     """One row per owned Dirichlet dof (all ranks' rows gathered): the modes it fixes."""
     nloc = V.dofmap.index_map.size_local
     x = V.tabulate_dof_coordinates()[:nloc, :2]
@@ -91,14 +99,15 @@ def _dirichlet_rows(scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray,
             continue
         m = _modes(x[here // 2], centres[k], sizes[k])
         r = np.zeros((len(here), 3 * nb))
-        r[:, 3 * k:3 * k + 3] = m[np.arange(len(here)), here % 2]
+        r[:, 3 * k : 3 * k + 3] = m[np.arange(len(here)), here % 2]
         rows.append(r)
     local = np.vstack(rows) if rows else np.zeros((0, 3 * nb))
     return np.vstack(scene.comm.allgather(local))
 
 
-def _contact_rows(scene: Scene, pairs: list[Contact], centres: np.ndarray, sizes: np.ndarray
-                  ) -> np.ndarray:
+def _contact_rows(
+    scene: Scene, pairs: list[Contact], centres: np.ndarray, sizes: np.ndarray
+) -> np.ndarray:
     """Rows n . (m_active - m_passive) at the active nodes of every pair (gathered data)."""
     index = {b.name: k for k, b in enumerate(scene.bodies)}
     rows = []
@@ -107,8 +116,8 @@ def _contact_rows(scene: Scene, pairs: list[Contact], centres: np.ndarray, sizes
         n = nodal_normals(surf)
         a, q = index[active_body.name], index[passive_body.name]
         r = np.zeros((surf.n_nodes, 3 * len(scene.bodies)))
-        r[:, 3 * a:3 * a + 3] = np.einsum("nd,ndm->nm", n, _modes(surf.x, centres[a], sizes[a]))
-        r[:, 3 * q:3 * q + 3] -= np.einsum("nd,ndm->nm", n, _modes(surf.x, centres[q], sizes[q]))
+        r[:, 3 * a : 3 * a + 3] = np.einsum("nd,ndm->nm", n, _modes(surf.x, centres[a], sizes[a]))
+        r[:, 3 * q : 3 * q + 3] -= np.einsum("nd,ndm->nm", n, _modes(surf.x, centres[q], sizes[q]))
         rows.append(r)
     return np.vstack(rows)
 
@@ -135,8 +144,9 @@ def _describe(mode: np.ndarray) -> str:
     return f"translation along ({d[0]:.3g}, {d[1]:.3g})"
 
 
-def check_held(scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray,
-               pairs: list[Contact]) -> list[Body]:
+def check_held(
+    scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray, pairs: list[Contact]
+) -> list[Body]:
     """Raise SingularSystemError if a body can move freely; return those needing contact."""
     owned, centres, sizes = _body_frames(scene, V)
     nb = len(scene.bodies)
@@ -145,10 +155,14 @@ def check_held(scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray,
     free = _free_modes(np.vstack([rows_d, _contact_rows(scene, pairs, centres, sizes)]), 3 * nb)
     if free.shape[0]:
         mode = free[0]
-        k = int(np.argmax([np.linalg.norm(mode[3 * i:3 * i + 3]) for i in range(nb)]))
+        k = int(np.argmax([np.linalg.norm(mode[3 * i : 3 * i + 3]) for i in range(nb)]))
         raise SingularSystemError(
             f"body '{scene.bodies[k].name}' can still move freely after its supports and "
-            f"contacts ({_describe(mode[3 * k:3 * k + 3])}): add a [[dirichlet]] support or a "
-            "contact pair that holds it")
-    return [b for k, b in enumerate(scene.bodies)
-            if free_d.size and np.abs(free_d[:, 3 * k:3 * k + 3]).max() > 1e-6]
+            f"contacts ({_describe(mode[3 * k : 3 * k + 3])}): add a [[dirichlet]] support or a "
+            "contact pair that holds it"
+        )
+    return [
+        b
+        for k, b in enumerate(scene.bodies)
+        if free_d.size and np.abs(free_d[:, 3 * k : 3 * k + 3]).max() > 1e-6
+    ]

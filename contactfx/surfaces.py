@@ -30,8 +30,11 @@ def vertex_to_block(V: fem.FunctionSpace) -> np.ndarray:
     msh.topology.create_connectivity(tdim, 0)
     c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
     ncells = c2v.shape[0]
-    v2b = np.full(msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts,
-                  -1, dtype=np.int32)
+    v2b = np.full(
+        msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts,
+        -1,
+        dtype=np.int32,
+    )
     # For Q1 the dofs of a cell are listed in the order of its vertices.
     v2b[c2v.ravel()] = V.dofmap.list[:ncells].ravel()
     return v2b
@@ -87,8 +90,12 @@ def gather_surface(scene: Scene, V: fem.FunctionSpace, name: str) -> GatheredSur
     uniq, first, inverse = np.unique(gb, return_index=True, return_inverse=True)
     segments = inverse.reshape(-1, 2)
     x = coords[first]
-    surface = Surface(x=x, segments=segments.astype(np.int64), normals=allrows[:, 4:6].copy(),
-                      dofs=np.column_stack([2 * uniq, 2 * uniq + 1]).astype(np.int64))
+    surface = Surface(
+        x=x,
+        segments=segments.astype(np.int64),
+        normals=allrows[:, 4:6].copy(),
+        dofs=np.column_stack([2 * uniq, 2 * uniq + 1]).astype(np.int64),
+    )
     return GatheredSurface(surface, own[first], uniq)
 
 
@@ -121,6 +128,8 @@ def check_facing(active: Surface, passive: Surface, op: ContactOperator, label: 
         j = int(np.argmax(dot))
         xa = active.x[near[j]]
         angle = np.degrees(np.arccos(min(dot[j], 1.0)))
-        raise GeometryError(f"the contact surfaces{label} do not face each other: at ({xa[0]:.4g}, "
-                            f"{xa[1]:.4g}) the outward normals of the active and passive "
-                            f"surfaces make an angle of {angle:.0f} degrees (180 expected)")
+        raise GeometryError(
+            f"the contact surfaces{label} do not face each other: at ({xa[0]:.4g}, "
+            f"{xa[1]:.4g}) the outward normals of the active and passive "
+            f"surfaces make an angle of {angle:.0f} degrees (180 expected)"
+        )

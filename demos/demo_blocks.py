@@ -62,27 +62,34 @@ def say(*args: object) -> None:
 rows = []
 t0 = time.perf_counter()
 for name, params in BLOCK_SCENES.items():
-    for active in ((2,) if name == "S1" else (2, 1)):
+    for active in (2,) if name == "S1" else (2, 1):
         for method in METHODS:
             sol, data = run_case("blocks", params, method, active=active, comm=comm)
             corner = params.l2 / 2
-            row = {"scene": name, "method": method.value, "active": active,
-                   "multipliers": data["multipliers"], "dofs": data["dofs"],
-                   "contact_force": data["contact_force"],
-                   "force_error": abs(data["contact_force"] / (params.p * params.l2 / 2) - 1),
-                   "time": data["times"]["total"], **{
-                       f"mismatch_{k}": v
-                       for k, v in mismatch(data["interface"], corner).items()}}
+            row = {
+                "scene": name,
+                "method": method.value,
+                "active": active,
+                "multipliers": data["multipliers"],
+                "dofs": data["dofs"],
+                "contact_force": data["contact_force"],
+                "force_error": abs(data["contact_force"] / (params.p * params.l2 / 2) - 1),
+                "time": data["times"]["total"],
+                **{f"mismatch_{k}": v for k, v in mismatch(data["interface"], corner).items()},
+            }
             if name == "S4":
                 dev = body_stress_deviation(sol, -params.p)
-                row.update({f"patch_{k}": v for k, v in patch_errors(data["interface"],
-                                                                     params.p).items()})
+                row.update(
+                    {f"patch_{k}": v for k, v in patch_errors(data["interface"], params.p).items()}
+                )
                 row.update({f"patch_field_{k}": v for k, v in dev.items()})
             row["interface"] = data["interface"]
             rows.append(row)
-            say(f"{name} {method.value:7s} active={active}: force error "
+            say(
+                f"{name} {method.value:7s} active={active}: force error "
                 f"{row['force_error']:.1e}, mismatch centre {row['mismatch_center']:.3g} MPa, "
-                f"corner {row['mismatch_corner']:.3g} MPa ({row['time']:.2f} s)")
+                f"corner {row['mismatch_corner']:.3g} MPa ({row['time']:.2f} s)"
+            )
             if method == Method.MORTAR and active == 2:
                 pic = deformed_fields(sol, OUT / f"{name}_fields.png")
                 if pic:
@@ -100,11 +107,13 @@ if comm.rank == 0:
     OUT.mkdir(parents=True, exist_ok=True)
     for name, params in BLOCK_SCENES.items():
         actives = (2,) if name == "S1" else (2, 1)
-        fig, axes = plt.subplots(1, len(actives), figsize=(6.5 * len(actives), 4.2),
-                                 squeeze=False, layout="constrained")
+        fig, axes = plt.subplots(
+            1, len(actives), figsize=(6.5 * len(actives), 4.2), squeeze=False, layout="constrained"
+        )
         for ax, active in zip(axes[0], actives, strict=True):
-            for k, row in enumerate(r for r in rows if r["scene"] == name
-                                    and r["active"] == active):
+            for k, row in enumerate(
+                r for r in rows if r["scene"] == name and r["active"] == active
+            ):
                 itf = row["interface"]
                 x = np.asarray(itf["x"])
                 for key, style in (("sigma_yy_1", "-"), ("sigma_yy_2", "--")):
@@ -112,8 +121,16 @@ if comm.rank == 0:
                     if name == "S4":
                         # The exact state is uniform: plot the relative error on a log axis.
                         y = np.maximum(np.abs(y / params.p + 1), 1e-16)
-                    ax.plot(x, y, style, color=f"C{k}", lw=1.2, marker=".", ms=3,
-                            label=f"{row['method']} body {key[-1]}")
+                    ax.plot(
+                        x,
+                        y,
+                        style,
+                        color=f"C{k}",
+                        lw=1.2,
+                        marker=".",
+                        ms=3,
+                        label=f"{row['method']} body {key[-1]}",
+                    )
             ax.set_title(f"{name}: sigma_yy on the contact line, body {active} active")
             ax.set_xlabel("x (cm)")
             ax.set_ylabel("sigma_yy (MPa)")
@@ -137,19 +154,27 @@ if comm.rank == 0:
 
 # +
 if comm.rank == 0:
-    header = ("| scene | method | active | mismatch centre (MPa) | mismatch corner (MPa) | "
-              "S4: body 1 | S4: body 2 | S4: pressure | time (s) |")
+    header = (
+        "| scene | method | active | mismatch centre (MPa) | mismatch corner (MPa) | "
+        "S4: body 1 | S4: body 2 | S4: pressure | time (s) |"
+    )
     lines = [header, "|" + "---|" * 9]
     for r in rows:
-        patch = [f"{r[k]:.1e}" if k in r else "" for k in
-                 ("patch_field_body1", "patch_field_body2", "patch_pressure")]
-        lines.append(f"| {r['scene']} | {r['method']} | {r['active']} | "
-                     f"{r['mismatch_center']:.3g} | {r['mismatch_corner']:.3g} | "
-                     + " | ".join(patch) + f" | {r['time']:.2f} |")
+        patch = [
+            f"{r[k]:.1e}" if k in r else ""
+            for k in ("patch_field_body1", "patch_field_body2", "patch_pressure")
+        ]
+        lines.append(
+            f"| {r['scene']} | {r['method']} | {r['active']} | "
+            f"{r['mismatch_center']:.3g} | {r['mismatch_corner']:.3g} | "
+            + " | ".join(patch)
+            + f" | {r['time']:.2f} |"
+        )
     table = "\n".join(lines)
     (OUT / "table.md").write_text(table + "\n")
-    (OUT / "summary.json").write_text(json.dumps(
-        [{k: v for k, v in r.items() if k != "interface"} for r in rows], indent=1))
+    (OUT / "summary.json").write_text(
+        json.dumps([{k: v for k, v in r.items() if k != "interface"} for r in rows], indent=1)
+    )
     print(table)
 # -
 

@@ -136,11 +136,15 @@ for method in METHODS:
     _, data = run_scene(scene, method)
     results[method] = data
     for h, c in zip(data["hertz_pairs"], data["contacts"], strict=True):
-        say(f"{method:8s} pair {h['pair']}: a {100 * (h['a'] / h['a_exact'] - 1):+6.2f} %, "
+        say(
+            f"{method:8s} pair {h['pair']}: a {100 * (h['a'] / h['a_exact'] - 1):+6.2f} %, "
             f"p0 {100 * (h['p0'] / h['p0_exact'] - 1):+6.2f} %, L2 {100 * h['l2_error']:5.2f} %, "
-            f"force {c['force'][1]:+.8g}, balance {c['balance']:.1e}")
-    say(f"{method:8s} {data['dofs']} dofs, {data['iterations']} active-set iterations, "
-        f"{time.perf_counter() - t0:.2f} s")
+            f"force {c['force'][1]:+.8g}, balance {c['balance']:.1e}"
+        )
+    say(
+        f"{method:8s} {data['dofs']} dofs, {data['iterations']} active-set iterations, "
+        f"{time.perf_counter() - t0:.2f} s"
+    )
 # -
 
 # ## The pressure of both pairs against Hertz
@@ -152,8 +156,14 @@ if comm.rank == 0:
         h = results["mortar"]["hertz_pairs"][k]
         a, p0 = h["a_exact"], h["p0_exact"]
         r = np.linspace(0.0, 1.6 * a, 300)
-        ax.plot(r, p0 * np.sqrt(np.clip(1 - (r / a) ** 2, 0, None)), "k-", lw=2, alpha=0.4,
-                label="exact plane-strain Hertz")
+        ax.plot(
+            r,
+            p0 * np.sqrt(np.clip(1 - (r / a) ** 2, 0, None)),
+            "k-",
+            lw=2,
+            alpha=0.4,
+            label="exact plane-strain Hertz",
+        )
         for method, style in zip(METHODS, ("o", "s", ".-", "x"), strict=True):
             itf = results[method]["contacts"][k]["interface"]
             x = np.asarray(itf["x"])

@@ -89,23 +89,34 @@ for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
         sol = solve_penalty(scene, eps)
         du = comm.allreduce(float(np.abs(sol.u.x.array - u_ref).max()), op=MPI.MAX)
         cond = condition_estimate(sol, eps, max_it=CG_MAX_IT)
-        row = {"scene": name, "factor": factor, "eps": eps, "penetration": penetration(sol),
-               "pressure_error_vs_mortar": float(np.max(np.abs(sol.pressure - ref.pressure))
-                                                 / p_scale),
-               "u_error_vs_mortar": du / u_scale,
-               "active": int(sol.active.sum()), "active_mortar": int(ref.active.sum()),
-               "iterations": sol.iterations, "condition": cond.get("condition", np.nan),
-               "cg_iterations": cond["linear_iterations"], "cg_converged": cond["converged"],
-               "p_max": float(sol.pressure.max())}
+        row = {
+            "scene": name,
+            "factor": factor,
+            "eps": eps,
+            "penetration": penetration(sol),
+            "pressure_error_vs_mortar": float(
+                np.max(np.abs(sol.pressure - ref.pressure)) / p_scale
+            ),
+            "u_error_vs_mortar": du / u_scale,
+            "active": int(sol.active.sum()),
+            "active_mortar": int(ref.active.sum()),
+            "iterations": sol.iterations,
+            "condition": cond.get("condition", np.nan),
+            "cg_iterations": cond["linear_iterations"],
+            "cg_converged": cond["converged"],
+            "p_max": float(sol.pressure.max()),
+        }
         if kind == "hertz":
             row["l2_error_vs_exact"] = hertz_summary(sol)["l2_error"]
             row["l2_error_mortar"] = ref_l2
         rows.append(row)
-        say(f"{name:5s} eps = {factor:7.0e} E/h = {eps:9.3e} MPa/cm: penetration "
+        say(
+            f"{name:5s} eps = {factor:7.0e} E/h = {eps:9.3e} MPa/cm: penetration "
             f"{row['penetration']:.2e} cm, pressure error vs mortar "
             f"{row['pressure_error_vs_mortar']:.2e}, u error {row['u_error_vs_mortar']:.2e}"
             + (f", L2 vs Hertz {row['l2_error_vs_exact']:.4f}" if kind == "hertz" else "")
-            + f", cond {row['condition']:.2e}, CG its {row['cg_iterations']}")
+            + f", cond {row['condition']:.2e}, CG its {row['cg_iterations']}"
+        )
 say(f"{len(rows)} penalty solves in {time.perf_counter() - t0:.1f} s")
 # -
 
@@ -121,25 +132,45 @@ if comm.rank == 0:
     for ax, name in zip(axes, ("S3", "Hertz"), strict=True):
         rs = [r for r in rows if r["scene"] == name]
         f = np.array([r["factor"] for r in rs])
-        ax.loglog(f, [r["penetration"] for r in rs], "o-", color="C0",
-                  label="penetration (cm)")
-        ax.loglog(f, [r["pressure_error_vs_mortar"] for r in rs], "s-", color="C1",
-                  label="max |p - p_mortar| / p_ref")
-        ax.loglog(f, [r["u_error_vs_mortar"] for r in rs], "^-", color="C2",
-                  label="max |u - u_mortar| / max |u|")
+        ax.loglog(f, [r["penetration"] for r in rs], "o-", color="C0", label="penetration (cm)")
+        ax.loglog(
+            f,
+            [r["pressure_error_vs_mortar"] for r in rs],
+            "s-",
+            color="C1",
+            label="max |p - p_mortar| / p_ref",
+        )
+        ax.loglog(
+            f,
+            [r["u_error_vs_mortar"] for r in rs],
+            "^-",
+            color="C2",
+            label="max |u - u_mortar| / max |u|",
+        )
         if name == "Hertz":
-            ax.loglog(f, [r["l2_error_vs_exact"] for r in rs], "D-", color="C3",
-                      label="L2 error of p vs exact Hertz")
-            ax.axhline(rs[0]["l2_error_mortar"], color="C3", ls=":", lw=1,
-                       label="mortar L2 error vs exact")
+            ax.loglog(
+                f,
+                [r["l2_error_vs_exact"] for r in rs],
+                "D-",
+                color="C3",
+                label="L2 error of p vs exact Hertz",
+            )
+            ax.axhline(
+                rs[0]["l2_error_mortar"], color="C3", ls=":", lw=1, label="mortar L2 error vs exact"
+            )
         ax.axvline(DEFAULT_FACTOR, color="k", ls=":", lw=1)
         ax.set_xlabel("eps / (E_max / h)")
         ax.set_ylabel("penetration (cm), relative error (-)")
         ax.grid(alpha=0.3, which="both")
         tw = ax.twinx()
         ok = [r for r in rs if r["cg_converged"] and r["factor"] <= COND_MAX_FACTOR]
-        tw.loglog([r["factor"] for r in ok], [r["condition"] for r in ok], "k--", marker="x",
-                  label="condition estimate (Jacobi-CG)")
+        tw.loglog(
+            [r["factor"] for r in ok],
+            [r["condition"] for r in ok],
+            "k--",
+            marker="x",
+            label="condition estimate (Jacobi-CG)",
+        )
         tw.set_ylabel("condition estimate of D^-1 (K + eps B^T W^-1 B)")
         h1, l1 = ax.get_legend_handles_labels()
         h2, l2 = tw.get_legend_handles_labels()
@@ -148,14 +179,19 @@ if comm.rank == 0:
         ax.set_title(f"{name}: penalty sweep (E_max/h = {eu:.3g} MPa/cm)")
     fig.savefig(OUT / "penalty_sweep.png", dpi=110)
     plt.close(fig)
-    lines = ["| scene | eps/(E/h) | eps (MPa/cm) | penetration (cm) | p error vs mortar | "
-             "u error vs mortar | L2 vs Hertz | condition | CG its |", "|" + "---|" * 9]
+    lines = [
+        "| scene | eps/(E/h) | eps (MPa/cm) | penetration (cm) | p error vs mortar | "
+        "u error vs mortar | L2 vs Hertz | condition | CG its |",
+        "|" + "---|" * 9,
+    ]
     for r in rows:
         l2 = f"{r['l2_error_vs_exact']:.4f}" if "l2_error_vs_exact" in r else ""
         its = f"{r['cg_iterations']}" + ("" if r["cg_converged"] else " (not converged)")
-        lines.append(f"| {r['scene']} | {r['factor']:.0e} | {r['eps']:.2e} | "
-                     f"{r['penetration']:.2e} | {r['pressure_error_vs_mortar']:.2e} | "
-                     f"{r['u_error_vs_mortar']:.2e} | {l2} | {r['condition']:.2e} | {its} |")
+        lines.append(
+            f"| {r['scene']} | {r['factor']:.0e} | {r['eps']:.2e} | "
+            f"{r['penetration']:.2e} | {r['pressure_error_vs_mortar']:.2e} | "
+            f"{r['u_error_vs_mortar']:.2e} | {l2} | {r['condition']:.2e} | {its} |"
+        )
     (OUT / "table.md").write_text("\n".join(lines) + "\n")
     (OUT / "summary.json").write_text(json.dumps(rows, indent=1))
     print("\n".join(lines))

@@ -61,8 +61,10 @@ def say(*args: object) -> None:
 
 
 def interface_arrays(data: dict) -> dict[str, np.ndarray]:
-    return {k: np.array([np.nan if v is None else v for v in data["interface"][k]], dtype=float)
-            for k in ("x", "pressure", "sigma_yy_1", "sigma_yy_2")}
+    return {
+        k: np.array([np.nan if v is None else v for v in data["interface"][k]], dtype=float)
+        for k in ("x", "pressure", "sigma_yy_1", "sigma_yy_2")
+    }
 
 
 # -
@@ -87,9 +89,11 @@ for name, params in BLOCK_SCENES.items():
             entry = {"history": err.history, "converged": False, "error": str(err)}
         runs[name][label] = entry
         last = entry["history"][-1]
-        say(f"{name} {label:22s}: {len(entry['history']):3d} iterations, "
+        say(
+            f"{name} {label:22s}: {len(entry['history']):3d} iterations, "
             f"{'converged' if entry['converged'] else 'FAILED'}, "
-            f"last residual {last['residual']:.2e}")
+            f"last residual {last['residual']:.2e}"
+        )
 # -
 
 # ## Interface residual against the iterations
@@ -101,8 +105,12 @@ for name, params in BLOCK_SCENES.items():
 if comm.rank == 0:
     OUT.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharey=True, layout="constrained")
-    notes = {"S1": "same material", "S2": "same material, non-matching",
-             "S3": "base 10x stiffer", "S4": "patch test"}
+    notes = {
+        "S1": "same material",
+        "S2": "same material, non-matching",
+        "S3": "base 10x stiffer",
+        "S4": "patch test",
+    }
     for ax, name in zip(axes.ravel(), BLOCK_SCENES, strict=True):
         for k, label in enumerate(SETTINGS):
             hist = runs[name][label]["history"]
@@ -135,26 +143,49 @@ for k in levels:
     params = replace(BLOCK_SCENES["S2"], size1=0.08 / k, size2=0.1 / k)
     _, mortar = run_case("blocks", params, Method.MORTAR, comm=comm)
     sol, schwarz = run_case("blocks", params, Method.SCHWARZ, comm=comm)
-    sweep.append({"refine": k, "dofs": schwarz["dofs"], "iterations": schwarz["iterations"],
-                  "schwarz_solve": schwarz["times"]["solve"],
-                  "schwarz_factorize": sol.timers.seconds["factorize"],
-                  "schwarz_total": schwarz["times"]["total"],
-                  "mortar_solve": mortar["times"]["solve"],
-                  "mortar_total": mortar["times"]["total"]})
-    say(f"S2 / {k}: {schwarz['dofs']} dofs, {schwarz['iterations']} iterations, Schwarz "
-        f"{sweep[-1]['schwarz_solve']:.3f} s vs mortar {sweep[-1]['mortar_solve']:.3f} s")
+    sweep.append(
+        {
+            "refine": k,
+            "dofs": schwarz["dofs"],
+            "iterations": schwarz["iterations"],
+            "schwarz_solve": schwarz["times"]["solve"],
+            "schwarz_factorize": sol.timers.seconds["factorize"],
+            "schwarz_total": schwarz["times"]["total"],
+            "mortar_solve": mortar["times"]["solve"],
+            "mortar_total": mortar["times"]["total"],
+        }
+    )
+    say(
+        f"S2 / {k}: {schwarz['dofs']} dofs, {schwarz['iterations']} iterations, Schwarz "
+        f"{sweep[-1]['schwarz_solve']:.3f} s vs mortar {sweep[-1]['mortar_solve']:.3f} s"
+    )
 
 if comm.rank == 0:
     fig, ax = plt.subplots(figsize=(6.5, 4.5), layout="constrained")
     dofs = [r["dofs"] for r in sweep]
     ax.loglog(dofs, [r["mortar_solve"] for r in sweep], "s-", label="mortar LM: saddle solve")
-    ax.loglog(dofs, [r["schwarz_solve"] for r in sweep], "o-",
-              label="Schwarz (Aitken): factorizations + iterations")
-    ax.loglog(dofs, [r["schwarz_factorize"] for r in sweep], "o--", color="C1", alpha=0.6,
-              label="Schwarz: the two factorizations alone")
+    ax.loglog(
+        dofs,
+        [r["schwarz_solve"] for r in sweep],
+        "o-",
+        label="Schwarz (Aitken): factorizations + iterations",
+    )
+    ax.loglog(
+        dofs,
+        [r["schwarz_factorize"] for r in sweep],
+        "o--",
+        color="C1",
+        alpha=0.6,
+        label="Schwarz: the two factorizations alone",
+    )
     for r in sweep:
-        ax.annotate(f"{r['iterations']} it", (r["dofs"], r["schwarz_solve"]),
-                    textcoords="offset points", xytext=(4, -12), fontsize=8)
+        ax.annotate(
+            f"{r['iterations']} it",
+            (r["dofs"], r["schwarz_solve"]),
+            textcoords="offset points",
+            xytext=(4, -12),
+            fontsize=8,
+        )
     ax.set_xlabel("degrees of freedom")
     ax.set_ylabel("wall time (s)")
     ax.set_title(f"S2 refined: solve time on {comm.size} rank(s)")
@@ -177,35 +208,59 @@ for name, params in BLOCK_SCENES.items():
     r = runs[name]
     ait = r["Aitken, omega_0 = 0.5"]["data"]
     a, m = interface_arrays(ait), interface_arrays(r["mortar"])
-    diff = max(float(np.nanmax(np.abs(a[k] - m[k]))) for k in ("pressure", "sigma_yy_1",
-                                                                   "sigma_yy_2")) / params.p
-    rows.append({"scene": name, "dofs": ait["dofs"], "multipliers": ait["multipliers"],
-                 **{label: (len(r[label]["history"]) if r[label]["converged"] else None)
-                    for label in SETTINGS},
-                 "schwarz_solve": ait["times"]["solve"], "schwarz_total": ait["times"]["total"],
-                 "mortar_solve": r["mortar"]["times"]["solve"],
-                 "mortar_total": r["mortar"]["times"]["total"], "diff_vs_mortar": diff,
-                 "patch": r["Aitken, omega_0 = 0.5"]["patch"]})
+    diff = (
+        max(float(np.nanmax(np.abs(a[k] - m[k]))) for k in ("pressure", "sigma_yy_1", "sigma_yy_2"))
+        / params.p
+    )
+    rows.append(
+        {
+            "scene": name,
+            "dofs": ait["dofs"],
+            "multipliers": ait["multipliers"],
+            **{
+                label: (len(r[label]["history"]) if r[label]["converged"] else None)
+                for label in SETTINGS
+            },
+            "schwarz_solve": ait["times"]["solve"],
+            "schwarz_total": ait["times"]["total"],
+            "mortar_solve": r["mortar"]["times"]["solve"],
+            "mortar_total": r["mortar"]["times"]["total"],
+            "diff_vs_mortar": diff,
+            "patch": r["Aitken, omega_0 = 0.5"]["patch"],
+        }
+    )
 if comm.rank == 0:
-    lines = ["| scene | dofs | Aitken | fixed 0.5 | fixed 1 | Schwarz solve (s) | "
-             "mortar solve (s) | Schwarz total (s) | mortar total (s) | max diff / p |",
-             "|" + "---|" * 10]
+    lines = [
+        "| scene | dofs | Aitken | fixed 0.5 | fixed 1 | Schwarz solve (s) | "
+        "mortar solve (s) | Schwarz total (s) | mortar total (s) | max diff / p |",
+        "|" + "---|" * 10,
+    ]
     for row in rows:
         its = [str(row[label]) if row[label] else "-" for label in SETTINGS]
-        lines.append(f"| {row['scene']} | {row['dofs']} | " + " | ".join(its)
-                     + f" | {row['schwarz_solve']:.3f} | {row['mortar_solve']:.3f} | "
-                     f"{row['schwarz_total']:.3f} | {row['mortar_total']:.3f} | "
-                     f"{row['diff_vs_mortar']:.1e} |")
-    lines += ["", "| S2 refined | dofs | iterations | Schwarz solve (s) | factorizations (s) | "
-              "mortar solve (s) |", "|" + "---|" * 6]
+        lines.append(
+            f"| {row['scene']} | {row['dofs']} | "
+            + " | ".join(its)
+            + f" | {row['schwarz_solve']:.3f} | {row['mortar_solve']:.3f} | "
+            f"{row['schwarz_total']:.3f} | {row['mortar_total']:.3f} | "
+            f"{row['diff_vs_mortar']:.1e} |"
+        )
+    lines += [
+        "",
+        "| S2 refined | dofs | iterations | Schwarz solve (s) | factorizations (s) | "
+        "mortar solve (s) |",
+        "|" + "---|" * 6,
+    ]
     for s in sweep:
-        lines.append(f"| /{s['refine']} | {s['dofs']} | {s['iterations']} | "
-                     f"{s['schwarz_solve']:.3f} | {s['schwarz_factorize']:.3f} | "
-                     f"{s['mortar_solve']:.3f} |")
+        lines.append(
+            f"| /{s['refine']} | {s['dofs']} | {s['iterations']} | "
+            f"{s['schwarz_solve']:.3f} | {s['schwarz_factorize']:.3f} | "
+            f"{s['mortar_solve']:.3f} |"
+        )
     table = "\n".join(lines)
     (OUT / "table.md").write_text(table + "\n")
-    (OUT / "summary.json").write_text(json.dumps({"ranks": comm.size, "scenes": rows,
-                                                  "refinement": sweep}, indent=1))
+    (OUT / "summary.json").write_text(
+        json.dumps({"ranks": comm.size, "scenes": rows, "refinement": sweep}, indent=1)
+    )
     print(table)
 # -
 

@@ -81,17 +81,27 @@ for num, den in RATIOS:
     h_act, h_pas = (H_BIG, H_BIG / r) if r >= 1 else (H_BIG * r, H_BIG)
     for e_ratio in E_RATIOS:
         for side in SIDES:
-            sizes = {"size2": h_act, "size1": h_pas} if side == 2 else \
-                {"size1": h_act, "size2": h_pas}
+            sizes = (
+                {"size2": h_act, "size1": h_pas} if side == 2 else {"size1": h_act, "size2": h_pas}
+            )
             params = replace(S4, E1=e_ratio * S4.E2, **sizes)
             scene = build_scene("blocks", params, active=side, comm=comm)
             for method in METHODS:
                 sol = solve(scene, method)
                 dev = body_stress_deviation(sol, -params.p)
                 err = patch_errors(interface(sol), params.p)
-                rows.append({"ratio": f"{num}/{den}", "r": r, "E1/E2": e_ratio, "active": side,
-                             "method": method.value, "body1": dev["body1"],
-                             "body2": dev["body2"], "pressure": err["pressure"]})
+                rows.append(
+                    {
+                        "ratio": f"{num}/{den}",
+                        "r": r,
+                        "E1/E2": e_ratio,
+                        "active": side,
+                        "method": method.value,
+                        "body1": dev["body1"],
+                        "body2": dev["body2"],
+                        "pressure": err["pressure"],
+                    }
+                )
 say(f"patch-test sweep: {len(rows)} solves in {time.perf_counter() - t0:.1f} s")
 # -
 
@@ -117,16 +127,27 @@ def grid(method: str, measure) -> np.ndarray:
 
 
 def heatmaps(measure, title: str, path: Path) -> None:
-    fig, axes = plt.subplots(1, len(METHODS), figsize=(4.2 * len(METHODS) + 1.5,
-                                                       1.0 + 0.45 * len(row_keys) + 1.2),
-                             layout="constrained", sharey=True)
+    fig, axes = plt.subplots(
+        1,
+        len(METHODS),
+        figsize=(4.2 * len(METHODS) + 1.5, 1.0 + 0.45 * len(row_keys) + 1.2),
+        layout="constrained",
+        sharey=True,
+    )
     norm = LogNorm(vmin=FLOOR, vmax=1.0)
     for ax, method in zip(np.atleast_1d(axes), METHODS, strict=True):
         data = grid(method.value, measure)
         im = ax.imshow(data, norm=norm, cmap="viridis", aspect="auto")
         for (i, j), v in np.ndenumerate(data):
-            ax.text(j, i, f"{np.log10(v):.0f}", ha="center", va="center", fontsize=7,
-                    color="w" if v < 1e-6 else "k")
+            ax.text(
+                j,
+                i,
+                f"{np.log10(v):.0f}",
+                ha="center",
+                va="center",
+                fontsize=7,
+                color="w" if v < 1e-6 else "k",
+            )
         ax.set_xticks(range(len(cols)), cols)
         ax.set_yticks(range(len(labels)), labels)
         ax.set_xlabel("element size ratio active / passive")
@@ -139,22 +160,33 @@ def heatmaps(measure, title: str, path: Path) -> None:
 
 if comm.rank == 0:
     OUT.mkdir(parents=True, exist_ok=True)
-    heatmaps(lambda r: max(r["body1"], r["body2"]), "max |sigma_yy/p + 1| over both bodies",
-             OUT / "patch_stress.png")
+    heatmaps(
+        lambda r: max(r["body1"], r["body2"]),
+        "max |sigma_yy/p + 1| over both bodies",
+        OUT / "patch_stress.png",
+    )
     heatmaps(lambda r: r["pressure"], "max |pressure/p - 1|", OUT / "patch_pressure.png")
-    lines = ["| method | active | E1/E2 | ratio | body 1 | body 2 | pressure |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| method | active | E1/E2 | ratio | body 1 | body 2 | pressure |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        lines.append(f"| {r['method']} | {r['active']} | {r['E1/E2']:g} | {r['ratio']} | "
-                     f"{r['body1']:.1e} | {r['body2']:.1e} | {r['pressure']:.1e} |")
+        lines.append(
+            f"| {r['method']} | {r['active']} | {r['E1/E2']:g} | {r['ratio']} | "
+            f"{r['body1']:.1e} | {r['body2']:.1e} | {r['pressure']:.1e} |"
+        )
     (OUT / "patch_table.md").write_text("\n".join(lines) + "\n")
     (OUT / "patch.json").write_text(json.dumps(rows, indent=1))
     for m in METHODS:
-        worst = max((r for r in rows if r["method"] == m.value),
-                    key=lambda r: max(r["body1"], r["body2"], r["pressure"]))
-        say(f"{m.value:8s} worst case: ratio {worst['ratio']}, E1/E2 {worst['E1/E2']:g}, "
+        worst = max(
+            (r for r in rows if r["method"] == m.value),
+            key=lambda r: max(r["body1"], r["body2"], r["pressure"]),
+        )
+        say(
+            f"{m.value:8s} worst case: ratio {worst['ratio']}, E1/E2 {worst['E1/E2']:g}, "
             f"B{worst['active']} active: body1 {worst['body1']:.1e}, body2 "
-            f"{worst['body2']:.1e}, pressure {worst['pressure']:.1e}")
+            f"{worst['body2']:.1e}, pressure {worst['pressure']:.1e}"
+        )
 # -
 
 # ## Oscillations near the corner singularity under refinement
@@ -168,6 +200,7 @@ if comm.rank == 0:
 # $O(h^2 |v''|)$ there, which shrinks under refinement; a node-to-node oscillation does not.
 # Also reported: the S2 measure of the paper, the mismatch $|\sigma^{(1)}_{yy} -
 # \sigma^{(2)}_{yy}|$ in the last 10 % of the contact line.
+
 
 # +
 def zigzag(x: np.ndarray, v: np.ndarray, lo: float, hi: float) -> float:
@@ -193,37 +226,61 @@ for name in OSC_SCENES:
                 sol = solve(scene, method)
                 order = np.argsort(sol.layout.x[:, 0])
                 xp, pp = sol.layout.x[order, 0], sol.pressure[order]
-                row = {"scene": name, "active": side, "level": level, "h2": params.size2,
-                       "method": method.value,
-                       "pressure": zigzag(xp, pp, 0.7 * xc, 0.95 * xc) / base.p}
+                row = {
+                    "scene": name,
+                    "active": side,
+                    "level": level,
+                    "h2": params.size2,
+                    "method": method.value,
+                    "pressure": zigzag(xp, pp, 0.7 * xc, 0.95 * xc) / base.p,
+                }
                 for body in (1, 2):
                     xs, s = surface_stress(sol, f"contact{body}")
                     row[f"sigma_yy_{body}"] = zigzag(xs, s, 0.7 * xc, 0.95 * xc) / base.p
                 row["mismatch_corner"] = mismatch(interface(sol), xc)["corner"] / base.p
                 osc.append(row)
-            say(f"{name} B{side} active, h2 = {params.size2:.3f}: " + ", ".join(
-                f"{r['method']} {r['pressure']:.1e}" for r in osc[-len(METHODS):]))
+            say(
+                f"{name} B{side} active, h2 = {params.size2:.3f}: "
+                + ", ".join(f"{r['method']} {r['pressure']:.1e}" for r in osc[-len(METHODS) :])
+            )
 say(f"oscillation study: {len(osc)} solves in {time.perf_counter() - t0:.1f} s")
 
 if comm.rank == 0:
-    keys = [("pressure", "pressure (multiplier / penalty traction)"),
-            ("sigma_yy_1", "sigma_yy of body 1 (base)"), ("sigma_yy_2", "sigma_yy of body 2"),
-            ("mismatch_corner", "|sigma_yy1 - sigma_yy2|, last 10 % (max, not zig-zag)")]
-    fig, axes = plt.subplots(len(OSC_SCENES), len(keys), figsize=(4.2 * len(keys),
-                             3.6 * len(OSC_SCENES)), squeeze=False, layout="constrained")
+    keys = [
+        ("pressure", "pressure (multiplier / penalty traction)"),
+        ("sigma_yy_1", "sigma_yy of body 1 (base)"),
+        ("sigma_yy_2", "sigma_yy of body 2"),
+        ("mismatch_corner", "|sigma_yy1 - sigma_yy2|, last 10 % (max, not zig-zag)"),
+    ]
+    fig, axes = plt.subplots(
+        len(OSC_SCENES),
+        len(keys),
+        figsize=(4.2 * len(keys), 3.6 * len(OSC_SCENES)),
+        squeeze=False,
+        layout="constrained",
+    )
     for i, name in enumerate(OSC_SCENES):
         for j, (key, title) in enumerate(keys):
             ax = axes[i, j]
             for k, m in enumerate(METHODS):
                 for side, style in zip(SIDES, ("-", "--"), strict=False):
-                    rs = [r for r in osc if r["scene"] == name and r["method"] == m.value
-                          and r["active"] == side]
+                    rs = [
+                        r
+                        for r in osc
+                        if r["scene"] == name and r["method"] == m.value and r["active"] == side
+                    ]
                     # The penalty curve lies on the mortar one: thinner, with crosses, on top.
                     thin = m == Method.PENALTY
-                    ax.loglog([r["h2"] for r in rs], [max(r[key], FLOOR) for r in rs],
-                              style, marker="x" if thin else "o", lw=0.8 if thin else 1.6,
-                              ms=7 if thin else 4, color=f"C{k}",
-                              label=f"{m.value}, B{side} act.")
+                    ax.loglog(
+                        [r["h2"] for r in rs],
+                        [max(r[key], FLOOR) for r in rs],
+                        style,
+                        marker="x" if thin else "o",
+                        lw=0.8 if thin else 1.6,
+                        ms=7 if thin else 4,
+                        color=f"C{k}",
+                        label=f"{m.value}, B{side} act.",
+                    )
             h2s = sorted({r["h2"] for r in osc})
             ax.set_xticks(h2s, [f"{h:g}" for h in h2s])
             ax.minorticks_off()
@@ -232,25 +289,40 @@ if comm.rank == 0:
             ax.set_title(f"{name}: {title}", fontsize=9)
             ax.grid(alpha=0.3, which="both")
     axes[0, 0].legend(fontsize=7)
-    fig.suptitle("Node-to-node oscillation near the corner (0.7 x_c .. 0.95 x_c) under "
-                 "refinement")
+    fig.suptitle("Node-to-node oscillation near the corner (0.7 x_c .. 0.95 x_c) under refinement")
     fig.savefig(OUT / "corner_oscillation.png", dpi=110)
     plt.close(fig)
     (OUT / "oscillation.json").write_text(json.dumps(osc, indent=1))
-    lines = ["| scene | active | method | " + " | ".join(f"h2={r:.3g}" for r in
-             sorted({o['h2'] for o in osc}, reverse=True)) + " |"]
+    lines = [
+        "| scene | active | method | "
+        + " | ".join(f"h2={r:.3g}" for r in sorted({o["h2"] for o in osc}, reverse=True))
+        + " |"
+    ]
     lines.append("|" + "---|" * (3 + len(LEVELS)))
     for name in OSC_SCENES:
         for side in SIDES:
             for m in METHODS:
-                rs = sorted((r for r in osc if r["scene"] == name and r["active"] == side
-                             and r["method"] == m.value), key=lambda r: -r["h2"])
-                lines.append(f"| {name} | {side} | {m.value} | " + " | ".join(
-                    f"{r['pressure']:.1e} / {r['sigma_yy_1']:.1e} / {r['sigma_yy_2']:.1e}"
-                    for r in rs) + " |")
+                rs = sorted(
+                    (
+                        r
+                        for r in osc
+                        if r["scene"] == name and r["active"] == side and r["method"] == m.value
+                    ),
+                    key=lambda r: -r["h2"],
+                )
+                lines.append(
+                    f"| {name} | {side} | {m.value} | "
+                    + " | ".join(
+                        f"{r['pressure']:.1e} / {r['sigma_yy_1']:.1e} / {r['sigma_yy_2']:.1e}"
+                        for r in rs
+                    )
+                    + " |"
+                )
     (OUT / "oscillation_table.md").write_text(
         "Zig-zag amplitude / p: pressure / sigma_yy body 1 / sigma_yy body 2\n\n"
-        + "\n".join(lines) + "\n")
+        + "\n".join(lines)
+        + "\n"
+    )
     print("\n".join(lines))
 # -
 
@@ -265,11 +337,12 @@ if comm.rank == 0:
 for r in rows:
     if r["method"] in ("mortar", "penalty"):
         assert max(r["body1"], r["body2"], r["pressure"]) < 1e-8, r
-nts_worst = max(max(r["body1"], r["body2"], r["pressure"]) for r in rows
-                if r["method"] == "nts")
+nts_worst = max(max(r["body1"], r["body2"], r["pressure"]) for r in rows if r["method"] == "nts")
 assert nts_worst > 1e-3, nts_worst
 for name in OSC_SCENES:
-    rs = sorted((r for r in osc if r["scene"] == name and r["method"] == "mortar"
-                 and r["active"] == 2), key=lambda r: -r["h2"])
+    rs = sorted(
+        (r for r in osc if r["scene"] == name and r["method"] == "mortar" and r["active"] == 2),
+        key=lambda r: -r["h2"],
+    )
     assert rs[-1]["pressure"] < rs[0]["pressure"], rs
 say("all checks passed")

@@ -40,7 +40,8 @@ def build_hertz(
     h_far = max(h_far, h_contact)
     # Plain floats: numpy scalars would print as np.float64(...) in the gmsh expression.
     R, height, h_contact, r_refine, h_far, slope = map(
-        float, (R, height, h_contact, r_refine, h_far, slope))
+        float, (R, height, h_contact, r_refine, h_far, slope)
+    )
     edge = None if edge is None else (float(edge[0]), float(edge[1]))
     yc = height + R
     geo = gmsh.model.geo

@@ -35,10 +35,15 @@ def graded_points(length: float, h0: float, r: float, slope: float, h_far: float
     n = max(1, round(total))
     target = np.arange(n + 1) * (total / n)
     n_r, n_1 = r / h0, float(count(s1))
-    s = np.where(target <= n_r, target * h0,
-                 np.where(target <= n_1,
-                          r + h0 * (np.exp(slope * (target - n_r)) - 1.0) / slope,
-                          s1 + (target - n_1) * h_far))
+    s = np.where(
+        target <= n_r,
+        target * h0,
+        np.where(
+            target <= n_1,
+            r + h0 * (np.exp(slope * (target - n_r)) - 1.0) / slope,
+            s1 + (target - n_1) * h_far,
+        ),
+    )
     s[0], s[-1] = 0.0, length
     return s
 
@@ -49,8 +54,15 @@ def _quads(ids: np.ndarray) -> np.ndarray:
     return np.stack(corners, axis=-1).reshape(-1, 4)
 
 
-def hertz_grid(R: float, width: float, height: float, h_contact: float, r_refine: float,
-               h_far: float, slope: float) -> tuple[np.ndarray, np.ndarray, int]:
+def hertz_grid(
+    R: float,
+    width: float,
+    height: float,
+    h_contact: float,
+    r_refine: float,
+    h_far: float,
+    slope: float,
+) -> tuple[np.ndarray, np.ndarray, int]:
     """Node coordinates, quad cells and the number of block cells (which come first)."""
     # Block [0, width] x [0, height]: fine at x = 0 along the top.
     xs = graded_points(width, h_contact, r_refine, slope, h_far)
@@ -72,28 +84,53 @@ def hertz_grid(R: float, width: float, height: float, h_contact: float, r_refine
     w = np.linspace(0.0, 1.0, nw + 1)
     C = np.array([0.0, yc])
     D, F, G = C + np.array([0.0, -d]), C + np.array([d, -d]), C + np.array([d, 0.0])
-    Pb, P45, Pr = (C + np.array([0.0, -R]), C + R * np.array([math.sqrt(0.5), -math.sqrt(0.5)]),
-                   C + np.array([R, 0.0]))
+    Pb, P45, Pr = (
+        C + np.array([0.0, -R]),
+        C + R * np.array([math.sqrt(0.5), -math.sqrt(0.5)]),
+        C + np.array([R, 0.0]),
+    )
 
     def arc(theta: np.ndarray) -> np.ndarray:
         return C + R * np.column_stack([np.cos(theta), np.sin(theta)])
 
-    def coons(bottom: np.ndarray, top: np.ndarray, left: np.ndarray, right: np.ndarray,
-              corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], s: np.ndarray,
-              t: np.ndarray) -> np.ndarray:
+    def coons(
+        bottom: np.ndarray,
+        top: np.ndarray,
+        left: np.ndarray,
+        right: np.ndarray,
+        corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+        s: np.ndarray,
+        t: np.ndarray,
+    ) -> np.ndarray:
         # Transfinite interpolation of four boundary curves, s along bottom/top, t along sides.
         S, T = s[:, None, None], t[None, :, None]
         c00, c10, c01, c11 = corners
-        edges = ((1 - T) * bottom[:, None] + T * top[:, None]
-                 + (1 - S) * left[None] + S * right[None])
-        return edges - ((1 - S) * (1 - T) * c00 + S * (1 - T) * c10 + (1 - S) * T * c01
-                        + S * T * c11)
+        edges = (
+            (1 - T) * bottom[:, None] + T * top[:, None] + (1 - S) * left[None] + S * right[None]
+        )
+        return edges - (
+            (1 - S) * (1 - T) * c00 + S * (1 - T) * c10 + (1 - S) * T * c01 + S * T * c11
+        )
 
     line = lambda a, b, s: a + s[:, None] * (b - a)  # noqa: E731
-    pa = coons(line(D, F, u), arc(-0.5 * math.pi + 0.25 * math.pi * u), line(D, Pb, v),
-               line(F, P45, v), (D, F, Pb, P45), u, v)
-    pb = coons(line(F, G, w), arc(-0.25 * math.pi + 0.25 * math.pi * w), line(F, P45, v),
-               line(G, Pr, v), (F, G, P45, Pr), w, v)
+    pa = coons(
+        line(D, F, u),
+        arc(-0.5 * math.pi + 0.25 * math.pi * u),
+        line(D, Pb, v),
+        line(F, P45, v),
+        (D, F, Pb, P45),
+        u,
+        v,
+    )
+    pb = coons(
+        line(F, G, w),
+        arc(-0.25 * math.pi + 0.25 * math.pi * w),
+        line(F, P45, v),
+        line(G, Pr, v),
+        (F, G, P45, Pr),
+        w,
+        v,
+    )
     nu, nv = len(u) - 1, len(v) - 1
     ida = np.arange((nu + 1) * (nv + 1)).reshape(nu + 1, nv + 1)
     n = ida.size

@@ -18,22 +18,24 @@ MPIRUN = str(Path(sys.executable).parent / "mpirun")
 ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
 
-def run_cli(*args: str, cwd: Path | None = None, ranks: int = 1,
-            timeout: float = 300) -> subprocess.CompletedProcess[str]:
+def run_cli(
+    *args: str, cwd: Path | None = None, ranks: int = 1, timeout: float = 300
+) -> subprocess.CompletedProcess[str]:
     """Run `python -m contactfx ...` (optionally under mpirun) and capture its output."""
     cmd = [sys.executable, "-m", "contactfx", *args]
     if ranks > 1:
         cmd = [MPIRUN, "-n", str(ranks), *cmd]
-    return subprocess.run(cmd, cwd=cwd or ROOT, env=ENV, capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run(
+        cmd, cwd=cwd or ROOT, env=ENV, capture_output=True, text=True, timeout=timeout
+    )
 
 
-def run_mpi_script(script: Path, *args: str, ranks: int = 2,
-                   timeout: float = 300) -> subprocess.CompletedProcess[str]:
+def run_mpi_script(
+    script: Path, *args: str, ranks: int = 2, timeout: float = 300
+) -> subprocess.CompletedProcess[str]:
     """Run a python script under mpirun with mpi4py's abort-on-exception wrapper."""
     cmd = [MPIRUN, "-n", str(ranks), sys.executable, "-m", "mpi4py", str(script), *args]
-    proc = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True,
-                          timeout=timeout)
+    proc = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return proc
 

@@ -5,15 +5,27 @@ import json
 import pytest
 from conftest import run_cli
 
-KEYS = {"scene", "method", "params", "ranks", "dofs", "multipliers", "elements", "iterations",
-        "times", "contact_force", "interface"}
+KEYS = {
+    "scene",
+    "method",
+    "params",
+    "ranks",
+    "dofs",
+    "multipliers",
+    "elements",
+    "iterations",
+    "times",
+    "contact_force",
+    "interface",
+}
 
 
 def test_blocks_nts_writes_schema(tmp_path) -> None:
     """`solve blocks --method nts --json r.json` writes every documented key."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", "blocks", "--method", "nts", "--json", str(out), "--out",
-                   str(tmp_path / "fields"))
+    proc = run_cli(
+        "solve", "blocks", "--method", "nts", "--json", str(out), "--out", str(tmp_path / "fields")
+    )
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     assert KEYS <= data.keys()
@@ -21,7 +33,12 @@ def test_blocks_nts_writes_schema(tmp_path) -> None:
     assert {"x", "pressure", "sigma_yy_1", "sigma_yy_2"} <= data["interface"].keys()
     params = data["params"]
     assert (params["l1"], params["l2"], params["E1"], params["p"], params["size1"]) == (
-        10.0, 6.0, 70000.0, 50.0, 0.125)
+        10.0,
+        6.0,
+        70000.0,
+        50.0,
+        0.125,
+    )
     n = data["multipliers"]
     assert all(len(data["interface"][k]) == n for k in ("x", "pressure", "sigma_yy_1"))
     assert data["contact_force"] == pytest.approx(150.0, rel=1e-10)
@@ -32,25 +49,44 @@ def test_blocks_nts_writes_schema(tmp_path) -> None:
 def test_mortar_patch_test_from_the_issue(tmp_path) -> None:
     """The issue's acceptance command: mortar on S4 geometry gives sigma_yy = -p to 1e-8."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", "blocks", "--method", "mortar", "--l2", "10", "--E1", "700000",
-                   "--E2", "70000", "--size1", "0.12", "--size2", "0.15", "--json", str(out))
+    proc = run_cli(
+        "solve",
+        "blocks",
+        "--method",
+        "mortar",
+        "--l2",
+        "10",
+        "--E1",
+        "700000",
+        "--E2",
+        "70000",
+        "--size1",
+        "0.12",
+        "--size2",
+        "0.15",
+        "--json",
+        str(out),
+    )
     assert proc.returncode == 0, proc.stderr
     itf = json.loads(out.read_text())["interface"]
     for key in ("sigma_yy_1", "sigma_yy_2"):
         assert max(abs(v / 50.0 + 1) for v in itf[key]) < 1e-8
 
 
-@pytest.mark.parametrize(("args", "needle"), [
-    (["blocks", "--nu1", "0.5"], "Poisson"),
-    (["blocks", "--nu2", "-1"], "Poisson"),
-    (["blocks", "--E2", "0"], "Young"),
-    (["blocks", "--E1", "-7"], "Young"),
-    (["blocks", "--size1", "0"], "size1"),
-    (["blocks", "--size2", "-0.1"], "size2"),
-    (["cylinder"], "unknown scene"),
-    (["blocks", "--R", "3"], "does not apply"),
-    (["blocks", "--solver", "cg"], "unknown solver"),
-])
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["blocks", "--nu1", "0.5"], "Poisson"),
+        (["blocks", "--nu2", "-1"], "Poisson"),
+        (["blocks", "--E2", "0"], "Young"),
+        (["blocks", "--E1", "-7"], "Young"),
+        (["blocks", "--size1", "0"], "size1"),
+        (["blocks", "--size2", "-0.1"], "size2"),
+        (["cylinder"], "unknown scene"),
+        (["blocks", "--R", "3"], "does not apply"),
+        (["blocks", "--solver", "cg"], "unknown solver"),
+    ],
+)
 def test_bad_input_one_line_no_traceback(tmp_path, args: list[str], needle: str) -> None:
     """Bad input: non-zero exit, one line on stderr naming the problem, no JSON written."""
     out = tmp_path / "r.json"
@@ -65,8 +101,18 @@ def test_bad_input_one_line_no_traceback(tmp_path, args: list[str], needle: str)
 def test_hertz_structured_mesh_from_the_cli(tmp_path) -> None:
     """`--mesh structured` builds the Hertz scene in DOLFINx and lands near the exact a."""
     out = tmp_path / "h.json"
-    proc = run_cli("solve", "hertz", "--mesh", "structured", "--refine", "0.04", "--method",
-                   "mortar", "--json", str(out))
+    proc = run_cli(
+        "solve",
+        "hertz",
+        "--mesh",
+        "structured",
+        "--refine",
+        "0.04",
+        "--method",
+        "mortar",
+        "--json",
+        str(out),
+    )
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     assert data["params"]["mesh"] == "structured"

@@ -15,8 +15,7 @@ DEMOS = sorted((ROOT / "demos").glob("demo_*.py"))
 @pytest.mark.parametrize("demo", DEMOS, ids=[d.stem for d in DEMOS])
 def test_demo(demo: Path, ranks: int, tmp_path: Path) -> None:
     """The demo runs to its final assertions."""
-    env = {**ENV, "CONTACTFX_QUICK": "1", "CONTACTFX_RESULTS": str(tmp_path),
-           "MPLBACKEND": "Agg"}
+    env = {**ENV, "CONTACTFX_QUICK": "1", "CONTACTFX_RESULTS": str(tmp_path), "MPLBACKEND": "Agg"}
     cmd = [sys.executable, str(demo)]
     if ranks > 1:
         cmd = [MPIRUN, "-n", str(ranks), sys.executable, "-m", "mpi4py", str(demo)]

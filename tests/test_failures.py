@@ -81,15 +81,19 @@ def assert_clean_failure(tmp_path: Path, args: list[str], words: str, mpi: int =
 
 # ---------------------------------------------------------------- parameters (API)
 
-@pytest.mark.parametrize(("change", "words"), [
-    ({"nu1": 0.5}, "Poisson ratio"),
-    ({"nu2": 0.7}, "Poisson ratio"),
-    ({"nu1": -1.0}, "Poisson ratio"),
-    ({"E1": 0.0}, "Young's modulus"),
-    ({"E2": -7e4}, "Young's modulus"),
-    ({"size1": 0.0}, "size1"),
-    ({"size2": -0.1}, "size2"),
-])
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        ({"nu1": 0.5}, "Poisson ratio"),
+        ({"nu2": 0.7}, "Poisson ratio"),
+        ({"nu1": -1.0}, "Poisson ratio"),
+        ({"E1": 0.0}, "Young's modulus"),
+        ({"E2": -7e4}, "Young's modulus"),
+        ({"size1": 0.0}, "size1"),
+        ({"size2": -0.1}, "size2"),
+    ],
+)
 def test_bad_parameters_raise_input_error(change: dict, words: str) -> None:
     with pytest.raises(InputError, match=words):
         run_case("blocks", replace(COARSE, **change), "mortar", comm=MPI.COMM_SELF)
@@ -101,6 +105,7 @@ def test_unknown_scene_raises_input_error() -> None:
 
 
 # ---------------------------------------------------------------- meshes and tags (API)
+
 
 @pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
 def test_missing_contact_tag(solve) -> None:
@@ -117,8 +122,9 @@ def test_empty_contact_tag(solve) -> None:
 
 
 def test_triangle_mesh_is_refused() -> None:
-    msh = dmesh.create_rectangle(MPI.COMM_SELF, [[0.0, 0.0], [1.0, 1.0]], [2, 2],
-                                 dmesh.CellType.triangle)
+    msh = dmesh.create_rectangle(
+        MPI.COMM_SELF, [[0.0, 0.0], [1.0, 1.0]], [2, 2], dmesh.CellType.triangle
+    )
     msh.topology.create_connectivity(1, 2)
     empty = np.zeros(0, dtype=np.int32)
     ct = dmesh.meshtags(msh, 2, empty, empty)
@@ -131,6 +137,7 @@ def test_triangle_mesh_is_refused() -> None:
 
 
 # ---------------------------------------------------------------- geometry (API)
+
 
 @pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
 def test_surfaces_not_facing(solve) -> None:
@@ -166,6 +173,7 @@ def test_penetration_within_tolerance_is_accepted() -> None:
 
 # ---------------------------------------------------------------- singular systems (API)
 
+
 @pytest.mark.parametrize("method", ["mortar", "nts", "penalty"])
 def test_body_pulled_off_is_singular(method: str) -> None:
     with pytest.raises(SingularSystemError, match="body 'body2' is not held by its supports"):
@@ -175,12 +183,14 @@ def test_body_pulled_off_is_singular(method: str) -> None:
 @pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
 def test_no_support_at_all(solve) -> None:
     scene = coarse_scene()
-    with pytest.raises(SingularSystemError,
-                       match=r"body 'body1' can still move freely.*translation along y"):
+    with pytest.raises(
+        SingularSystemError, match=r"body 'body1' can still move freely.*translation along y"
+    ):
         solve(with_groups(scene, support=(1, 9999)))
 
 
 # ---------------------------------------------------------------- solvers (API)
+
 
 def test_linear_solve_not_converging_reports_reason() -> None:
     opts = {"ksp_type": "gmres", "pc_type": "none", "ksp_max_it": 5}
@@ -207,12 +217,12 @@ def test_active_set_iteration_limit(method: str, limit: int) -> None:
     from contactfx.scenes import HertzParams
 
     with pytest.raises(ActiveSetError, match=f"did not converge in {limit} iterations"):
-        run_case("hertz", HertzParams(refine=0.1), method, max_iterations=limit,
-                 comm=MPI.COMM_SELF)
+        run_case("hertz", HertzParams(refine=0.1), method, max_iterations=limit, comm=MPI.COMM_SELF)
 
 
-@pytest.mark.parametrize("err", [InputError, MeshError, GeometryError, SingularSystemError,
-                                 SolverError, ActiveSetError])
+@pytest.mark.parametrize(
+    "err", [InputError, MeshError, GeometryError, SingularSystemError, SolverError, ActiveSetError]
+)
 def test_cli_turns_every_error_type_into_one_line(err: type, monkeypatch, capsys) -> None:
     """Whatever contactfx error a run raises, main() prints one line and returns 2."""
     from contactfx import cli
@@ -231,21 +241,46 @@ def test_cli_turns_every_error_type_into_one_line(err: type, monkeypatch, capsys
 S4 = ["blocks", "--preset", "S4", "--size1", "0.5", "--size2", "0.6"]
 
 
-@pytest.mark.parametrize(("args", "words"), [
-    ([*S4, "--nu1", "0.5"], "Poisson ratio must lie in (-1, 0.5) (got nu = 0.5)"),
-    ([*S4, "--nu2", "-1"], "Poisson ratio"),
-    ([*S4, "--E2", "0"], "Young's modulus must be > 0"),
-    ([*S4, "--size1", "0"], "size1 must be a positive number"),
-    (["cube"], "unknown scene 'cube'"),
-    ([*S4, "--p", "-50"], "body 'body2' is not held"),
-    ([*S4, "--method", "penalty", "--p", "-50"], "body 'body2' is not held"),
-    ([*S4, "--petsc-option", "ksp_type=gmres", "--petsc-option", "pc_type=none", "--petsc-option", "ksp_max_it=5"], "PETSc reason -3 (DIVERGED_MAX_IT)"),
-    ([*S4, "--solver", "fieldsplit", "--petsc-option", "ksp_max_it=1", "--petsc-option", "fieldsplit_lambda_ksp_max_it=1"], "did not converge: PETSc reason"),
-    ([*S4, "--petsc-option", "pc_type=bogus"], "PETSc error 86"),
-    ([*S4, "--method", "penalty", "--penalty", "-1"], "penalty parameter must be a positive"),
-    ([*S4, "--penalty", "1e6"], "--penalty applies to --method penalty only"),
-    (["hertz", "--refine", "0.1", "--max-iterations", "1"], "did not converge in 1 iterations"),
-])
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        ([*S4, "--nu1", "0.5"], "Poisson ratio must lie in (-1, 0.5) (got nu = 0.5)"),
+        ([*S4, "--nu2", "-1"], "Poisson ratio"),
+        ([*S4, "--E2", "0"], "Young's modulus must be > 0"),
+        ([*S4, "--size1", "0"], "size1 must be a positive number"),
+        (["cube"], "unknown scene 'cube'"),
+        ([*S4, "--p", "-50"], "body 'body2' is not held"),
+        ([*S4, "--method", "penalty", "--p", "-50"], "body 'body2' is not held"),
+        (
+            [
+                *S4,
+                "--petsc-option",
+                "ksp_type=gmres",
+                "--petsc-option",
+                "pc_type=none",
+                "--petsc-option",
+                "ksp_max_it=5",
+            ],
+            "PETSc reason -3 (DIVERGED_MAX_IT)",
+        ),
+        (
+            [
+                *S4,
+                "--solver",
+                "fieldsplit",
+                "--petsc-option",
+                "ksp_max_it=1",
+                "--petsc-option",
+                "fieldsplit_lambda_ksp_max_it=1",
+            ],
+            "did not converge: PETSc reason",
+        ),
+        ([*S4, "--petsc-option", "pc_type=bogus"], "PETSc error 86"),
+        ([*S4, "--method", "penalty", "--penalty", "-1"], "penalty parameter must be a positive"),
+        ([*S4, "--penalty", "1e6"], "--penalty applies to --method penalty only"),
+        (["hertz", "--refine", "0.1", "--max-iterations", "1"], "did not converge in 1 iterations"),
+    ],
+)
 def test_cli_one_line_no_json(tmp_path: Path, args: list[str], words: str) -> None:
     assert_clean_failure(tmp_path, args, words)
 

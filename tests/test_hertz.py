@@ -29,8 +29,9 @@ _LEVELS_CACHE: dict[str, list[dict]] = {}
 def levels_of(method: str) -> list[dict]:
     """Hertz summaries of `method` on three graded meshes (coarse to fine), computed once."""
     if method not in _LEVELS_CACHE:
-        _LEVELS_CACHE[method] = [run_case("hertz", _graded(h, s), method, comm=MPI.COMM_SELF)[1]
-                                 for h, s in LEVELS]
+        _LEVELS_CACHE[method] = [
+            run_case("hertz", _graded(h, s), method, comm=MPI.COMM_SELF)[1] for h, s in LEVELS
+        ]
     return _LEVELS_CACHE[method]
 
 
@@ -145,8 +146,7 @@ def test_lcp_kernel_on_a_small_m_matrix() -> None:
 
 def test_pulling_load_is_a_clear_error() -> None:
     with pytest.raises(SingularSystemError, match="pulls the bodies apart"):
-        run_case("blocks", BlockParams(p=-50.0, size1=0.5, size2=0.5), "mortar",
-                 comm=MPI.COMM_SELF)
+        run_case("blocks", BlockParams(p=-50.0, size1=0.5, size2=0.5), "mortar", comm=MPI.COMM_SELF)
     # A negative Hertz load has no Hertz solution: rejected as input.
     with pytest.raises(InputError, match="P must be a positive"):
         run_case("hertz", HertzParams(P=-100.0), "mortar", comm=MPI.COMM_SELF)
@@ -182,8 +182,9 @@ def test_mpi_equals_serial(tmp_path: Path, mpi_script) -> None:
     mpi_script(script, str(out), timeout=120)
     par = json.loads(out.read_text())
     assert par["ranks"] == 2
-    _, ser = run_case("hertz", HertzParams(refine=0.08, refine_edge=0.02, slope=0.2), "mortar",
-                      comm=MPI.COMM_SELF)
+    _, ser = run_case(
+        "hertz", HertzParams(refine=0.08, refine_edge=0.02, slope=0.2), "mortar", comm=MPI.COMM_SELF
+    )
     assert np.allclose(par["x"], ser["interface"]["x"], rtol=0, atol=1e-12)
     assert np.allclose(par["p"], ser["interface"]["pressure"], rtol=0, atol=1e-8)
     for key in ("a", "p0", "l2_error"):

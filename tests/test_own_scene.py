@@ -37,8 +37,13 @@ def test_inclined_patch_test_mortar_exact(inclined: Scene) -> None:
     assert patch["max"] < 1e-8, patch
     assert set(patch["bodies"]) == {"lower", "upper"}
     pair = patch["pairs"][0]
-    for key in ("pressure", "sigma_nn_active", "sigma_nn_passive", "sigma_nt_active",
-                "sigma_nt_passive"):
+    for key in (
+        "pressure",
+        "sigma_nn_active",
+        "sigma_nn_passive",
+        "sigma_nt_active",
+        "sigma_nt_passive",
+    ):
         assert pair[key] < 1e-8, (key, pair)
     # The interface really is inclined: the contact force is along the rotated normal.
     f = np.asarray(data["contacts"][0]["force"])
@@ -46,8 +51,9 @@ def test_inclined_patch_test_mortar_exact(inclined: Scene) -> None:
 
 
 @pytest.mark.parametrize(("method", "low", "high"), [("nts", 0.1, 0.9), ("sts", 0.05, 0.5)])
-def test_inclined_patch_test_nts_sts_fail_by_their_known_size(inclined: Scene, method: str,
-                                                              low: float, high: float) -> None:
+def test_inclined_patch_test_nts_sts_fail_by_their_known_size(
+    inclined: Scene, method: str, low: float, high: float
+) -> None:
     """NTS and STS do not pass the patch test on non-matching meshes: errors of 14-43 %
     (measured: nts 0.43 / 0.28, sts 0.14 / 0.28 with body 2 / body 1 active)."""
     _, data = run_scene(inclined, method)
@@ -102,8 +108,18 @@ def test_interface_along_the_normal_has_every_key() -> None:
     """contacts[k].interface holds x, y, s, pressure, gap and both sigma_nn, sigma_nt."""
     _, data = run_scene(load_scene_file(SCENES / "two_cylinders.toml"), "mortar")
     itf = data["contacts"][0]["interface"]
-    keys = {"x", "y", "s", "pressure", "gap", "sigma_nn_active", "sigma_nn_passive",
-            "sigma_nt_active", "sigma_nt_passive", "active"}
+    keys = {
+        "x",
+        "y",
+        "s",
+        "pressure",
+        "gap",
+        "sigma_nn_active",
+        "sigma_nn_passive",
+        "sigma_nt_active",
+        "sigma_nt_passive",
+        "active",
+    }
     assert keys <= itf.keys()
     n = data["contacts"][0]["multipliers"]
     assert all(len(itf[k]) == n for k in keys)
@@ -116,12 +132,14 @@ def test_interface_along_the_normal_has_every_key() -> None:
     assert np.max(np.abs(-snn[inner] / p[inner] - 1)) < 0.1
 
 
-def _blocks_geo(path: Path, *, dy: float = 0.0, recombine: bool = True,
-                contact_on_top: bool = False) -> Path:
+def _blocks_geo(
+    path: Path, *, dy: float = 0.0, recombine: bool = True, contact_on_top: bool = False
+) -> Path:
     """Two unit-height blocks: lower [0, 2] x [0, 1], upper [0.5, 1.5] x [1 + dy, 2 + dy]."""
     rec = "Recombine Surface{1, 2};" if recombine else ""
     top = "7" if contact_on_top else "5"
-    path.write_text(textwrap.dedent(f"""
+    path.write_text(
+        textwrap.dedent(f"""
         Point(1) = {{0, 0, 0}}; Point(2) = {{2, 0, 0}}; Point(3) = {{2, 1, 0}};
         Point(4) = {{0, 1, 0}};
         Line(1) = {{1, 2}}; Line(2) = {{2, 3}}; Line(3) = {{3, 4}}; Line(4) = {{4, 1}};
@@ -138,13 +156,16 @@ def _blocks_geo(path: Path, *, dy: float = 0.0, recombine: bool = True,
         Physical Curve("base") = {{1}}; Physical Curve("left") = {{8}};
         Physical Curve("loaded") = {{7}};
         Physical Point("corner") = {{1}};
-    """))
+    """)
+    )
     return path
 
 
-def _toml(path: Path, geo: str, extra: str = "", body_group: str = "upper",
-          nu: float = 0.3) -> Path:
-    path.write_text(textwrap.dedent(f"""
+def _toml(
+    path: Path, geo: str, extra: str = "", body_group: str = "upper", nu: float = 0.3
+) -> Path:
+    path.write_text(
+        textwrap.dedent(f"""
         mesh = "{geo}"
         [bodies.lower]
         E = 1000.0
@@ -164,7 +185,9 @@ def _toml(path: Path, geo: str, extra: str = "", body_group: str = "upper",
         [[pressure]]
         group = "loaded"
         p = 2.0
-    """) + textwrap.dedent(extra))
+    """)
+        + textwrap.dedent(extra)
+    )
     return path
 
 
@@ -173,8 +196,9 @@ def test_small_user_scene_point_support_and_cli(tmp_path: Path) -> None:
     _blocks_geo(tmp_path / "b.geo")
     scene = _toml(tmp_path / "s.toml", "b.geo", '[[dirichlet]]\ngroup = "left"\nux = 0.0\n')
     out = tmp_path / "r.json"
-    proc = run_cli("solve", str(scene), "--method", "mortar", "--json", str(out), "--out",
-                   str(tmp_path / "o"))
+    proc = run_cli(
+        "solve", str(scene), "--method", "mortar", "--json", str(out), "--out", str(tmp_path / "o")
+    )
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     c = data["contacts"][0]
@@ -194,8 +218,7 @@ def test_from_gmsh_model_in_python() -> None:
         geo = gmsh.model.geo
         tags = []
         for y0, x0, x1 in ((0.0, 0.0, 2.0), (1.0, 0.5, 1.5)):
-            p = [geo.addPoint(x, y, 0) for x, y in ((x0, y0), (x1, y0), (x1, y0 + 1),
-                                                     (x0, y0 + 1))]
+            p = [geo.addPoint(x, y, 0) for x, y in ((x0, y0), (x1, y0), (x1, y0 + 1), (x0, y0 + 1))]
             lines = [geo.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
             surf = geo.addPlaneSurface([geo.addCurveLoop(lines)])
             tags.append((surf, lines))
@@ -206,35 +229,55 @@ def test_from_gmsh_model_in_python() -> None:
             gmsh.model.mesh.setTransfiniteSurface(surf)
             gmsh.model.mesh.setRecombine(2, surf)
         (s1, l1), (s2, l2) = tags
-        for dim, ents, name in ((2, [s1], "lower"), (2, [s2], "upper"), (1, [l1[2]], "top"),
-                                (1, [l2[0]], "bottom"), (1, [l1[0]], "base"),
-                                (1, [l1[3], l2[3]], "left"), (1, [l2[2]], "load")):
+        for dim, ents, name in (
+            (2, [s1], "lower"),
+            (2, [s2], "upper"),
+            (1, [l1[2]], "top"),
+            (1, [l2[0]], "bottom"),
+            (1, [l1[0]], "base"),
+            (1, [l1[3], l2[3]], "left"),
+            (1, [l2[2]], "load"),
+        ):
             gmsh.model.addPhysicalGroup(dim, ents, name=name)
-        scene = Scene.from_gmsh(gmsh.model, bodies={"lower": Material(1000.0, 0.3),
-                                                    "upper": {"E": 500.0, "nu": 0.25}},
-                                contacts=[ContactPair("bottom", "top")],
-                                dirichlet=[Dirichlet("base", uy=0.0), Dirichlet("left", ux=0.0)],
-                                loads=[Pressure("load", 3.0)])
+        scene = Scene.from_gmsh(
+            gmsh.model,
+            bodies={"lower": Material(1000.0, 0.3), "upper": {"E": 500.0, "nu": 0.25}},
+            contacts=[ContactPair("bottom", "top")],
+            dirichlet=[Dirichlet("base", uy=0.0), Dirichlet("left", ux=0.0)],
+            loads=[Pressure("load", 3.0)],
+        )
     finally:
         gmsh.finalize()
     _, data = run_scene(scene, "mortar")
     assert data["contacts"][0]["force"][1] == pytest.approx(3.0, rel=1e-10)
 
 
-@pytest.mark.parametrize(("geo_kw", "toml_kw", "error", "needle"), [
-    ({}, {"extra": '[[pressure]]\ngroup = "nowhere"\np = 1.0\n'}, MeshError, "has: base"),
-    ({}, {"body_group": "lower_top"}, MeshError, "is a curve group"),
-    ({"recombine": False}, {}, MeshError, "Q1 only"),
-    ({}, {"extra": "[bodies.upper.extra]\n"}, InputError, "unknown key"),
-    ({}, {"nu": 0.5}, InputError, "Poisson"),
-    ({}, {}, SingularSystemError, "body 'upper' can still move freely"),
-    ({"contact_on_top": True}, {"extra": '[[dirichlet]]\ngroup = "left"\nux = 0.0\n'},
-     GeometryError, "do not face each other"),
-    ({"dy": -0.05}, {"extra": '[[dirichlet]]\ngroup = "left"\nux = 0.0\n'}, GeometryError,
-     "overlap"),
-])
-def test_bad_scene_input(tmp_path: Path, geo_kw: dict, toml_kw: dict, error: type,
-                         needle: str) -> None:
+@pytest.mark.parametrize(
+    ("geo_kw", "toml_kw", "error", "needle"),
+    [
+        ({}, {"extra": '[[pressure]]\ngroup = "nowhere"\np = 1.0\n'}, MeshError, "has: base"),
+        ({}, {"body_group": "lower_top"}, MeshError, "is a curve group"),
+        ({"recombine": False}, {}, MeshError, "Q1 only"),
+        ({}, {"extra": "[bodies.upper.extra]\n"}, InputError, "unknown key"),
+        ({}, {"nu": 0.5}, InputError, "Poisson"),
+        ({}, {}, SingularSystemError, "body 'upper' can still move freely"),
+        (
+            {"contact_on_top": True},
+            {"extra": '[[dirichlet]]\ngroup = "left"\nux = 0.0\n'},
+            GeometryError,
+            "do not face each other",
+        ),
+        (
+            {"dy": -0.05},
+            {"extra": '[[dirichlet]]\ngroup = "left"\nux = 0.0\n'},
+            GeometryError,
+            "overlap",
+        ),
+    ],
+)
+def test_bad_scene_input(
+    tmp_path: Path, geo_kw: dict, toml_kw: dict, error: type, needle: str
+) -> None:
     """Each kind of bad input raises its typed error with a message naming the problem."""
     _blocks_geo(tmp_path / "b.geo", **geo_kw)
     path = _toml(tmp_path / "s.toml", "b.geo", **toml_kw)
@@ -245,8 +288,9 @@ def test_bad_scene_input(tmp_path: Path, geo_kw: dict, toml_kw: dict, error: typ
 def test_bad_scene_file_cli_one_line(tmp_path: Path) -> None:
     """Missing mesh file and a misspelled key: exit 2, one line, no traceback, no JSON."""
     _toml(tmp_path / "s.toml", "missing.geo")
-    (tmp_path / "t.toml").write_text('mesh = "b.geo"\n[bodies.a]\nE = 1.0\nnu = 0.3\n'
-                                     '[[contact]]\nactive = "x"\npasive = "y"\n')
+    (tmp_path / "t.toml").write_text(
+        'mesh = "b.geo"\n[bodies.a]\nE = 1.0\nnu = 0.3\n[[contact]]\nactive = "x"\npasive = "y"\n'
+    )
     for name, needle in (("s.toml", "does not exist"), ("t.toml", "unknown key 'pasive'")):
         out = tmp_path / "r.json"
         proc = run_cli("solve", str(tmp_path / name), "--json", str(out))
@@ -276,10 +320,12 @@ MPI_SCRIPT = textwrap.dedent("""
 
 
 @pytest.mark.mpi
-@pytest.mark.parametrize(("scene", "method"), [(THREE_BODIES, "mortar"),
-                                                (SCENES / "inclined_patch.toml", "sts")])
-def test_user_scene_two_ranks_equal_serial(tmp_path: Path, mpi_script, scene: Path,
-                                           method: str) -> None:
+@pytest.mark.parametrize(
+    ("scene", "method"), [(THREE_BODIES, "mortar"), (SCENES / "inclined_patch.toml", "sts")]
+)
+def test_user_scene_two_ranks_equal_serial(
+    tmp_path: Path, mpi_script, scene: Path, method: str
+) -> None:
     """A user scene gives the same displacements, pressures and stresses on 1 and 2 ranks."""
     script = tmp_path / "run.py"
     script.write_text(MPI_SCRIPT)

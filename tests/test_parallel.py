@@ -25,12 +25,15 @@ SCRIPT = textwrap.dedent("""
 """)
 
 
-@pytest.mark.parametrize(("scene", "method", "active", "solver"), [
-    ("S2", "nts", 2, "mumps"),
-    ("S3", "sts", 1, "mumps"),
-    ("S4", "mortar", 2, "mumps"),
-    ("S2", "mortar", 1, "fieldsplit"),
-])
+@pytest.mark.parametrize(
+    ("scene", "method", "active", "solver"),
+    [
+        ("S2", "nts", 2, "mumps"),
+        ("S3", "sts", 1, "mumps"),
+        ("S4", "mortar", 2, "mumps"),
+        ("S2", "mortar", 1, "fieldsplit"),
+    ],
+)
 def test_two_ranks_equal_serial(tmp_path, mpi_script, scene, method, active, solver) -> None:
     """Same mesh, same answer: the rank count changes only the round-off."""
     script = tmp_path / "run.py"
@@ -54,8 +57,9 @@ def test_two_ranks_equal_serial(tmp_path, mpi_script, scene, method, active, sol
 def test_cli_under_mpirun(tmp_path) -> None:
     """The CLI under mpirun writes one JSON, from rank 0, saying 2 ranks."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", "blocks", "--method", "mortar", "--preset", "S2", "--json",
-                   str(out), ranks=2)
+    proc = run_cli(
+        "solve", "blocks", "--method", "mortar", "--preset", "S2", "--json", str(out), ranks=2
+    )
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     assert data["ranks"] == 2

@@ -29,8 +29,7 @@ HERTZ = HertzParams(refine=0.1)
 def test_patch_test_uniform_penetration(active: int) -> None:
     # Exact solution: sigma_yy = -p everywhere, pressure p, and a uniform penetration p / eps.
     eps = 1e7
-    sol, data = run_case("blocks", S4, "penalty", active=active, penalty=eps,
-                         comm=MPI.COMM_SELF)
+    sol, data = run_case("blocks", S4, "penalty", active=active, penalty=eps, comm=MPI.COMM_SELF)
     p = S4.p
     err = patch_errors(data["interface"], p)
     dev = body_stress_deviation(sol, -p)
@@ -70,8 +69,24 @@ def test_small_penalty_spreads_the_contact() -> None:
 
 def test_cli_json_has_penalty_and_penetration(tmp_path: Path) -> None:
     out = tmp_path / "p.json"
-    cmd = [sys.executable, "-m", "contactfx", "solve", "blocks", "--preset", "S4", "--size1",
-           "0.3", "--size2", "0.4", "--method", "penalty", "--json", str(out), "-q"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "contactfx",
+        "solve",
+        "blocks",
+        "--preset",
+        "S4",
+        "--size1",
+        "0.3",
+        "--size2",
+        "0.4",
+        "--method",
+        "penalty",
+        "--json",
+        str(out),
+        "-q",
+    ]
     subprocess.run(cmd, check=True, env=ENV, timeout=120)
     data = json.loads(out.read_text())
     h = np.median(np.diff(np.sort(data["interface"]["x"])))
@@ -82,12 +97,29 @@ def test_cli_json_has_penalty_and_penetration(tmp_path: Path) -> None:
 
 
 def test_penalty_mpi_matches_serial(tmp_path: Path) -> None:
-    args = ["-m", "contactfx", "solve", "hertz", "--refine", "0.1", "--method", "penalty",
-            "--penalty", "1e6", "-q", "--json"]
-    subprocess.run([sys.executable, *args, str(tmp_path / "s.json")], check=True, env=ENV,
-                   timeout=120)
-    subprocess.run([MPIRUN, "-n", "2", sys.executable, *args, str(tmp_path / "m.json")],
-                   check=True, env=ENV, timeout=300)
+    args = [
+        "-m",
+        "contactfx",
+        "solve",
+        "hertz",
+        "--refine",
+        "0.1",
+        "--method",
+        "penalty",
+        "--penalty",
+        "1e6",
+        "-q",
+        "--json",
+    ]
+    subprocess.run(
+        [sys.executable, *args, str(tmp_path / "s.json")], check=True, env=ENV, timeout=120
+    )
+    subprocess.run(
+        [MPIRUN, "-n", "2", sys.executable, *args, str(tmp_path / "m.json")],
+        check=True,
+        env=ENV,
+        timeout=300,
+    )
     s, m = (json.loads((tmp_path / f"{k}.json").read_text()) for k in "sm")
     assert m["ranks"] == 2
     assert m["iterations"] == s["iterations"]

@@ -63,16 +63,34 @@ def test_persistent_solver_equals_fresh_solves(hertz_system) -> None:
     """Every reuse path (refactor, lagged LU + GMRES, released-row capacitance) is exact."""
     el, B, g, x = hertz_system
     sets = [x < 1.0, x < 1.3, x < 1.2, (x < 1.1) | ((x > 1.4) & (x < 1.5)), x < 0.9]
-    with SaddleSolver(el.K, B, el.f, {"ksp_type": "preonly", "pc_type": "lu",
-                                       "pc_factor_mat_solver_type": "mumps"}) as solver:
+    with SaddleSolver(
+        el.K,
+        B,
+        el.f,
+        {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
+    ) as solver:
         solver.policy = "reuse"
         paths = []
         for active in sets:
             res = solver.solve(g, active)
-            _close(res, solve_saddle(el.K, B, el.f, g, active, {
-                "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}))
-            paths.append("released" if "released" in res.info else
-                         "factorized" if res.info["refactored"] else "lagged")
+            _close(
+                res,
+                solve_saddle(
+                    el.K,
+                    B,
+                    el.f,
+                    g,
+                    active,
+                    {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
+                ),
+            )
+            paths.append(
+                "released"
+                if "released" in res.info
+                else "factorized"
+                if res.info["refactored"]
+                else "lagged"
+            )
         assert solver.stats["factorizations"] == 1
     # The factorized set stays x < 1: the next three add rows to it, so GMRES runs on the
     # lagged factorization (a low-rank change); the last only releases rows (capacitance).
@@ -103,7 +121,8 @@ def test_near_nullspace_is_the_kernel_of_free_bodies() -> None:
     E, nu = material_fields(scene)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     K = dolfinx.fem.petsc.assemble_matrix(
-        fem.form(ufl.inner(sigma(u, E, nu), ufl.sym(ufl.grad(v))) * ufl.dx))
+        fem.form(ufl.inner(sigma(u, E, nu), ufl.sym(ufl.grad(v))) * ufl.dx)
+    )
     K.assemble()
     modes = rigid_body_modes(V, scene)
     assert len(modes) == 6
@@ -122,10 +141,13 @@ def test_near_nullspace_is_the_kernel_of_free_bodies() -> None:
     K.destroy()
 
 
-@pytest.mark.parametrize(("kind", "params", "method"), [
-    ("hertz", HertzParams(), Method.MORTAR),
-    ("blocks", BLOCK_SCENES["S2"], Method.MORTAR),
-])
+@pytest.mark.parametrize(
+    ("kind", "params", "method"),
+    [
+        ("hertz", HertzParams(), Method.MORTAR),
+        ("blocks", BLOCK_SCENES["S2"], Method.MORTAR),
+    ],
+)
 def test_gamg_fieldsplit_agrees_with_mumps(kind, params, method) -> None:
     """GAMG fieldsplit (rtol 1e-10) gives the MUMPS displacement and pressure to ~1e-6."""
     scene = build_scene(kind, params)
@@ -141,8 +163,7 @@ def test_gamg_fieldsplit_agrees_with_mumps(kind, params, method) -> None:
 def test_reference_timing_in_json(tmp_path) -> None:
     """--reference-timing adds times.reference_solve; per-iteration solver data is there."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", "hertz", "--method", "mortar", "--reference-timing", "--json",
-                   str(out))
+    proc = run_cli("solve", "hertz", "--method", "mortar", "--reference-timing", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     assert data["times"]["reference_solve"] > 0.0
@@ -170,8 +191,11 @@ def test_structured_hertz_geometry_and_contact() -> None:
     """Areas, tags and the Hertz half-width on the structured mesh (no gmsh)."""
     x, cells, n_block = hertz_grid(60.0, 60.0, 60.0, 0.05, 2.0, 2.0, 0.1)
     p = x[cells][:, [0, 1, 3, 2]]
-    area = 0.5 * np.abs(np.sum(p[..., 0] * np.roll(p[..., 1], -1, 1)
-                               - np.roll(p[..., 0], -1, 1) * p[..., 1], axis=1))
+    area = 0.5 * np.abs(
+        np.sum(
+            p[..., 0] * np.roll(p[..., 1], -1, 1) - np.roll(p[..., 0], -1, 1) * p[..., 1], axis=1
+        )
+    )
     assert area[:n_block].sum() == pytest.approx(3600.0, rel=1e-12)
     # The polygonal arc cuts off at most (chord^3 / 12 R) per facet: under 0.1%.
     assert area[n_block:].sum() == pytest.approx(math.pi * 900.0, rel=1e-3)
@@ -299,8 +323,7 @@ def test_any_initial_set_converges_to_the_same_answer(structured_pair, guess) ->
     a = fine.params["hertz_exact"]["a"]
     radius = {"inside": 0.5 * a, "far": 3.0 * a, "nothing": -1.0}[guess]
     plain = solve_contact(fine, Method.MORTAR, "mumps")
-    sol = solve_contact(fine, Method.MORTAR, "mumps",
-                        initial_active=lambda x: x[:, 0] <= radius)
+    sol = solve_contact(fine, Method.MORTAR, "mumps", initial_active=lambda x: x[:, 0] <= radius)
     assert np.array_equal(sol.active, plain.active)
     p_max = np.abs(plain.pressure).max()
     assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max

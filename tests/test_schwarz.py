@@ -91,24 +91,33 @@ def test_s4_patch_test() -> None:
 def test_aitken_needs_fewer_iterations_than_fixed_relaxation() -> None:
     """Same material (S1): Aitken 14 iterations, fixed 0.5 needs 28 (measured)."""
     params = BLOCK_SCENES["S1"]
-    _, fixed = run_case("blocks", params, "schwarz",
-                        schwarz=SchwarzOptions(relaxation=0.5, aitken=False))
+    _, fixed = run_case(
+        "blocks", params, "schwarz", schwarz=SchwarzOptions(relaxation=0.5, aitken=False)
+    )
     _, aitken = run_case("blocks", params, "schwarz")
     assert aitken["iterations"] < 0.75 * fixed["iterations"]
 
 
 def test_no_relaxation_converges_with_the_stiffer_body_neumann() -> None:
     """S3: B1 (Neumann side) 10x stiffer, so omega = 1 contracts (8 iterations measured)."""
-    _, data = run_case("blocks", BLOCK_SCENES["S3"], "schwarz",
-                       schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=15))
+    _, data = run_case(
+        "blocks",
+        BLOCK_SCENES["S3"],
+        "schwarz",
+        schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=15),
+    )
     assert data["iterations"] <= 10
 
 
 def test_no_relaxation_same_material_fails_at_the_limit() -> None:
     """S1 with omega = 1 stalls (eigenvalue near -1): ConvergenceError at the limit."""
     with pytest.raises(ConvergenceError, match="did not converge in 30 iterations") as err:
-        run_case("blocks", BLOCK_SCENES["S1"], "schwarz",
-                 schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=30))
+        run_case(
+            "blocks",
+            BLOCK_SCENES["S1"],
+            "schwarz",
+            schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=30),
+        )
     last = err.value.history[-1]["residual"]
     # Measured: the relative residual stays near 3e-3 instead of falling below 1e-8.
     assert 1e-4 < last < 1e-1
@@ -118,8 +127,12 @@ def test_stiff_top_on_soft_base_diverges() -> None:
     """S3 with the stiffnesses swapped (Dirichlet body 10x stiffer), omega = 1: it blows up."""
     params = replace(BLOCK_SCENES["S3"], E1=70000.0, E2=700000.0)
     with pytest.raises(ConvergenceError, match="diverged at iteration"):
-        run_case("blocks", params, "schwarz",
-                 schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=50))
+        run_case(
+            "blocks",
+            params,
+            "schwarz",
+            schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=50),
+        )
 
 
 def test_logs_every_iteration(caplog) -> None:
@@ -149,8 +162,18 @@ def test_cli_writes_the_usual_schema(tmp_path) -> None:
     proc = run_cli("solve", "blocks", "--method", "schwarz", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
-    for key in ("scene", "method", "params", "ranks", "dofs", "multipliers", "iterations",
-                "times", "contact_force", "interface"):
+    for key in (
+        "scene",
+        "method",
+        "params",
+        "ranks",
+        "dofs",
+        "multipliers",
+        "iterations",
+        "times",
+        "contact_force",
+        "interface",
+    ):
         assert key in data
     assert data["method"] == "schwarz" and data["iterations"] == 14
     assert set(data["interface"]) == {"x", "pressure", "sigma_yy_1", "sigma_yy_2"}

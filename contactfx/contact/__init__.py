@@ -17,8 +17,9 @@ OPERATORS: dict[str, Callable[..., ContactOperator]] = {
 }
 
 
-def contact_operator(method: str, active: Surface, passive: Surface, ndofs: int,
-                     **options: object) -> ContactOperator:
+def contact_operator(
+    method: str, active: Surface, passive: Surface, ndofs: int, **options: object
+) -> ContactOperator:
     """Build the contact operator of the named method ("nts", "sts" or "mortar").
 
     `options` go to the kernel (e.g. the mortar multiplier basis).

@@ -61,14 +61,14 @@ class HertzParams:
     E2: float = 7000.0
     nu1: float = 0.23
     nu2: float = 0.23
-    refine: float = 0.02        # element size on the contact zone, x <= r_refine (cm)
-    r_refine: float = 0.0       # end of the refined zone; 0 = 1.4 a (Hertz's half-width)
+    refine: float = 0.02  # element size on the contact zone, x <= r_refine (cm)
+    r_refine: float = 0.0  # end of the refined zone; 0 = 1.4 a (Hertz's half-width)
     refine_edge: float = 0.005  # element size at x = a, the pressure's sqrt edge; 0 = off
-    slope: float = 0.1          # growth of the element size per unit distance
+    slope: float = 0.1  # growth of the element size per unit distance
     width: float = 60.0
     height: float = 60.0
-    mesh: str = "gmsh"          # "gmsh" (graded unstructured quads) or "structured" (large runs)
-    h_far: float = 0.0          # largest element size (cm); 0 = R / 6
+    mesh: str = "gmsh"  # "gmsh" (graded unstructured quads) or "structured" (large runs)
+    h_far: float = 0.0  # largest element size (cm); 0 = R / 6
 
 
 MESHERS = ("gmsh", "structured")
@@ -103,8 +103,9 @@ def validate(params: BlockParams | HertzParams) -> None:
             raise InputError(f"{key} must be a positive number (got {value})")
     if isinstance(params, BlockParams):
         if params.l2 > params.l1:
-            raise InputError(f"l2 = {params.l2} > l1 = {params.l1}: the top block must not "
-                             "overhang the base")
+            raise InputError(
+                f"l2 = {params.l2} > l1 = {params.l1}: the top block must not overhang the base"
+            )
         for key, length in (("size1", params.l1), ("size2", params.l2)):
             if getattr(params, key) > length / 2:
                 raise InputError(f"{key} = {getattr(params, key)} is larger than the half width")
@@ -123,42 +124,66 @@ def validate(params: BlockParams | HertzParams) -> None:
             raise InputError(f"h_far must be >= 0 (got {params.h_far})")
 
 
-def _two_body_scene(data: Any, groups: dict[str, tuple[int, int]],
-                    params: BlockParams | HertzParams, load: float, active: int, name: str,
-                    references: tuple[Reference, ...], extra: dict[str, Any]) -> Scene:
+def _two_body_scene(
+    data: Any,
+    groups: dict[str, tuple[int, int]],
+    params: BlockParams | HertzParams,
+    load: float,
+    active: int,
+    name: str,
+    references: tuple[Reference, ...],
+    extra: dict[str, Any],
+) -> Scene:
     """The common shape of the paper's scenes: body1 below, body2 on top, rollers, one load."""
     if active not in (1, 2):
         raise InputError(f"active body must be 1 or 2 (got {active})")
-    bodies = (Body("body1", Material(params.E1, params.nu1)),
-              Body("body2", Material(params.E2, params.nu2)))
+    bodies = (
+        Body("body1", Material(params.E1, params.nu1)),
+        Body("body2", Material(params.E2, params.nu2)),
+    )
     pair = ContactPair(f"contact{active}", f"contact{3 - active}")
     # Rollers, as in the paper: u_x = 0 on the symmetry axis, u_y = 0 on the base only.
     supports = (Dirichlet("symmetry", ux=0.0), Dirichlet("support", uy=0.0))
-    return Scene(data.mesh, data.cell_tags, data.facet_tags, None, Groups(groups), bodies,
-                 (pair,), supports, (Pressure("load", load),), references, name=name,
-                 params={**asdict(params), "active": active, **extra},
-                 cartesian_interface=True)
+    return Scene(
+        data.mesh,
+        data.cell_tags,
+        data.facet_tags,
+        None,
+        Groups(groups),
+        bodies,
+        (pair,),
+        supports,
+        (Pressure("load", load),),
+        references,
+        name=name,
+        params={**asdict(params), "active": active, **extra},
+        cartesian_interface=True,
+    )
 
 
-def blocks(params: BlockParams = BlockParams(), active: int = 2,
-           comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+def blocks(
+    params: BlockParams = BlockParams(), active: int = 2, comm: MPI.Comm = MPI.COMM_WORLD
+) -> Scene:
     """Two stacked blocks (S1-S4): pressure p on top, rollers on the axis and the base."""
     validate(params)
     p = params
-    build = partial(build_blocks, p.l1, p.l2, p.h1, p.h2, p.size1, p.size2, p.grading1,
-                    p.grading2)
+    build = partial(build_blocks, p.l1, p.l2, p.h1, p.h2, p.size1, p.size2, p.grading1, p.grading2)
     data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
     groups = {k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()}
     # Equal widths make the stress uniaxial and uniform: the contact patch test.
-    refs: tuple[Reference, ...] = ((UniformStress(((0.0, 0.0), (0.0, -p.p))),)
-                                   if p.l1 == p.l2 else ())
+    refs: tuple[Reference, ...] = (
+        (UniformStress(((0.0, 0.0), (0.0, -p.p))),) if p.l1 == p.l2 else ()
+    )
     scene = _two_body_scene(data, groups, p, p.p, active, "blocks", refs, {})
-    return replace(scene, resize=lambda f: blocks(
-        replace(p, size1=p.size1 * f, size2=p.size2 * f), active, comm))
+    return replace(
+        scene,
+        resize=lambda f: blocks(replace(p, size1=p.size1 * f, size2=p.size2 * f), active, comm),
+    )
 
 
-def hertz(params: HertzParams = HertzParams(), active: int = 2,
-          comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+def hertz(
+    params: HertzParams = HertzParams(), active: int = 2, comm: MPI.Comm = MPI.COMM_WORLD
+) -> Scene:
     """A quarter cylinder on a block (S5), line load P, on the gmsh or the structured mesh."""
     validate(params)
     exact = hertz_exact(params)
@@ -173,29 +198,47 @@ def hertz(params: HertzParams = HertzParams(), active: int = 2,
         # Built directly in DOLFINx: gmsh's quad mesher is too slow for millions of DOFs.
         from .structured import build_hertz_structured
 
-        data = build_hertz_structured(comm, h.R, h.width, h.height, h.refine, h.r_refine,
-                                      h_far, h.slope)
+        data = build_hertz_structured(
+            comm, h.R, h.width, h.height, h.refine, h.r_refine, h_far, h.slope
+        )
         groups = data.physical_groups
     else:
         # The edge grading targets the Hertz estimate of a, as a user would plan a mesh.
         edge = (exact["a"], h.refine_edge) if h.refine_edge > 0 else None
-        build = partial(build_hertz, h.R, h.width, h.height, h.refine, h.r_refine,
-                        h_far=h_far, slope=h.slope, edge=edge)
+        build = partial(
+            build_hertz,
+            h.R,
+            h.width,
+            h.height,
+            h.refine,
+            h.r_refine,
+            h_far=h_far,
+            slope=h.slope,
+            edge=edge,
+        )
         data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
         groups = {k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()}
     ref = (HertzReference(pair=0, R=h.R, P=h.P, symmetric=True),)
     scene = _two_body_scene(data, groups, h, h.P / (2 * h.R), active, "hertz", ref, extra)
-    return replace(scene, resize=lambda f: hertz(
-        replace(h, refine=h.refine * f, refine_edge=h.refine_edge * f, h_far=h.h_far * f),
-        active, comm))
+    return replace(
+        scene,
+        resize=lambda f: hertz(
+            replace(h, refine=h.refine * f, refine_edge=h.refine_edge * f, h_far=h.h_far * f),
+            active,
+            comm,
+        ),
+    )
 
 
-def build_scene(kind: str, params: BlockParams | HertzParams, active: int = 2,
-                comm: MPI.Comm = MPI.COMM_WORLD) -> Scene:
+def build_scene(
+    kind: str, params: BlockParams | HertzParams, active: int = 2, comm: MPI.Comm = MPI.COMM_WORLD
+) -> Scene:
     """A built-in scene by name: 'blocks' with BlockParams or 'hertz' with HertzParams."""
     if kind == "blocks" and isinstance(params, BlockParams):
         return blocks(params, active, comm)
     if kind == "hertz" and isinstance(params, HertzParams):
         return hertz(params, active, comm)
-    raise InputError(f"unknown scene '{kind}' with {type(params).__name__} "
-                     "(choose blocks with BlockParams or hertz with HertzParams)")
+    raise InputError(
+        f"unknown scene '{kind}' with {type(params).__name__} "
+        "(choose blocks with BlockParams or hertz with HertzParams)"
+    )

@@ -31,8 +31,11 @@ def body_of_curve(scene: Scene, name: str) -> Body:
     facets = scene.facet_tags.find(tag)
     f2c = msh.topology.connectivity(tdim - 1, tdim)
     cells = f2c.array[f2c.offsets[facets]] if facets.size else np.zeros(0, np.int32)
-    cell_values = np.full(msh.topology.index_map(tdim).size_local
-                          + msh.topology.index_map(tdim).num_ghosts, -1, dtype=np.int64)
+    cell_values = np.full(
+        msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts,
+        -1,
+        dtype=np.int64,
+    )
     cell_values[scene.cell_tags.indices] = scene.cell_tags.values
     local = set(np.unique(cell_values[cells]).tolist())
     found = set().union(*scene.comm.allgather(local))
@@ -40,8 +43,10 @@ def body_of_curve(scene: Scene, name: str) -> Body:
     if not names:
         raise MeshError(f"curve group '{name}' has no facet on the boundary of any body")
     if len(names) > 1:
-        raise MeshError(f"curve group '{name}' lies on several bodies "
-                        f"({', '.join(b.name for b in names)}): give one group per body")
+        raise MeshError(
+            f"curve group '{name}' lies on several bodies "
+            f"({', '.join(b.name for b in names)}): give one group per body"
+        )
     return names[0]
 
 
@@ -57,8 +62,10 @@ def _check_bodies(scene: Scene) -> None:
     surfaces = {n: t for n, (d, t) in scene.groups.by_name.items() if d == 2}
     extra = [n for n, t in surfaces.items() if t not in known]
     if extra:
-        raise InputError(f"physical surface group '{extra[0]}' is not a body of the scene: "
-                         f"give it a material ([bodies.{extra[0]}] with E and nu)")
+        raise InputError(
+            f"physical surface group '{extra[0]}' is not a body of the scene: "
+            f"give it a material ([bodies.{extra[0]}] with E and nu)"
+        )
 
 
 def _check_pairs(scene: Scene) -> None:
@@ -68,8 +75,10 @@ def _check_pairs(scene: Scene) -> None:
         a = body_of_curve(scene, pair.active)
         p = body_of_curve(scene, pair.passive)
         if a == p:
-            raise InputError(f"contact pair {k}: '{pair.active}' and '{pair.passive}' lie on "
-                             f"the same body '{a.name}' (self-contact is not supported)")
+            raise InputError(
+                f"contact pair {k}: '{pair.active}' and '{pair.passive}' lie on "
+                f"the same body '{a.name}' (self-contact is not supported)"
+            )
 
 
 def _check_conditions(scene: Scene) -> None:
@@ -92,8 +101,10 @@ def _check_conditions(scene: Scene) -> None:
     for ref in scene.references:
         pair = getattr(ref, "pair", 0)
         if not 0 <= pair < len(scene.contacts):
-            raise InputError(f"reference: pair {pair} does not exist "
-                             f"(the scene has {len(scene.contacts)} contact pairs)")
+            raise InputError(
+                f"reference: pair {pair} does not exist "
+                f"(the scene has {len(scene.contacts)} contact pairs)"
+            )
 
 
 def check_scene(scene: Scene) -> None:

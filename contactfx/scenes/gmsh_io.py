@@ -25,8 +25,12 @@ from .model import ContactPair, Dirichlet, Groups, Load, Material, Reference, Sc
 
 # gmsh element type of the 4-node quadrangle; the other 2D types named for the error message.
 QUAD4 = 3
-_GMSH_2D_NAMES = {2: "3-node triangles", 9: "6-node triangles", 10: "9-node quadrangles",
-                  16: "8-node quadrangles"}
+_GMSH_2D_NAMES = {
+    2: "3-node triangles",
+    9: "6-node triangles",
+    10: "9-node quadrangles",
+    16: "8-node quadrangles",
+}
 
 
 def _gmsh_node_coordinates() -> np.ndarray:
@@ -81,12 +85,15 @@ def check_quadrilaterals() -> None:
     other = [(int(t), len(e)) for t, e in zip(types, tags, strict=True) if t != QUAD4]
     if other:
         what = ", ".join(f"{n} {_GMSH_2D_NAMES.get(t, f'type-{t} elements')}" for t, n in other)
-        raise MeshError(f"contactfx needs an all-quadrilateral mesh (Q1 only), the mesh has "
-                        f"{what}: recombine it (Mesh.RecombineAll = 1, Mesh.Algorithm = 8)")
+        raise MeshError(
+            f"contactfx needs an all-quadrilateral mesh (Q1 only), the mesh has "
+            f"{what}: recombine it (Mesh.RecombineAll = 1, Mesh.Algorithm = 8)"
+        )
 
 
-def _run_on_root(comm: MPI.Comm, build: Callable[[], None], own_session: bool) -> tuple[
-        bool | None, str | None]:
+def _run_on_root(
+    comm: MPI.Comm, build: Callable[[], None], own_session: bool
+) -> tuple[bool | None, str | None]:
     """Open a model on rank 0 and run `build` there; the error text is broadcast."""
     error = ""
     fresh, previous = None, None
@@ -127,17 +134,23 @@ def _close(fresh: bool | None, previous: str | None) -> None:
             gmsh.model.setCurrent(previous)
 
 
-def to_dolfinx(comm: MPI.Comm, build: Callable[[], None],
-               partitioner: Callable[..., Any] | None = None,
-               own_session: bool = True) -> MeshData:
+def to_dolfinx(
+    comm: MPI.Comm,
+    build: Callable[[], None],
+    partitioner: Callable[..., Any] | None = None,
+    own_session: bool = True,
+) -> MeshData:
     """Run `build` on rank 0 (in a fresh gmsh model) and return the distributed MeshData."""
     fresh, previous = _run_on_root(comm, build, own_session)
     try:
-        return model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=2,
-                             partitioner=partitioner)
+        return model_to_mesh(
+            gmsh.model if comm.rank == 0 else None, comm, 0, gdim=2, partitioner=partitioner
+        )
     except RuntimeError as exc:  # raised on every rank alike (DOLFINx broadcasts the check)
-        raise MeshError(f"the gmsh mesh cannot be loaded: {exc} (every cell must belong to "
-                        "exactly one physical surface group)") from None
+        raise MeshError(
+            f"the gmsh mesh cannot be loaded: {exc} (every cell must belong to "
+            "exactly one physical surface group)"
+        ) from None
     finally:
         if comm.rank == 0 and own_session:
             _close(fresh, previous)
@@ -174,6 +187,7 @@ def load_meshdata(model_or_path: Any, comm: MPI.Comm, size_factor: float = 1.0) 
     if isinstance(model_or_path, str | Path):
         build = open_mesh_file(Path(model_or_path), size_factor)
         return to_dolfinx(comm, build, balanced_partitioner())
+
     # A model the user built with the gmsh API: mesh it if it has no 2D elements yet.
     def mesh_model() -> None:
         if not len(gmsh.model.mesh.getElements(2)[0]):
@@ -182,9 +196,17 @@ def load_meshdata(model_or_path: Any, comm: MPI.Comm, size_factor: float = 1.0) 
     return to_dolfinx(comm, mesh_model, balanced_partitioner(), own_session=False)
 
 
-def scene_from_gmsh(model_or_path: Any, bodies: dict[str, Material], contacts: list[ContactPair],
-                    dirichlet: list[Dirichlet], loads: list[Load], references: list[Reference],
-                    comm: MPI.Comm, name: str, size_factor: float = 1.0) -> Scene:
+def scene_from_gmsh(
+    model_or_path: Any,
+    bodies: dict[str, Material],
+    contacts: list[ContactPair],
+    dirichlet: list[Dirichlet],
+    loads: list[Load],
+    references: list[Reference],
+    comm: MPI.Comm,
+    name: str,
+    size_factor: float = 1.0,
+) -> Scene:
     """Load the mesh, build the Scene and check it against the mesh's groups."""
     from .checks import check_scene
     from .model import Body
@@ -199,14 +221,27 @@ def scene_from_gmsh(model_or_path: Any, bodies: dict[str, Material], contacts: l
     def resize(factor: float) -> Scene:
         if path is None:
             raise InputError("a scene built from an in-memory gmsh model cannot be remeshed")
-        return scene_from_gmsh(path, bodies, contacts, dirichlet, loads, references, comm,
-                               name, size_factor * factor)
+        return scene_from_gmsh(
+            path, bodies, contacts, dirichlet, loads, references, comm, name, size_factor * factor
+        )
 
-    scene = Scene(data.mesh, data.cell_tags, data.facet_tags, data.ridge_tags, groups,
-                  tuple(Body(k, m) for k, m in bodies.items()), tuple(contacts),
-                  tuple(dirichlet), tuple(loads), tuple(references), name=name,
-                  params={"mesh": str(path) if path is not None else "gmsh model",
-                          "size_factor": size_factor},
-                  resize=resize if path is not None and Path(path).suffix == ".geo" else None)
+    scene = Scene(
+        data.mesh,
+        data.cell_tags,
+        data.facet_tags,
+        data.ridge_tags,
+        groups,
+        tuple(Body(k, m) for k, m in bodies.items()),
+        tuple(contacts),
+        tuple(dirichlet),
+        tuple(loads),
+        tuple(references),
+        name=name,
+        params={
+            "mesh": str(path) if path is not None else "gmsh model",
+            "size_factor": size_factor,
+        },
+        resize=resize if path is not None and Path(path).suffix == ".geo" else None,
+    )
     check_scene(scene)
     return scene

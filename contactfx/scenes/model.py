@@ -120,8 +120,10 @@ class Groups:
         gdim, tag = self.by_name[name]
         if gdim != dim:
             kinds = {0: "point", 1: "curve", 2: "surface"}
-            raise MeshError(f"{what}: physical group '{name}' is a {kinds.get(gdim, gdim)} "
-                            f"group, a {kinds[dim]} group is needed")
+            raise MeshError(
+                f"{what}: physical group '{name}' is a {kinds.get(gdim, gdim)} "
+                f"group, a {kinds[dim]} group is needed"
+            )
         return tag
 
 
@@ -172,19 +174,36 @@ class Scene:
         return dict(self.params)
 
     @classmethod
-    def from_gmsh(cls, model_or_path: Any, *, bodies: dict[str, Material | dict[str, float]],
-                  contacts: list[tuple[str, str]] | list[ContactPair],
-                  dirichlet: list[Dirichlet] | None = None,
-                  loads: list[Load] | None = None,
-                  references: list[Reference] | None = None,
-                  comm: MPI.Comm = MPI.COMM_WORLD, name: str | None = None) -> Scene:
+    def from_gmsh(
+        cls,
+        model_or_path: Any,
+        *,
+        bodies: dict[str, Material | dict[str, float]],
+        contacts: list[tuple[str, str]] | list[ContactPair],
+        dirichlet: list[Dirichlet] | None = None,
+        loads: list[Load] | None = None,
+        references: list[Reference] | None = None,
+        comm: MPI.Comm = MPI.COMM_WORLD,
+        name: str | None = None,
+    ) -> Scene:
         """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path."""
         from .gmsh_io import scene_from_gmsh
 
-        mats = {k: v if isinstance(v, Material) else Material(float(v["E"]), float(v["nu"]))
-                for k, v in bodies.items()}
+        mats = {
+            k: v if isinstance(v, Material) else Material(float(v["E"]), float(v["nu"]))
+            for k, v in bodies.items()
+        }
         pairs = [p if isinstance(p, ContactPair) else ContactPair(*p) for p in contacts]
-        label = name or (Path(model_or_path).stem if isinstance(model_or_path, str | Path)
-                         else "gmsh-model")
-        return scene_from_gmsh(model_or_path, mats, pairs, list(dirichlet or []),
-                               list(loads or []), list(references or []), comm, label)
+        label = name or (
+            Path(model_or_path).stem if isinstance(model_or_path, str | Path) else "gmsh-model"
+        )
+        return scene_from_gmsh(
+            model_or_path,
+            mats,
+            pairs,
+            list(dirichlet or []),
+            list(loads or []),
+            list(references or []),
+            comm,
+            label,
+        )

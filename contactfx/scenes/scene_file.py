@@ -44,8 +44,9 @@ def _keys(where: str, table: Any, allowed: set[str], required: set[str]) -> dict
         raise InputError(f"{where}: expected a table of keys")
     unknown = sorted(set(table) - allowed)
     if unknown:
-        raise InputError(f"{where}: unknown key '{unknown[0]}' (allowed: "
-                         f"{', '.join(sorted(allowed))})")
+        raise InputError(
+            f"{where}: unknown key '{unknown[0]}' (allowed: {', '.join(sorted(allowed))})"
+        )
     missing = sorted(required - set(table))
     if missing:
         raise InputError(f"{where}: missing key '{missing[0]}'")
@@ -78,8 +79,7 @@ def _entries(doc: dict[str, Any], key: str) -> list[Any]:
 def _reference(k: int, entry: Any) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
     if kind not in ("hertz", "uniform_stress"):
-        raise InputError(f"reference {k}: type must be 'hertz' or 'uniform_stress' "
-                         f"(got {kind!r})")
+        raise InputError(f"reference {k}: type must be 'hertz' or 'uniform_stress' (got {kind!r})")
     where = f"reference {k} ({kind})"
     if kind == "hertz":
         e = _keys(where, entry, SECTION_KEYS["reference.hertz"], {"type", "R", "P"})
@@ -95,8 +95,9 @@ def _reference(k: int, entry: Any) -> Reference:
         return HertzReference(pair, R, P, symmetric)
     e = _keys(where, entry, SECTION_KEYS["reference.uniform_stress"], {"type", "sigma"})
     s = e["sigma"]
-    if not (isinstance(s, list) and len(s) == 2 and all(isinstance(r, list) and len(r) == 2
-                                                        for r in s)):
+    if not (
+        isinstance(s, list) and len(s) == 2 and all(isinstance(r, list) and len(r) == 2 for r in s)
+    ):
         raise InputError(f"{where}: sigma must be [[sxx, sxy], [syx, syy]]")
     sig = tuple(tuple(_number(f"{where}.sigma", v) for v in row) for row in s)
     if sig[0][1] != sig[1][0]:
@@ -104,8 +105,11 @@ def _reference(k: int, entry: Any) -> Reference:
     return UniformStress(sig)  # type: ignore[arg-type]
 
 
-def parse_scene_file(path: Path) -> tuple[Path, str, dict[str, Material], list[ContactPair],
-                                          list[Dirichlet], list[Load], list[Reference]]:
+def parse_scene_file(
+    path: Path,
+) -> tuple[
+    Path, str, dict[str, Material], list[ContactPair], list[Dirichlet], list[Load], list[Reference]
+]:
     """Read and check a scene file; return the mesh path and the scene's parts."""
     try:
         doc = tomllib.loads(path.read_text())
@@ -129,8 +133,12 @@ def parse_scene_file(path: Path) -> tuple[Path, str, dict[str, Material], list[C
     pairs = []
     for k, entry in enumerate(_entries(doc, "contact")):
         e = _keys(f"contact {k}", entry, SECTION_KEYS["contact"], {"active", "passive"})
-        pairs.append(ContactPair(_string(f"contact {k}.active", e["active"]),
-                                 _string(f"contact {k}.passive", e["passive"])))
+        pairs.append(
+            ContactPair(
+                _string(f"contact {k}.active", e["active"]),
+                _string(f"contact {k}.passive", e["passive"]),
+            )
+        )
     bcs = []
     for k, entry in enumerate(_entries(doc, "dirichlet")):
         e = _keys(f"dirichlet {k}", entry, SECTION_KEYS["dirichlet"], {"group"})
@@ -141,21 +149,27 @@ def parse_scene_file(path: Path) -> tuple[Path, str, dict[str, Material], list[C
     loads: list[Load] = []
     for k, entry in enumerate(_entries(doc, "pressure")):
         e = _keys(f"pressure {k}", entry, SECTION_KEYS["pressure"], {"group", "p"})
-        loads.append(Pressure(_string(f"pressure {k}.group", e["group"]),
-                              _number(f"pressure {k}.p", e["p"])))
+        loads.append(
+            Pressure(_string(f"pressure {k}.group", e["group"]), _number(f"pressure {k}.p", e["p"]))
+        )
     for k, entry in enumerate(_entries(doc, "traction")):
         e = _keys(f"traction {k}", entry, SECTION_KEYS["traction"], {"group", "t"})
         t = e["t"]
         if not (isinstance(t, list) and len(t) == 2):
             raise InputError(f"traction {k}: t must be a vector [tx, ty]")
-        loads.append(Traction(_string(f"traction {k}.group", e["group"]),
-                              (_number(f"traction {k}.t", t[0]), _number(f"traction {k}.t", t[1]))))
+        loads.append(
+            Traction(
+                _string(f"traction {k}.group", e["group"]),
+                (_number(f"traction {k}.t", t[0]), _number(f"traction {k}.t", t[1])),
+            )
+        )
     refs = [_reference(k, e) for k, e in enumerate(_entries(doc, "reference"))]
     return mesh, name, bodies, pairs, bcs, loads, refs
 
 
-def load_scene_file(path: str | Path, comm: MPI.Comm = MPI.COMM_WORLD,
-                    size_factor: float = 1.0) -> Scene:
+def load_scene_file(
+    path: str | Path, comm: MPI.Comm = MPI.COMM_WORLD, size_factor: float = 1.0
+) -> Scene:
     """The Scene of a TOML scene file (mesh path relative to the file)."""
     from .gmsh_io import scene_from_gmsh
 

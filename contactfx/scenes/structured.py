@@ -16,8 +16,15 @@ from ..errors import InputError
 from .gmsh_io import balanced_partitioner
 
 # Physical groups, named like the gmsh scene's (the numbers themselves are free).
-TAGS = {"body1": (2, 1), "body2": (2, 2), "contact1": (1, 3), "contact2": (1, 4),
-        "symmetry": (1, 5), "support": (1, 6), "load": (1, 7)}
+TAGS = {
+    "body1": (2, 1),
+    "body2": (2, 2),
+    "contact1": (1, 3),
+    "contact2": (1, 4),
+    "symmetry": (1, 5),
+    "support": (1, 6),
+    "load": (1, 7),
+}
 
 
 @dataclass(frozen=True)
@@ -30,10 +37,17 @@ class StructuredMesh:
     physical_groups: dict[str, tuple[int, int]]
 
 
-def build_hertz_structured(comm: MPI.Comm, R: float, width: float, height: float,
-                           h_contact: float, r_refine: float, h_far: float | None = None,
-                           slope: float = 0.1, contact_extent: float | None = None
-                           ) -> StructuredMesh:
+def build_hertz_structured(
+    comm: MPI.Comm,
+    R: float,
+    width: float,
+    height: float,
+    h_contact: float,
+    r_refine: float,
+    h_far: float | None = None,
+    slope: float = 0.1,
+    contact_extent: float | None = None,
+) -> StructuredMesh:
     """The Hertz half model (quarter disc on a block) as a distributed structured quad mesh."""
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
@@ -52,8 +66,7 @@ def build_hertz_structured(comm: MPI.Comm, R: float, width: float, height: float
     tdim = msh.topology.dim
     ncells = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
     body = np.where(np.asarray(msh.topology.original_cell_index)[:ncells] < n_block, 1, 2)
-    cell_tags = dmesh.meshtags(msh, tdim, np.arange(ncells, dtype=np.int32),
-                               body.astype(np.int32))
+    cell_tags = dmesh.meshtags(msh, tdim, np.arange(ncells, dtype=np.int32), body.astype(np.int32))
     msh.topology.create_connectivity(tdim - 1, tdim)
     facets = dmesh.exterior_facet_indices(msh.topology)
     f2c = msh.topology.connectivity(tdim - 1, tdim)
@@ -74,6 +87,7 @@ def build_hertz_structured(comm: MPI.Comm, R: float, width: float, height: float
         values[(values == 0) & in_body & cond] = TAGS[name][1]
     keep = values > 0
     order = np.argsort(facets[keep])
-    facet_tags = dmesh.meshtags(msh, tdim - 1, facets[keep][order].astype(np.int32),
-                                values[keep][order])
+    facet_tags = dmesh.meshtags(
+        msh, tdim - 1, facets[keep][order].astype(np.int32), values[keep][order]
+    )
     return StructuredMesh(msh, cell_tags, facet_tags, dict(TAGS))

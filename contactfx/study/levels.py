@@ -102,9 +102,7 @@ def builtin_levels(
     for k, f in enumerate(factors):
         p = at(params, f)  # type: ignore[arg-type]
         out.append(
-            Level(
-                k, f, builtin_sizes(p), partial(build_scene, kind, p, active=active, comm=comm)
-            )
+            Level(k, f, builtin_sizes(p), partial(build_scene, kind, p, active=active, comm=comm))
         )
     return out
 
