@@ -135,20 +135,7 @@ def _study_parser(sub: Any) -> None:
         "(default 1: the scene as given; e.g. 8 to start coarser)",
     )
     st.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
-    v = s.add_argument_group("linear solver")
-    v.add_argument(
-        "--solver",
-        default="mumps",
-        help="mumps | fieldsplit | fieldsplit-gamg | condensed (multipliers "
-        "eliminated, CG + GAMG; needs --method nts or mortar --basis dual)",
-    )
-    v.add_argument(
-        "--petsc-option",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="extra PETSc option for the saddle-point KSP (no leading dash)",
-    )
+    _solver_options(s)
     o = s.add_argument_group("output")
     o.add_argument(
         "--out",
@@ -163,6 +150,25 @@ def _study_parser(sub: Any) -> None:
         action="store_true",
         help="also log every active-set iteration (default: one line per run)",
     )
+
+
+def _solver_options(p: argparse.ArgumentParser) -> Any:
+    """The linear-solver option group, shared by solve and study."""
+    v = p.add_argument_group("linear solver")
+    v.add_argument(
+        "--solver",
+        default="mumps",
+        help="mumps | fieldsplit | fieldsplit-gamg | condensed (multipliers "
+        "eliminated, CG + GAMG; needs --method nts or mortar --basis dual)",
+    )
+    v.add_argument(
+        "--petsc-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="extra PETSc option for the saddle-point KSP (no leading dash)",
+    )
+    return v
 
 
 def _solve_parser(sub: Any) -> None:
@@ -206,20 +212,7 @@ def _solve_parser(sub: Any) -> None:
         "200k DOFs, for scenes that can be remeshed (the answer does not "
         "depend on it)",
     )
-    v = s.add_argument_group("linear solver")
-    v.add_argument(
-        "--solver",
-        default="mumps",
-        help="mumps | fieldsplit | fieldsplit-gamg | condensed (multipliers "
-        "eliminated, CG + GAMG; needs --method nts or mortar --basis dual)",
-    )
-    v.add_argument(
-        "--petsc-option",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="extra PETSc option for the saddle-point KSP (no leading dash)",
-    )
+    v = _solver_options(s)
     v.add_argument(
         "--reference-timing",
         action="store_true",
