@@ -46,17 +46,25 @@ def main() -> None:
     ap.add_argument("--mesh", default="structured", choices=("structured", "gmsh"))
     ap.add_argument("--basis", default="standard", help="mortar's multiplier basis")
     ap.add_argument("--refine", type=float, required=True, help="h at the contact (cm)")
-    ap.add_argument("--refine-edge", type=float, default=None,
-                    help="gmsh: h at x = a (cm); default refine / 4")
+    ap.add_argument(
+        "--refine-edge", type=float, default=None, help="gmsh: h at x = a (cm); default refine / 4"
+    )
     ap.add_argument("--h-far", type=float, required=True, help="largest element size (cm)")
     ap.add_argument("--option", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--no-reference", action="store_true")
-    ap.add_argument("--predictor", default="auto", choices=("auto", "coarse", "none"),
-                    help="first active set from a solve with 8x coarser sizes (timed as "
-                    "'predictor', part of the contact solve); auto: the library's default")
-    ap.add_argument("--fixed-set", action="store_true",
-                    help="no active-set loop: one fresh solve with the Hertz zone x < a active "
-                    "(the iterative path's scaling of linear iterations)")
+    ap.add_argument(
+        "--predictor",
+        default="auto",
+        choices=("auto", "coarse", "none"),
+        help="first active set from a solve with 8x coarser sizes (timed as "
+        "'predictor', part of the contact solve); auto: the library's default",
+    )
+    ap.add_argument(
+        "--fixed-set",
+        action="store_true",
+        help="no active-set loop: one fresh solve with the Hertz zone x < a active "
+        "(the iterative path's scaling of linear iterations)",
+    )
     args = ap.parse_args()
     comm = MPI.COMM_WORLD
     solver: str | dict[str, object] = args.solver
@@ -67,16 +75,26 @@ def main() -> None:
             options[key] = value
         solver = options
     edge = args.refine / 4 if args.refine_edge is None else args.refine_edge
-    params = HertzParams(refine=args.refine, h_far=args.h_far, mesh=args.mesh,
-                         **({"refine_edge": edge} if args.mesh == "gmsh" else {}))
+    params = HertzParams(
+        refine=args.refine,
+        h_far=args.h_far,
+        mesh=args.mesh,
+        **({"refine_edge": edge} if args.mesh == "gmsh" else {}),
+    )
     comm.Barrier()
     t0 = time.perf_counter()
     mesh_timers = Timers()
     with mesh_timers("mesh"):
         scene = hertz(params, comm=comm)
-    common = {"solver": args.solver, "ranks": comm.size, "mesh": args.mesh, "basis": args.basis,
-              "refine": args.refine, "h_far": args.h_far,
-              "refine_edge": edge if args.mesh == "gmsh" else None}
+    common = {
+        "solver": args.solver,
+        "ranks": comm.size,
+        "mesh": args.mesh,
+        "basis": args.basis,
+        "refine": args.refine,
+        "h_far": args.h_far,
+        "refine_edge": edge if args.mesh == "gmsh" else None,
+    }
     for method in args.method.split(","):
         gc.collect()  # the previous method's PETSc objects
         timers = Timers()
@@ -88,30 +106,51 @@ def main() -> None:
         else:
             try:
                 basis = args.basis if method == "mortar" else "standard"
-                sol = solve(scene, method, solver=solver, timers=timers, basis=basis,
-                            reference_timing=not args.no_reference, predictor=args.predictor)
+                sol = solve(
+                    scene,
+                    method,
+                    solver=solver,
+                    timers=timers,
+                    basis=basis,
+                    reference_timing=not args.no_reference,
+                    predictor=args.predictor,
+                )
             except Exception as err:  # one method's failure must not hide the others
                 if comm.rank == 0:
-                    print("RESULT " + json.dumps({**common, "method": method,
-                                                  "error": f"{type(err).__name__}: {err}"}),
-                          flush=True)
+                    print(
+                        "RESULT "
+                        + json.dumps(
+                            {**common, "method": method, "error": f"{type(err).__name__}: {err}"}
+                        ),
+                        flush=True,
+                    )
                 continue
             V = sol.elasticity.V
             record = {
                 "predictor": "predictor" in timers.seconds,
                 "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
-                "multipliers": int(sol.layout.size), "active_nodes": int(sol.active.sum()),
+                "multipliers": int(sol.layout.size),
+                "active_nodes": int(sol.active.sum()),
                 "iterations": sol.iterations,
-                "history": [{k: (float(v) if not isinstance(v, int) else v)
-                             for k, v in h.items()} for h in sol.history],
-                "contact_force_error": abs(float((sol.pressure * sol.layout.weights).sum())
-                                           - scene.params["P"] / 2) / (scene.params["P"] / 2),
+                "history": [
+                    {k: (float(v) if not isinstance(v, int) else v) for k, v in h.items()}
+                    for h in sol.history
+                ],
+                "contact_force_error": abs(
+                    float((sol.pressure * sol.layout.weights).sum()) - scene.params["P"] / 2
+                )
+                / (scene.params["P"] / 2),
             }
         comm.Barrier()
         times = {k: comm.allreduce(v, op=MPI.MAX) for k, v in timers.seconds.items()}
         times["total"] = time.perf_counter() - t_run + times["mesh"]
-        record.update(common, method=method, times=times, since_start=time.perf_counter() - t0,
-                      peak_rss_mb=comm.allreduce(peak_rss_mb()))
+        record.update(
+            common,
+            method=method,
+            times=times,
+            since_start=time.perf_counter() - t0,
+            peak_rss_mb=comm.allreduce(peak_rss_mb()),
+        )
         if comm.rank == 0:
             print("RESULT " + json.dumps(record), flush=True)
 
@@ -128,17 +167,21 @@ def fixed_set_solve(scene, method: Method, options: dict, timers: Timers) -> dic
     setup = prepare_contact(scene, method.operator, ActiveSetOptions().penetration_tol, timers)
     el, layout = setup.elasticity, setup.layout
     V = el.V
-    gamma = (max(b.material.E for b in scene.bodies) / setup.h**2 if uses_augmentation(options)
-             else 0.0)
+    gamma = (
+        max(b.material.E for b in scene.bodies) / setup.h**2 if uses_augmentation(options) else 0.0
+    )
     active = layout.x[layout.mine, 0] < scene.params["hertz_exact"]["a"]
     nsp = near_nullspace(V, scene) if uses_augmentation(options) else None
     res, seconds = reference_solve(el.K, setup.B, el.f, setup.g, active, options, gamma, nsp)
     setup.B.destroy()
     timers.seconds["reference_solve"] = seconds
-    return {"dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
-            "multipliers": int(layout.size),
-            "active_nodes": comm.allreduce(int(active.sum())), "iterations": 1,
-            "linear_iterations": res.iterations}
+    return {
+        "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+        "multipliers": int(layout.size),
+        "active_nodes": comm.allreduce(int(active.sum())),
+        "iterations": 1,
+        "linear_iterations": res.iterations,
+    }
 
 
 if __name__ == "__main__":

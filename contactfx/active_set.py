@@ -34,9 +34,9 @@ class ActiveSetOptions:
 
     max_iterations: int = 50
     penetration_tol: float = 1e-6  # allowed initial penetration relative to the element size
-    tolerance: float = 1e-6        # complementarity residual (relative) required at the end
-    predictor: bool = True         # probe candidate sets with multi-RHS solves (direct solvers)
-    max_probes: int = 2000         # largest candidate set probed
+    tolerance: float = 1e-6  # complementarity residual (relative) required at the end
+    predictor: bool = True  # probe candidate sets with multi-RHS solves (direct solvers)
+    max_probes: int = 2000  # largest candidate set probed
     # With cheap probe responses (serial MUMPS: selected entries of the inverse), start from
     # every multiplier row in contact and probe them all: one factorization, the predicted
     # set by the small complementarity problem, then one solve that only releases rows.
@@ -56,8 +56,7 @@ class InitialSet:
     uncertain: Callable[[np.ndarray], np.ndarray] | None = None
 
 
-def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0
-                       ) -> InitialSet:
+def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0) -> InitialSet:
     """An InitialSet from the solution of the same scene on a coarser mesh.
 
     In contact: nodes within `margin` coarse elements of a coarse active node; uncertain:
@@ -119,8 +118,9 @@ class SetHistory:
         rhs[rows, np.searchsorted(probe, self.mine[rows])] = 1.0
         return rhs
 
-    def predict(self, probe: np.ndarray, lam: np.ndarray, dmu: np.ndarray,
-                active: np.ndarray) -> np.ndarray | None:
+    def predict(
+        self, probe: np.ndarray, lam: np.ndarray, dmu: np.ndarray, active: np.ndarray
+    ) -> np.ndarray | None:
         """Active set (local mask) solving the complementarity problem restricted to `probe`.
 
         Rows of `active` (local mask) outside `probe` stay as they are.
@@ -138,8 +138,7 @@ class SetHistory:
         return mask[self.mine]
 
 
-def lcp_active_set(k: np.ndarray, lam0: np.ndarray, max_iterations: int = 100
-                   ) -> np.ndarray | None:
+def lcp_active_set(k: np.ndarray, lam0: np.ndarray, max_iterations: int = 100) -> np.ndarray | None:
     """Active set of lam = lam0 + k s >= 0, s >= 0, lam s = 0 by dense primal-dual steps.
 
     Starts from everything in contact (lam0 itself); returns None on cycling, on an empty
@@ -174,12 +173,12 @@ def lcp_active_set(k: np.ndarray, lam0: np.ndarray, max_iterations: int = 100
 class Step:
     """One solve on a given set: owned-row tractions and gaps, the updated set, what it cost."""
 
-    lam: np.ndarray            # contact traction per owned row (compression > 0)
-    gap: np.ndarray            # normalized gap per owned row at the solution
-    new_active: np.ndarray     # the semi-smooth Newton update of the set
-    residual: float            # relative complementarity residual (0 where not defined)
+    lam: np.ndarray  # contact traction per owned row (compression > 0)
+    gap: np.ndarray  # normalized gap per owned row at the solution
+    new_active: np.ndarray  # the semi-smooth Newton update of the set
+    residual: float  # relative complementarity residual (0 where not defined)
     record: dict[str, float] = field(default_factory=dict)  # extra history columns
-    text: str = ""             # extra words for the log line
+    text: str = ""  # extra words for the log line
 
 
 class Iteration(Protocol):
@@ -201,9 +200,13 @@ class Iteration(Protocol):
         ...
 
 
-def run_active_set(setup: ContactSetup, iteration: Iteration, active: np.ndarray,
-                   aso: ActiveSetOptions, timers: Timers
-                   ) -> tuple[Step, np.ndarray, list[dict[str, float]]]:
+def run_active_set(
+    setup: ContactSetup,
+    iteration: Iteration,
+    active: np.ndarray,
+    aso: ActiveSetOptions,
+    timers: Timers,
+) -> tuple[Step, np.ndarray, list[dict[str, float]]]:
     """Iterate until the active set is stationary; return the last step, set and history."""
     comm = setup.scene.comm
     state = SetHistory(comm, setup.layout.mine, setup.layout.size)
@@ -221,18 +224,39 @@ def run_active_set(setup: ContactSetup, iteration: Iteration, active: np.ndarray
         resid = step.residual
         entered = comm.allreduce(int(np.sum(step.new_active & ~active)))
         left = comm.allreduce(int(np.sum(active & ~step.new_active)))
-        history.append({"iteration": it, "active": n_active, "entered": entered, "left": left,
-                        "residual": resid, **step.record, "solve_time": t_solve})
+        history.append(
+            {
+                "iteration": it,
+                "active": n_active,
+                "entered": entered,
+                "left": left,
+                "residual": resid,
+                **step.record,
+                "solve_time": t_solve,
+            }
+        )
         if comm.rank == 0:
-            log.info("%s %2d: %5d active, +%d -%d, %s%.3f s", iteration.label, it, n_active,
-                     entered, left, step.text, t_solve)
+            log.info(
+                "%s %2d: %5d active, +%d -%d, %s%.3f s",
+                iteration.label,
+                it,
+                n_active,
+                entered,
+                left,
+                step.text,
+                t_solve,
+            )
         if entered == 0 and left == 0:
             if resid > aso.tolerance:
-                raise ActiveSetError(f"active set is stationary at iteration {it} but the "
-                                     f"complementarity residual {resid:.2e} exceeds "
-                                     f"{aso.tolerance:.1e}: the linear solves are too inexact")
+                raise ActiveSetError(
+                    f"active set is stationary at iteration {it} but the "
+                    f"complementarity residual {resid:.2e} exceeds "
+                    f"{aso.tolerance:.1e}: the linear solves are too inexact"
+                )
             return step, active, history
         proposed = iteration.next_set(active, step, entered)
         active = step.new_active if proposed is None else proposed
-    raise ActiveSetError(f"active set did not converge in {aso.max_iterations} iterations "
-                         f"(last change: +{entered} -{left}, residual {resid:.2e})")
+    raise ActiveSetError(
+        f"active set did not converge in {aso.max_iterations} iterations "
+        f"(last change: +{entered} -{left}, residual {resid:.2e})"
+    )

@@ -55,18 +55,31 @@ def use_coarse(predictor: str, scene: Scene, options: Mapping[str, object]) -> b
     return predictor == "coarse"
 
 
-def coarse_prediction(coarse: Scene, method: Method, options: Mapping[str, object],
-                      max_iterations: int = 50, basis: str = "standard") -> InitialSet:
+def coarse_prediction(
+    coarse: Scene,
+    method: Method,
+    options: Mapping[str, object],
+    max_iterations: int = 50,
+    basis: str = "standard",
+) -> InitialSet:
     """Solve `coarse` (the same scene, coarser) and turn its contact zone into an InitialSet."""
     sol = solve_contact(coarse, method, options, ActiveSetOptions(max_iterations), basis=basis)
     return coarse_initial_set(sol)
 
 
-def solve(scene: Scene, method: Method | str = Method.MORTAR, *,
-          solver: str | Mapping[str, object] = "mumps", max_iterations: int = 50,
-          penalty: float | None = None, schwarz: SchwarzOptions | None = None,
-          reference_timing: bool = False, predictor: str = "auto",
-          timers: Timers | None = None, basis: str = "standard") -> Solution:
+def solve(
+    scene: Scene,
+    method: Method | str = Method.MORTAR,
+    *,
+    solver: str | Mapping[str, object] = "mumps",
+    max_iterations: int = 50,
+    penalty: float | None = None,
+    schwarz: SchwarzOptions | None = None,
+    reference_timing: bool = False,
+    predictor: str = "auto",
+    timers: Timers | None = None,
+    basis: str = "standard",
+) -> Solution:
     """Solve the frictionless contact problem of `scene` with `method`.
 
     `predictor` "coarse" starts the active-set loop from a solve of the same scene with mesh
@@ -78,9 +91,12 @@ def solve(scene: Scene, method: Method | str = Method.MORTAR, *,
     if basis != "standard" and method != Method.MORTAR:
         raise InputError(f"the {basis} multiplier basis applies to the mortar method only")
     if method == Method.SCHWARZ and (solver if isinstance(solver, str) else dict(solver)) not in (
-            "mumps", dict(SOLVERS["mumps"])):
-        raise InputError("schwarz factorizes each body with MUMPS: the solver option does "
-                         "not apply to it")
+        "mumps",
+        dict(SOLVERS["mumps"]),
+    ):
+        raise InputError(
+            "schwarz factorizes each body with MUMPS: the solver option does not apply to it"
+        )
     if isinstance(solver, str) and solver not in SOLVERS:
         raise InputError(f"unknown solver '{solver}' (choose {', '.join(SOLVERS)})")
     options = SOLVERS[solver] if isinstance(solver, str) else solver
@@ -93,32 +109,54 @@ def solve(scene: Scene, method: Method | str = Method.MORTAR, *,
         sol.info.update({"penalty": sol.history[-1]["penalty"], "penetration": penetration(sol)})
         return sol
     if method == Method.SCHWARZ:
-        return solve_schwarz(scene, schwarz or SchwarzOptions(max_iterations=max_iterations),
-                             timers)
+        return solve_schwarz(
+            scene, schwarz or SchwarzOptions(max_iterations=max_iterations), timers
+        )
     init = None
     if scene.resize is not None and use_coarse(predictor, scene, options):
         with timers("predictor"):
             coarse = scene.resize(COARSE_FACTOR)
             init = coarse_prediction(coarse, method, options, max_iterations, basis)
-    return solve_contact(scene, method, options, aso, timers,
-                         reference_timing=reference_timing, initial_active=init, basis=basis)
+    return solve_contact(
+        scene,
+        method,
+        options,
+        aso,
+        timers,
+        reference_timing=reference_timing,
+        initial_active=init,
+        basis=basis,
+    )
 
 
-def run_scene(scene: Scene, method: Method | str = Method.MORTAR, *,
-              solver: str | Mapping[str, object] = "mumps", t_start: float | None = None,
-              timers: Timers | None = None, **options: Any) -> tuple[Solution, dict[str, Any]]:
+def run_scene(
+    scene: Scene,
+    method: Method | str = Method.MORTAR,
+    *,
+    solver: str | Mapping[str, object] = "mumps",
+    t_start: float | None = None,
+    timers: Timers | None = None,
+    **options: Any,
+) -> tuple[Solution, dict[str, Any]]:
     """Solve `scene` and return the solution with its JSON summary (times from `t_start`)."""
     t_start = time.perf_counter() if t_start is None else t_start
     timers = timers or Timers()
     sol = solve(scene, method, solver=solver, timers=timers, **options)
-    times = {k: timers.seconds.get(k, 0.0)
-             for k in ("mesh", "assemble", "search", "contact", "solve")}
+    times = {
+        k: timers.seconds.get(k, 0.0) for k in ("mesh", "assemble", "search", "contact", "solve")
+    }
     for key in ("predictor", "reference_solve"):
         if key in timers.seconds:
             times[key] = timers.seconds[key]
     times["total"] = time.perf_counter() - t_start
-    return sol, summary(sol, times, {"solver": solver if isinstance(solver, str) else "custom",
-                                     "memory": peak_memory(scene.comm)})
+    return sol, summary(
+        sol,
+        times,
+        {
+            "solver": solver if isinstance(solver, str) else "custom",
+            "memory": peak_memory(scene.comm),
+        },
+    )
 
 
 def peak_memory(comm: MPI.Comm) -> dict[str, float]:
@@ -127,21 +165,39 @@ def peak_memory(comm: MPI.Comm) -> dict[str, float]:
 
     # ru_maxrss is in kilobytes on Linux.
     mine = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    return {"peak_mb": float(comm.allreduce(mine)),
-            "peak_mb_max_rank": float(comm.allreduce(mine, op=MPI.MAX))}
+    return {
+        "peak_mb": float(comm.allreduce(mine)),
+        "peak_mb_max_rank": float(comm.allreduce(mine, op=MPI.MAX)),
+    }
 
 
-def run_case(kind: str, params: BlockParams | HertzParams, method: Method | str,
-             active: int = 2, solver: str | Mapping[str, object] = "mumps",
-             max_iterations: int = 50, comm: MPI.Comm = MPI.COMM_WORLD,
-             penalty: float | None = None, schwarz: SchwarzOptions | None = None,
-             reference_timing: bool = False, predictor: str = "auto"
-             ) -> tuple[Solution, dict[str, Any]]:
+def run_case(
+    kind: str,
+    params: BlockParams | HertzParams,
+    method: Method | str,
+    active: int = 2,
+    solver: str | Mapping[str, object] = "mumps",
+    max_iterations: int = 50,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    penalty: float | None = None,
+    schwarz: SchwarzOptions | None = None,
+    reference_timing: bool = False,
+    predictor: str = "auto",
+) -> tuple[Solution, dict[str, Any]]:
     """Mesh, assemble and solve a built-in scene; return the solution and its JSON summary."""
     t_start = time.perf_counter()
     timers = Timers()
     with timers("mesh"):
         scene = build_scene(kind, params, active=active, comm=comm)
-    return run_scene(scene, method, solver=solver, t_start=t_start, timers=timers,
-                     max_iterations=max_iterations, penalty=penalty, schwarz=schwarz,
-                     reference_timing=reference_timing, predictor=predictor)
+    return run_scene(
+        scene,
+        method,
+        solver=solver,
+        t_start=t_start,
+        timers=timers,
+        max_iterations=max_iterations,
+        penalty=penalty,
+        schwarz=schwarz,
+        reference_timing=reference_timing,
+        predictor=predictor,
+    )

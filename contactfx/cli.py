@@ -209,8 +209,9 @@ def _solve_parser(sub: Any) -> None:
         choices=["auto", "coarse", "none"],
         default="auto",
         help="first active set from a coarser solve of the same scene: auto = above "
-        "200k DOFs, for scenes that can be remeshed (the answer does not "
-        "depend on it)",
+        "200k DOFs on several ranks, always for --solver condensed, never for serial MUMPS "
+        "(which probes every row from its selected inverse); the answer does not depend "
+        "on it",
     )
     v = _solver_options(s)
     v.add_argument(

@@ -35,8 +35,13 @@ from .solution import Solution
 from .solvers import SOLVERS, is_direct, uses_augmentation
 from .timers import Timers
 
-__all__ = ["ActiveSetOptions", "InitialSet", "coarse_initial_set", "lcp_active_set",
-           "solve_contact"]
+__all__ = [
+    "ActiveSetOptions",
+    "InitialSet",
+    "coarse_initial_set",
+    "lcp_active_set",
+    "solve_contact",
+]
 
 
 DEFAULT_OPTIONS = ActiveSetOptions()
@@ -47,15 +52,21 @@ class MultiplierIteration:
 
     label = "active set"
 
-    def __init__(self, setup: ContactSetup, solver: SaddleSolver | CondensedSolver,
-                 aso: ActiveSetOptions,
-                 c: float, direct: bool, given_start: bool) -> None:
+    def __init__(
+        self,
+        setup: ContactSetup,
+        solver: SaddleSolver | CondensedSolver,
+        aso: ActiveSetOptions,
+        c: float,
+        direct: bool,
+        given_start: bool,
+    ) -> None:
         self.setup, self.solver, self.aso, self.c = setup, solver, aso, c
         self.direct, self.given_start = direct, given_start
         layout = setup.layout
         self.state = SetHistory(setup.scene.comm, layout.mine, layout.size)
         self.u = fem.Function(setup.elasticity.V, name="u")
-        self.probe: np.ndarray | None = None   # global indices of the candidates probed
+        self.probe: np.ndarray | None = None  # global indices of the candidates probed
         self.band = np.zeros(len(layout.mine), dtype=bool)  # rows the first set is unsure of
         self._probes: np.ndarray | None = None
 
@@ -77,8 +88,13 @@ class MultiplierIteration:
         if guess is None:
             layout = self.setup.layout
             size = layout.size
-            if not (self.aso.start_all and self.aso.predictor and self.direct
-                    and self.solver.cheap_responses and 0 < size <= self.aso.max_probes):
+            if not (
+                self.aso.start_all
+                and self.aso.predictor
+                and self.direct
+                and self.solver.cheap_responses
+                and 0 < size <= self.aso.max_probes
+            ):
                 return active
             node = np.asarray(layout.gblock)
             counts = np.unique(node, return_counts=True)
@@ -116,10 +132,14 @@ class MultiplierIteration:
         resid = np.sqrt(comm.allreduce(float(np.sum(w * ncp**2)), op=MPI.SUM))
         resid /= max(lam_max * np.sqrt(comm.allreduce(float(w.sum()))), 1e-300)
         n_probes = 0 if self.probe is None else len(self.probe)
-        record: dict[str, float] = {"linear_iterations": res.iterations, "probes": n_probes,
-                  "factorized": int(bool(res.info.get("refactored", True)))}
-        text = (f"complementarity {resid:.2e}, {res.iterations} linear its, "
-                + (f"{n_probes} probes, " if n_probes else ""))
+        record: dict[str, float] = {
+            "linear_iterations": res.iterations,
+            "probes": n_probes,
+            "factorized": int(bool(res.info.get("refactored", True))),
+        }
+        text = f"complementarity {resid:.2e}, {res.iterations} linear its, " + (
+            f"{n_probes} probes, " if n_probes else ""
+        )
         return Step(lam, gap, new_active, float(resid), record, text)
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
@@ -152,11 +172,16 @@ class MultiplierIteration:
         return None
 
 
-def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, object] = "mumps",
-                  aso: ActiveSetOptions = DEFAULT_OPTIONS,
-                  timers: Timers | None = None, reference_timing: bool = False,
-                  initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None,
-                  basis: str = "standard") -> Solution:
+def solve_contact(
+    scene: Scene,
+    method: Method,
+    solver: str | Mapping[str, object] = "mumps",
+    aso: ActiveSetOptions = DEFAULT_OPTIONS,
+    timers: Timers | None = None,
+    reference_timing: bool = False,
+    initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None,
+    basis: str = "standard",
+) -> Solution:
     """Solve the frictionless unilateral contact problem of `scene` with `method`.
 
     `initial_active` (node coordinates -> bool, or an InitialSet) adds nodes to the first
@@ -164,11 +189,15 @@ def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, objec
     "dual" takes mortar's biorthogonal multipliers (D diagonal).
     """
     if method not in IMPLEMENTED:
-        raise InputError(f"method '{method.value}' is not implemented yet "
-                         f"(available: {', '.join(sorted(m.value for m in IMPLEMENTED))})")
+        raise InputError(
+            f"method '{method.value}' is not implemented yet "
+            f"(available: {', '.join(sorted(m.value for m in IMPLEMENTED))})"
+        )
     if method in (Method.PENALTY, Method.SCHWARZ):
-        raise InputError(f"the {method.value} method has no saddle-point multipliers: call "
-                         "contactfx.solve (it dispatches every method)")
+        raise InputError(
+            f"the {method.value} method has no saddle-point multipliers: call "
+            "contactfx.solve (it dispatches every method)"
+        )
     options = SOLVERS[solver] if isinstance(solver, str) else solver
     timers = timers or Timers()
     if basis != "standard" and method != Method.MORTAR:
@@ -180,22 +209,29 @@ def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, objec
     gamma = e_max / h**2 if uses_augmentation(options) else 0.0
     condensed = is_condensed(options)
     if condensed and not (method == Method.NTS or (method == Method.MORTAR and basis == "dual")):
-        raise InputError("the condensed solver needs a diagonal D: use --method nts or "
-                         "--method mortar --basis dual")
+        raise InputError(
+            "the condensed solver needs a diagonal D: use --method nts or "
+            "--method mortar --basis dual"
+        )
     # One solver for the whole loop: fixed matrix pattern, reused analysis and factorization.
     nullspace = near_nullspace(el.V, scene) if uses_augmentation(options) else None
     saddle: SaddleSolver | CondensedSolver
     if condensed:
         node_dofs = owned_node_dofs(setup.layout.gblock, setup.layout.mine)
-        saddle = CondensedSolver(el.K, setup.B, el.f, options, node_dofs,
-                                 rigid_body_modes(el.V, scene))
+        saddle = CondensedSolver(
+            el.K, setup.B, el.f, options, node_dofs, rigid_body_modes(el.V, scene)
+        )
     else:
         saddle = SaddleSolver(el.K, setup.B, el.f, options, gamma, nullspace)
-    guess = (initial_active if isinstance(initial_active, InitialSet) or initial_active is None
-             else InitialSet(initial_active))
+    guess = (
+        initial_active
+        if isinstance(initial_active, InitialSet) or initial_active is None
+        else InitialSet(initial_active)
+    )
     # Probes need the exact inverse: only a factorization of the whole saddle point gives it.
-    iteration = MultiplierIteration(setup, saddle, aso, e_max / h, is_direct(options),
-                                    guess is not None)
+    iteration = MultiplierIteration(
+        setup, saddle, aso, e_max / h, is_direct(options), guess is not None
+    )
     active = iteration.start(setup.initial_active(aso.penetration_tol * h), guess)
     try:
         step, active, history = run_active_set(setup, iteration, active, aso, timers)
@@ -205,14 +241,16 @@ def solve_contact(scene: Scene, method: Method, solver: str | Mapping[str, objec
         # The cost floor: one fresh solve of the final system by the same solver.
         scene.comm.Barrier()
         t0 = time.perf_counter()
-        fresh = CondensedSolver(el.K, setup.B, el.f, options, node_dofs,
-                                rigid_body_modes(el.V, scene))
+        fresh = CondensedSolver(
+            el.K, setup.B, el.f, options, node_dofs, rigid_body_modes(el.V, scene)
+        )
         fresh.solve(setup.g, active)
         fresh.destroy()
         timers.seconds["reference_solve"] = time.perf_counter() - t0
     elif reference_timing:
         _, timers.seconds["reference_solve"] = reference_solve(
-            el.K, setup.B, el.f, setup.g, active, options, gamma, nullspace)
+            el.K, setup.B, el.f, setup.g, active, options, gamma, nullspace
+        )
     sol = setup.solution(method, iteration.u, step.lam, step.gap, active, history, timers)
     if basis != "standard":
         sol.info["basis"] = basis

@@ -7,14 +7,18 @@ keeps its ordering and symbolic analysis). With a direct solver it goes further:
 active set differs from the factorized one in a few rows is a low-rank change, which GMRES
 preconditioned by the old factorization solves in a few iterations; it refactors only when
 that would cost more than a new numeric factorization. Multiplier responses (probes) come from
-MUMPS' selected entries of the inverse (ICNTL(30)) where that is available: a few
-milliseconds for what costs one back-substitution per column as dense right-hand sides.
+MUMPS' selected entries of the inverse (ICNTL(30), `mumps_inverse.py`) where that is
+available: a few milliseconds for what costs one back-substitution per column as dense
+right-hand sides.
+
+Why one module of ~600 lines: the factorization-reuse policy (fresh, lagged, released rows
+by a capacitance system, probes) is one state machine over one factorization; every path
+reads and updates the same cached set, timings and PETSc objects, so split across modules
+each part would need the whole solver passed in.
 """
 
 from __future__ import annotations
 
-import ctypes
-import functools
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -26,6 +30,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from .errors import SolverError
+from .mumps_inverse import inverse_entries, selected_inverse_available
 from .solvers import PrefixedOptions, is_direct, petsc_error_message, reason_name
 
 # Largest set of released rows solved by a capacitance system instead of a refactorization.
@@ -43,35 +48,6 @@ _APPLY_RTOL = 1e-7
 _RELEASED_RTOL = 1e-8
 
 
-@functools.cache
-def _petsc_library() -> ctypes.CDLL | None:
-    """The libpetsc that petsc4py loaded (for MUMPS calls petsc4py does not wrap), or None."""
-    try:
-        with open("/proc/self/maps") as maps:
-            paths = {line.split()[-1] for line in maps if "libpetsc" in line.rsplit("/", 1)[-1]}
-        for path in sorted(paths):
-            lib = ctypes.CDLL(path)
-            if hasattr(lib, "MatMumpsGetInverse") and hasattr(lib, "MatMumpsSetIcntl"):
-                lib.MatMumpsGetInverse.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
-                lib.MatMumpsGetIcntl.argtypes = [ctypes.c_void_p, ctypes.c_int,
-                                                 ctypes.POINTER(ctypes.c_int)]
-                lib.MatMumpsSetIcntl.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
-                return lib
-    except OSError:
-        pass
-    return None
-
-
-def selected_inverse_available(options: Mapping[str, object], ranks: int) -> bool:
-    """Whether a solve with `options` on `ranks` ranks gets probe responses cheaply.
-
-    That is MUMPS' LU of the whole saddle point on one rank (see SaddleSolver.cheap_responses).
-    """
-    return (ranks == 1 and options.get("pc_type") == "lu"
-            and options.get("pc_factor_mat_solver_type") == "mumps"
-            and _petsc_library() is not None)
-
-
 @dataclass
 class SaddleResult:
     """Solution blocks (owned parts) and what the Krylov solver reported."""
@@ -86,11 +62,17 @@ class SaddleResult:
 def _diagonal_matrix(comm: PETSc.Comm, values: np.ndarray, offset: int) -> PETSc.Mat:
     """A square AIJ matrix with `values` on this rank's diagonal rows (global first row offset)."""
     m = len(values)
-    csr = (np.arange(m + 1, dtype=PETSc.IntType), np.arange(offset, offset + m,
-           dtype=PETSc.IntType), np.asarray(values, dtype=PETSc.ScalarType))
+    csr = (
+        np.arange(m + 1, dtype=PETSc.IntType),
+        np.arange(offset, offset + m, dtype=PETSc.IntType),
+        np.asarray(values, dtype=PETSc.ScalarType),
+    )
     # The stub asks for Sequences; petsc4py takes (and converts) numpy arrays.
-    C = PETSc.Mat().createAIJ(size=((m, PETSc.DETERMINE), (m, PETSc.DETERMINE)), csr=csr,  # type: ignore[arg-type]
-                              comm=comm)
+    C = PETSc.Mat().createAIJ(
+        size=((m, PETSc.DETERMINE), (m, PETSc.DETERMINE)),
+        csr=csr,  # type: ignore[arg-type]
+        comm=comm,
+    )
     C.assemble()
     return C
 
@@ -108,9 +90,16 @@ def schur_al_diagonal(active: np.ndarray, gamma: float, inactive: float = 1.0) -
 class SaddleSolver:
     """A persistent saddle-point solver for one (K, B, f): call `solve(g, active)` repeatedly."""
 
-    def __init__(self, K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, options: Mapping[str, object],
-                 gamma: float = 0.0, nullspace: PETSc.NullSpace | None = None,
-                 reuse_factorization: bool = True) -> None:
+    def __init__(
+        self,
+        K: PETSc.Mat,
+        B: PETSc.Mat,
+        f: PETSc.Vec,
+        options: Mapping[str, object],
+        gamma: float = 0.0,
+        nullspace: PETSc.NullSpace | None = None,
+        reuse_factorization: bool = True,
+    ) -> None:
         self.options = dict(options)
         self.gamma = gamma
         self.direct = is_direct(self.options)
@@ -163,9 +152,17 @@ class SaddleSolver:
             # GMRES around the LU: one iteration with a fresh factorization, a few with a
             # lagged one (the change is low-rank); right preconditioning tests the true
             # residual, modified Gram-Schmidt keeps the basis orthogonal down to round-off.
-            keys.update({"ksp_type": "gmres", "ksp_pc_side": "right", "ksp_rtol": 1e-13,
-                         "ksp_atol": 0.0, "ksp_max_it": 120, "ksp_gmres_restart": 120,
-                         "ksp_gmres_modifiedgramschmidt": True})
+            keys.update(
+                {
+                    "ksp_type": "gmres",
+                    "ksp_pc_side": "right",
+                    "ksp_rtol": 1e-13,
+                    "ksp_atol": 0.0,
+                    "ksp_max_it": 120,
+                    "ksp_gmres_restart": 120,
+                    "ksp_gmres_modifiedgramschmidt": True,
+                }
+            )
         self._options = PrefixedOptions(keys)
         self._ksp = PETSc.KSP().create(comm)
         self._ksp.setOptionsPrefix(self._options.prefix)
@@ -235,13 +232,18 @@ class SaddleSolver:
             self._rhs_u.axpy(1.0, tmp)
             tmp.destroy()
         if self._Sp is not None:
-            diag.array[:] = (schur_al_diagonal(active, self.gamma, self._c_inactive)
-                             if self.gamma > 0 else self._c_inactive)
+            diag.array[:] = (
+                schur_al_diagonal(active, self.gamma, self._c_inactive)
+                if self.gamma > 0
+                else self._c_inactive
+            )
             self._Sp.setDiagonal(diag)
         diag.destroy()
         self._A.assemble()
-        for iset, values in ((self._is_u, self._rhs_u.array_r),
-                             (self._is_l, np.where(active, -g, 0.0))):
+        for iset, values in (
+            (self._is_u, self._rhs_u.array_r),
+            (self._is_l, np.where(active, -g, 0.0)),
+        ):
             sub = self._b.getSubVector(iset)
             sub.array[:] = values
             self._b.restoreSubVector(iset, sub)
@@ -268,8 +270,9 @@ class SaddleSolver:
             return -1
         return self._mpi.allreduce(int(np.count_nonzero(active != self._factored)))
 
-    def solve(self, g: np.ndarray, active: np.ndarray,
-              probes: np.ndarray | None = None) -> SaddleResult:
+    def solve(
+        self, g: np.ndarray, active: np.ndarray, probes: np.ndarray | None = None
+    ) -> SaddleResult:
         """Solve with the rows of `active` enforced as equalities and mu = 0 elsewhere.
 
         `probes` (local rows x k), if given, are extra right-hand sides of the multiplier block
@@ -287,18 +290,27 @@ class SaddleSolver:
         changed = self._changed(active)
         if probes is not None and self.direct:
             changed = -1  # the multi-RHS probes need the exact factorization of this set
-        if (self.reuse and self.gamma == 0.0 and probes is None and self.policy != "refactor"
-                and 0 < changed <= _MAX_RELEASED and self._factored is not None
-                and not self._mpi.allreduce(bool(np.any(active & ~self._factored)), op=MPI.LOR)):
+        if (
+            self.reuse
+            and self.gamma == 0.0
+            and probes is None
+            and self.policy != "refactor"
+            and 0 < changed <= _MAX_RELEASED
+            and self._factored is not None
+            and not self._mpi.allreduce(bool(np.any(active & ~self._factored)), op=MPI.LOR)
+        ):
             released = self._solve_released(g, active)
             if released is not None:
                 return released
         # A lagged factorization costs about one solve per changed row and side (the change is
         # a rank-2 update per row): refactor when that exceeds a numeric factorization.
-        refactor = (not self.reuse or changed < 0 or self.policy == "refactor"
-                    or (self.policy == "auto"
-                        and (2 * changed + 1) * self._t_apply > self._t_numeric)
-                    or 2 * changed + 1 > 100)
+        refactor = (
+            not self.reuse
+            or changed < 0
+            or self.policy == "refactor"
+            or (self.policy == "auto" and (2 * changed + 1) * self._t_apply > self._t_numeric)
+            or 2 * changed + 1 > 100
+        )
         try:
             t0 = time.perf_counter()
             if refactor:
@@ -343,17 +355,26 @@ class SaddleSolver:
             self._factored = None
             return self.solve(g, active)
         if not ok:
-            raise SolverError(f"linear solve ({ksp.getType()}) did not converge: PETSc reason "
-                              f"{reason} ({reason_name(reason)}) after {its} iterations")
+            raise SolverError(
+                f"linear solve ({ksp.getType()}) did not converge: PETSc reason "
+                f"{reason} ({reason_name(reason)}) after {its} iterations"
+            )
         if self.direct and self._factored is not None and np.array_equal(active, self._factored):
-            self._last = (self.stats["factorizations"], np.array(g, copy=True),
-                          self._x.array_r.copy())
+            self._last = (
+                self.stats["factorizations"],
+                np.array(g, copy=True),
+                self._x.array_r.copy(),
+            )
         u_sub, l_sub = self._x.getSubVector(self._is_u), self._x.getSubVector(self._is_l)
         u, mu = u_sub.array.copy(), l_sub.array.copy()
         self._x.restoreSubVector(self._is_u, u_sub)
         self._x.restoreSubVector(self._is_l, l_sub)
-        info: dict[str, object] = {"refactored": refactor, "changed_rows": changed,
-                                   "setup": t1 - t0, "solve": t2 - t1}
+        info: dict[str, object] = {
+            "refactored": refactor,
+            "changed_rows": changed,
+            "setup": t1 - t0,
+            "solve": t2 - t1,
+        }
         if probes is not None:
             info["probes"] = self._solve_probes(np.asarray(probes, dtype=float), active)
         return SaddleResult(u, mu, its, reason, info)
@@ -405,16 +426,20 @@ class SaddleSolver:
         last = self._last
         applies = 1
         try:
-            if (last is not None and last[0] == self.stats["factorizations"]
-                    and np.array_equal(last[1], g)):
+            if (
+                last is not None
+                and last[0] == self.stats["factorizations"]
+                and np.array_equal(last[1], g)
+            ):
                 self._x.array[:] = last[2]  # the factorized set's own solution, kept
             else:
                 pc.apply(b, self._x)
                 applies += 1
             mu0 = np.concatenate(self._mpi.allgather(self._x.array_r[rows_r]))
             resp = self._responses(rel_global, rel, factored)
-            lu = scipy.linalg.lu_factor(np.concatenate(self._mpi.allgather(resp[rel])),
-                                        check_finite=True)
+            lu = scipy.linalg.lu_factor(
+                np.concatenate(self._mpi.allgather(resp[rel])), check_finite=True
+            )
             shift = scipy.linalg.lu_solve(lu, -mu0)
             b.array[rows_r] += shift[mine]
             pc.apply(b, self._x)
@@ -451,9 +476,14 @@ class SaddleSolver:
         u, mu = u_sub.array.copy(), l_sub.array.copy()
         self._x.restoreSubVector(self._is_u, u_sub)
         self._x.restoreSubVector(self._is_l, l_sub)
-        info: dict[str, object] = {"refactored": False, "changed_rows": len(rel_global),
-                                   "released": len(rel_global), "setup": 0.0, "solve": t1 - t0,
-                                   "residual": res}
+        info: dict[str, object] = {
+            "refactored": False,
+            "changed_rows": len(rel_global),
+            "released": len(rel_global),
+            "setup": 0.0,
+            "solve": t1 - t0,
+            "residual": res,
+        }
         return SaddleResult(u, mu, applies, 1, info)
 
     def _responses(self, rows: np.ndarray, local: np.ndarray, factored: np.ndarray) -> np.ndarray:
@@ -508,8 +538,7 @@ class SaddleSolver:
         (inactive rows respond with mu = 0). MUMPS prunes its elimination tree to the paths
         of these rows: 60 x 60 entries took 0.14 s at 1M dofs, 9.7 s as dense columns.
         """
-        lib = _petsc_library()
-        if not self.cheap_responses or lib is None:
+        if not self.cheap_responses:
             return None
         nz = probes != 0.0
         if not (np.all(nz.sum(axis=0) == 1) and np.all(probes[nz] == 1.0)):
@@ -523,27 +552,9 @@ class SaddleSolver:
         cols, where = np.unique(rows_l[col_rows], return_inverse=True)
         wanted = np.sort(rows_l[req])
         order = np.argsort(rows_l[req])
-        # Row c of the transposed pattern asks for the entries (wanted, c) of A^-1.
-        count = np.zeros(n, dtype=np.int64)
-        count[cols] = len(wanted)
-        indptr = np.concatenate([[0], np.cumsum(count)]).astype(PETSc.IntType)
-        indices = np.tile(wanted, len(cols)).astype(PETSc.IntType)
-        values = np.zeros(len(indices), dtype=PETSc.ScalarType)
-        spT = PETSc.Mat().createAIJ((n, n), csr=(indptr, indices, values),  # type: ignore[arg-type]
-                                    comm=PETSc.COMM_SELF)
-        spT.assemble()
-        sp = PETSc.Mat().createTranspose(spT)
         F = self._ksp.getPC().getFactorMatrix()
-        saved = {i: ctypes.c_int() for i in (20, 30)}
-        for i, v in saved.items():
-            lib.MatMumpsGetIcntl(F.handle, i, ctypes.byref(v))
-        err = lib.MatMumpsGetInverse(F.handle, sp.handle)
-        for i, v in saved.items():  # back to ordinary solves
-            lib.MatMumpsSetIcntl(F.handle, i, v.value)
-        entries = spT.getValuesCSR()[2].reshape(len(cols), len(wanted)).copy()
-        sp.destroy()
-        spT.destroy()
-        if err != 0 or not np.all(np.isfinite(entries)):
+        entries = inverse_entries(F, wanted, cols, n)
+        if entries is None:
             return None
         out = np.zeros((len(active), probes.shape[1]))
         out[req[order], :] = entries[where].T
@@ -627,18 +638,32 @@ def _inactive_scale(K: PETSc.Mat, B: PETSc.Mat) -> float:
     return -b2 / kd if b2 > 0.0 and kd > 0.0 else 1.0
 
 
-def solve_saddle(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray, active: np.ndarray,
-                 options: Mapping[str, object], gamma: float = 0.0,
-                 nullspace: PETSc.NullSpace | None = None,
-                 probes: np.ndarray | None = None) -> SaddleResult:
+def solve_saddle(
+    K: PETSc.Mat,
+    B: PETSc.Mat,
+    f: PETSc.Vec,
+    g: np.ndarray,
+    active: np.ndarray,
+    options: Mapping[str, object],
+    gamma: float = 0.0,
+    nullspace: PETSc.NullSpace | None = None,
+    probes: np.ndarray | None = None,
+) -> SaddleResult:
     """One fresh solve (setup, factorization or preconditioner set-up, solve), nothing kept."""
     with SaddleSolver(K, B, f, options, gamma, nullspace, reuse_factorization=False) as solver:
         return solver.solve(g, active, probes)
 
 
-def reference_solve(K: PETSc.Mat, B: PETSc.Mat, f: PETSc.Vec, g: np.ndarray,
-                    active: np.ndarray, options: Mapping[str, object], gamma: float = 0.0,
-                    nullspace: PETSc.NullSpace | None = None) -> tuple[SaddleResult, float]:
+def reference_solve(
+    K: PETSc.Mat,
+    B: PETSc.Mat,
+    f: PETSc.Vec,
+    g: np.ndarray,
+    active: np.ndarray,
+    options: Mapping[str, object],
+    gamma: float = 0.0,
+    nullspace: PETSc.NullSpace | None = None,
+) -> tuple[SaddleResult, float]:
     """A fresh solve with the active set fixed, and its wall-clock seconds (the cost floor)."""
     K.getComm().tompi4py().Barrier()
     t0 = time.perf_counter()

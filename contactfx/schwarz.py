@@ -8,6 +8,9 @@ data: the interface force D exerts on it. The transfer uses the mortar matrices 
 B2's reaction R2, the force on B1 is -M^T lambda, so no force is lost across non-matching
 meshes. The fixed point satisfies exactly the equations of the mortar Lagrange-multiplier
 method with D active (full contact): the iteration is an independent solver for them.
+
+Longer than ~300 lines because the body solvers, the owned-node bookkeeping and the
+iteration share one transfer setup; split, each part would need all of it passed in.
 """
 
 from __future__ import annotations
