@@ -3,6 +3,10 @@
 Stresses are each body's own FE stress, averaged at the surface nodes over the adjacent
 cells, resolved on the active surface's outward normal n and the tangent t (the direction of
 increasing arc length s along the active surface).
+
+One module (~320 lines) because every quantity here is computed on the same gathered pair
+data (nodal stresses by global node, arc length, projections); the JSON assembly is in
+report.py.
 """
 
 from __future__ import annotations
