@@ -15,6 +15,7 @@ displacement is the initial guess. Near-nullspace: each body's rigid modes, zero
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping
 from typing import Any, cast
 
@@ -22,6 +23,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from .errors import InputError, SolverError
+from .nullspace import orthonormalize
 from .saddle import SaddleResult
 from .solvers import PrefixedOptions, petsc_error_message, reason_name
 
@@ -146,8 +148,6 @@ class CondensedSolver:
         """Displacements and multipliers (owned parts) with `active` rows in contact."""
         if probes is not None:
             raise InputError("the condensed solver has no probes (it is not a factorization)")
-        import time
-
         t0 = time.perf_counter()
         rows, piv, coef = self._pivots(np.asarray(active, dtype=bool))
         # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
@@ -229,11 +229,7 @@ class CondensedSolver:
             w.setValues(cast(Any, piv.astype(PETSc.IntType)), cast(Any, np.zeros(len(piv))))
             w.assemble()
             modes.append(w)
-        for _ in range(2):
-            for i, w in enumerate(modes):
-                for q in modes[:i]:
-                    w.axpy(-w.dot(q), q)
-                w.normalize()
+        orthonormalize(modes)
         nsp = PETSc.NullSpace().create(vectors=modes, comm=self._comm)
         for w in modes:
             w.destroy()

@@ -40,11 +40,11 @@ def rigid_body_modes(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Vec]:
             v = PETSc.Vec().createMPI((nloc * bs, PETSc.DETERMINE), bsize=bs, comm=comm)
             v.array[:] = a
             modes.append(v)
-    _orthonormalize(modes)
+    orthonormalize(modes)
     return modes
 
 
-def _orthonormalize(vectors: list[PETSc.Vec]) -> None:
+def orthonormalize(vectors: list[PETSc.Vec]) -> None:
     """Modified Gram-Schmidt in place (twice, for round-off)."""
     for _ in range(2):
         for i, v in enumerate(vectors):

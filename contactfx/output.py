@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from .postprocess import sigma_field
+from .postprocess import INTERFACE_FIELDS, sigma_field
 from .solution import Solution
 
 
@@ -90,15 +90,7 @@ def write_contact_surfaces(data: dict[str, Any], outdir: Path) -> list[Path]:
         itf = c["interface"]
         pts = np.column_stack([itf["x"], itf["y"], np.zeros(len(itf["x"]))])
         line = pyvista.lines_from_points(pts) if len(pts) > 1 else pyvista.PolyData(pts)
-        for key in (
-            "s",
-            "pressure",
-            "gap",
-            "sigma_nn_active",
-            "sigma_nn_passive",
-            "sigma_nt_active",
-            "sigma_nt_passive",
-        ):
+        for key in INTERFACE_FIELDS[2:]:  # all but the coordinates
             line.point_data[key] = np.array([np.nan if v is None else v for v in itf[key]])
         line.point_data["active"] = np.asarray(itf["active"], dtype=np.int8)
         path = outdir / f"contact{k}_{c['active']}.vtp"

@@ -23,11 +23,32 @@ from .elasticity import sigma
 from .solution import Solution
 from .surfaces import owned_facets, vertex_coordinates, vertex_to_block
 
+# The numeric columns of every pair's `interface` (plus the boolean `active`), in order.
+INTERFACE_FIELDS = (
+    "x",
+    "y",
+    "s",
+    "pressure",
+    "gap",
+    "sigma_nn_active",
+    "sigma_nn_passive",
+    "sigma_nt_active",
+    "sigma_nt_passive",
+)
+
 REF_VERTICES = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
 
 
 def nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(global node, x, sigma (k, 2, 2)) at the nodes of curve group `group`, cell-averaged."""
+    key = ("nodal_stress", group)
+    if key not in sol.cache:
+        sol.cache[key] = _nodal_stress(sol, group)
+    return sol.cache[key]  # type: ignore[return-value]
+
+
+def _nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """nodal_stress, computed (collective)."""
     scene = sol.scene
     msh = scene.mesh
     tdim = msh.topology.dim
@@ -122,6 +143,14 @@ def _none_if_nan(v: np.ndarray) -> list[float | None]:
 
 def pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     """Pressure, gap and both bodies' sigma_nn, sigma_nt at pair k's multipliers, by s."""
+    key = ("pair_interface", k)
+    if key not in sol.cache:
+        sol.cache[key] = _pair_interface(sol, k)
+    return sol.cache[key]  # type: ignore[return-value]
+
+
+def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
+    """pair_interface, computed (collective)."""
     pd = sol.pairs[k]
     rows = sol.rows_of(k)
     surf_a, surf_p = pd.active.surface, pd.passive.surface
@@ -144,17 +173,18 @@ def pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     nn_a, nt_a = _resolve(sa, n, t)
     nn_p, nt_p = _resolve(sp, n, t)
     order = np.argsort(s_all[node], kind="stable")
-    cols = {
-        "x": x[:, 0],
-        "y": x[:, 1],
-        "s": s_all[node],
-        "pressure": sol.pressure[rows],
-        "gap": sol.gap[rows],
-        "sigma_nn_active": nn_a,
-        "sigma_nn_passive": nn_p,
-        "sigma_nt_active": nt_a,
-        "sigma_nt_passive": nt_p,
-    }
+    values = (
+        x[:, 0],
+        x[:, 1],
+        s_all[node],
+        sol.pressure[rows],
+        sol.gap[rows],
+        nn_a,
+        nn_p,
+        nt_a,
+        nt_p,
+    )
+    cols = dict(zip(INTERFACE_FIELDS, values, strict=True))
     out: dict[str, Any] = {key: _none_if_nan(np.asarray(v)[order]) for key, v in cols.items()}
     out["active"] = [bool(a) for a in sol.active[rows][order]]
     return out

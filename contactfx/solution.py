@@ -37,6 +37,9 @@ class Solution:
     history: Sequence[Mapping[str, float | None]] = field(default_factory=list)
     timers: Timers = field(default_factory=Timers)
     info: dict[str, object] = field(default_factory=dict)
+    # Post-processing computed once per solution (nodal stresses, interfaces): the summary,
+    # the references and the charts all read the same ones.
+    cache: dict[object, object] = field(default_factory=dict, init=False, repr=False)
 
     def rows_of(self, pair: int) -> np.ndarray:
         """Layout rows of contact pair `pair`."""

@@ -8,18 +8,14 @@ null space of all these conditions make K + contact singular, whatever the load.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 from dolfinx import fem
+from mpi4py import MPI
 
 from .contact.geometry import nodal_normals
 from .errors import SingularSystemError
 from .scenes import Body, Scene
 from .surfaces import GatheredSurface
-
-if TYPE_CHECKING:
-    from mpi4py import MPI
 
 # A contact pair as the check needs it: (active body, passive body, active surface).
 Contact = tuple[Body, Body, GatheredSurface]
@@ -57,26 +53,14 @@ def _body_frames(
         n = comm.allreduce(len(b))
         c = np.array([comm.allreduce(float(x[b, d].sum())) for d in (0, 1)]) / max(n, 1)
         lo = np.array(
-            [comm.allreduce(float(x[b, d].min(initial=np.inf)), op=_min()) for d in (0, 1)]
+            [comm.allreduce(float(x[b, d].min(initial=np.inf)), op=MPI.MIN) for d in (0, 1)]
         )
         hi = np.array(
-            [comm.allreduce(float(x[b, d].max(initial=-np.inf)), op=_max()) for d in (0, 1)]
+            [comm.allreduce(float(x[b, d].max(initial=-np.inf)), op=MPI.MAX) for d in (0, 1)]
         )
         centres.append(c)
         sizes.append(max(float(np.max(hi - lo)), 1e-300))
     return owned, np.array(centres), np.array(sizes)
-
-
-def _min() -> MPI.Op:
-    from mpi4py import MPI
-
-    return MPI.MIN
-
-
-def _max() -> MPI.Op:
-    from mpi4py import MPI
-
-    return MPI.MAX
 
 
 def _dirichlet_rows(

@@ -40,13 +40,13 @@ def test_dual_mortar_straight_patch_test(active: int) -> None:
 def test_dual_hertz_within_ten_percent_of_standard() -> None:
     """Hertz errors (a, p0, L2) of the dual basis stay within 10 % of the standard basis'.
 
-    Relative to the exact values the two differ by less than 0.1 % here; the 10 % band of the
-    issue is on the errors themselves, checked as |err_dual| <= 1.1 |err_std| + 1e-4."""
+    The band is on the errors themselves: |err_dual| <= 1.1 |err_std| (measured: a 1.09e-3
+    vs 1.03e-3, p0 1.24e-3 vs 1.53e-3, L2 2.46e-3 vs 3.43e-3)."""
     scene = build_scene("hertz", HertzParams(), comm=MPI.COMM_SELF)
     out = {b: run_scene(scene, "mortar", basis=b)[1]["hertz"] for b in ("standard", "dual")}
     for key, exact in (("a", "a_exact"), ("p0", "p0_exact")):
         errs = {b: abs(h[key] / h[exact] - 1) for b, h in out.items()}
-        assert errs["dual"] <= 1.1 * errs["standard"] + 1e-4, (key, errs)
+        assert errs["dual"] <= 1.1 * errs["standard"], (key, errs)
     assert out["dual"]["l2_error"] <= 1.1 * out["standard"]["l2_error"]
 
 

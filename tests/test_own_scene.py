@@ -50,12 +50,13 @@ def test_inclined_patch_test_mortar_exact(inclined: Scene) -> None:
     assert abs(np.degrees(np.arctan2(abs(f[0]), abs(f[1]))) - 30.0) < 1e-6
 
 
-@pytest.mark.parametrize(("method", "low", "high"), [("nts", 0.1, 0.9), ("sts", 0.05, 0.5)])
+@pytest.mark.parametrize(("method", "low", "high"), [("nts", 0.14, 0.65), ("sts", 0.07, 0.42)])
 def test_inclined_patch_test_nts_sts_fail_by_their_known_size(
     inclined: Scene, method: str, low: float, high: float
 ) -> None:
     """NTS and STS do not pass the patch test on non-matching meshes: errors of 14-43 %
-    (measured: nts 0.43 / 0.28, sts 0.14 / 0.28 with body 2 / body 1 active)."""
+    (measured: nts 0.43 / 0.28, sts 0.14 / 0.28 with body 2 / body 1 active); the band is the
+    measured range +-50 %."""
     _, data = run_scene(inclined, method)
     assert low < data["patch"]["max"] < high
 
@@ -125,11 +126,13 @@ def test_interface_along_the_normal_has_every_key() -> None:
     assert all(len(itf[k]) == n for k in keys)
     s = np.asarray(itf["s"])
     assert np.all(np.diff(s) > 0)
-    # Inside the contact zone each body's normal stress carries the multiplier pressure.
+    # Inside the contact zone each body's own normal stress carries the multiplier pressure,
+    # up to Q1 stress recovery (nodal averages): measured 1.5 % (active), 2.8 % (passive).
     p = np.asarray(itf["pressure"])
     inner = p > 0.5 * p.max()
-    snn = np.asarray(itf["sigma_nn_active"], dtype=float)
-    assert np.max(np.abs(-snn[inner] / p[inner] - 1)) < 0.1
+    for key in ("sigma_nn_active", "sigma_nn_passive"):
+        snn = np.asarray(itf[key], dtype=float)
+        assert np.max(np.abs(-snn[inner] / p[inner] - 1)) < 0.04, key
 
 
 def _blocks_geo(

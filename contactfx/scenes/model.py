@@ -149,6 +149,11 @@ class Scene:
     # The same scene with every mesh size times a factor (None: cannot be remeshed). Used
     # by the coarse predictor and by refinement studies.
     resize: Callable[[float], Scene] | None = field(default=None, compare=False, repr=False)
+    # Which body each curve group lies on, found once (a collective pass over the mesh);
+    # not an init field, so dataclasses.replace (other groups) starts a fresh one.
+    _curve_bodies: dict[str, Body] = field(
+        default_factory=dict, init=False, compare=False, repr=False
+    )
 
     @property
     def comm(self) -> MPI.Comm:
@@ -167,7 +172,9 @@ class Scene:
         """The body whose cells own the facets of curve group `name` (MeshError if several)."""
         from .checks import body_of_curve
 
-        return body_of_curve(self, name)
+        if name not in self._curve_bodies:
+            self._curve_bodies[name] = body_of_curve(self, name)
+        return self._curve_bodies[name]
 
     def params_dict(self) -> dict[str, Any]:
         """Parameters for the JSON summary."""
