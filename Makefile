@@ -11,7 +11,7 @@ PYTHON312 := $(shell python3.12 -c 'import sys' >/dev/null 2>&1 && echo python3.
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: demo test lint bench paper clean venv
+.PHONY: demo test lint bench bench-scale paper clean venv
 
 venv: $(STAMP)
 
@@ -33,6 +33,10 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/run.py
+
+# The condensed solver against MUMPS from 100k to 10M dofs (about 25 min).
+bench-scale: $(STAMP)
+	$(PY) benchmarks/scale.py
 
 clean:
 	rm -rf results .pytest_cache

@@ -20,6 +20,7 @@ import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 from mpi4py import MPI
 
 from contactfx.api import solve
+from contactfx.hertz import hertz_summary
 from contactfx.methods import Method
 from contactfx.scenes import HertzParams, hertz
 from contactfx.solvers import SOLVERS
@@ -136,6 +137,12 @@ def main() -> None:
                     {k: (float(v) if not isinstance(v, int) else v) for k, v in h.items()}
                     for h in sol.history
                 ],
+                "reference_linear_iterations": sol.info.get("reference_linear_iterations"),
+                "hertz": {
+                    k: v
+                    for k, v in hertz_summary(sol).items()
+                    if k in ("a", "a_exact", "p0", "p0_exact", "l2_error")
+                },
                 "contact_force_error": abs(
                     float((sol.pressure * sol.layout.weights).sum()) - scene.params["P"] / 2
                 )

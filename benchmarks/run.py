@@ -51,8 +51,8 @@ TARGET = 1.5
 START, END = "<!-- bench:start -->", "<!-- bench:end -->"
 
 
-def refine_for(dofs: float, mesh: str = "structured") -> float:
-    """Contact element size h0 (cm) whose Hertz mesh (h_far = 10 h0) has about `dofs` dofs.
+def refine_for(dofs: float, mesh: str = "structured", ratio: float = H_RATIO) -> float:
+    """Contact element size h0 (cm) whose Hertz mesh (h_far = ratio * h0) has about `dofs` dofs.
 
     Structured: the grid itself is counted. gmsh: a fit of its dof counts on these meshes
     (edge refinement h0 / 4), dofs ~ 125.6 / h0^2 + 324 / h0 (within ~5% from 14k to 500k).
@@ -61,9 +61,9 @@ def refine_for(dofs: float, mesh: str = "structured") -> float:
     def count(h: float) -> float:
         if mesh == "gmsh":
             return 125.6 / h**2 + 324.0 / h
-        return 2 * len(hertz_grid(60.0, 60.0, 60.0, h, 2.0, H_RATIO * h, 0.1)[0])
+        return 2 * len(hertz_grid(60.0, 60.0, 60.0, h, 2.0, ratio * h, 0.1)[0])
 
-    lo, hi = 1e-3, 0.2
+    lo, hi = 1e-3, 2.0
     for _ in range(30):
         mid = (lo * hi) ** 0.5
         lo, hi = (mid, hi) if count(mid) > dofs else (lo, mid)
@@ -79,8 +79,14 @@ def run_case(
     fixed: bool = False,
     timeout: float = 1800,
     basis: str = "standard",
+    h_far: float | None = None,
+    reference: bool = True,
 ) -> list[dict[str, Any]]:
-    """Run benchmarks/case.py once (all `methods` on one mesh); return one record per method."""
+    """Run benchmarks/case.py once (all `methods` on one mesh); return one record per method.
+
+    `h_far` defaults to H_RATIO * h0 (the sweep's meshes); `reference=False` skips the
+    reference solve.
+    """
     cmd = [
         PY,
         str(HERE / "case.py"),
@@ -93,10 +99,12 @@ def run_case(
         "--refine",
         str(h0),
         "--h-far",
-        str(H_RATIO * h0),
+        str(H_RATIO * h0 if h_far is None else h_far),
         "--basis",
         basis,
     ]
+    if not reference:
+        cmd.append("--no-reference")
     if mesh == "gmsh":
         cmd += ["--refine-edge", str(round(h0 / EDGE_RATIO, 8))]
     if fixed:

@@ -29,6 +29,7 @@ COARSE_PREDICTOR_DOFS = 200_000
 # Mesh sizes of the coarse solve relative to the fine one (1/40 of the dofs on the graded
 # Hertz meshes): its zone edge is then good to a coarse element, which the band probes cover.
 COARSE_FACTOR = 8.0
+CONDENSED_COARSE_FACTOR = 4.0
 
 
 def scene_dofs(scene: Scene) -> int:
@@ -64,7 +65,10 @@ def coarse_prediction(
 ) -> InitialSet:
     """Solve `coarse` (the same scene, coarser) and turn its contact zone into an InitialSet."""
     sol = solve_contact(coarse, method, options, ActiveSetOptions(max_iterations), basis=basis)
-    return coarse_initial_set(sol)
+    # A direct solver probes the uncertain band, so a generous superset costs it nothing;
+    # every ring of nodes the condensed loop must release costs a whole solve, so it starts
+    # from half a coarse element around the coarse zone (463k DOFs: 6 -> 4 steps).
+    return coarse_initial_set(sol, margin=0.5 if is_condensed(options) else 1.5)
 
 
 def solve(
@@ -115,7 +119,11 @@ def solve(
     init = None
     if scene.resize is not None and use_coarse(predictor, scene, options):
         with timers("predictor"):
-            coarse = scene.resize(COARSE_FACTOR)
+            # The condensed loop pays a whole solve per ring of nodes it adds or releases, so
+            # a sharper prediction (1/16 of the DOFs, not 1/64) pays for itself
+            # (1.85M DOFs: 4 fine steps -> 2, 27.6 s -> 21.9 s with the predictor).
+            factor = CONDENSED_COARSE_FACTOR if is_condensed(options) else COARSE_FACTOR
+            coarse = scene.resize(factor)
             init = coarse_prediction(coarse, method, options, max_iterations, basis)
     return solve_contact(
         scene,

@@ -8,9 +8,14 @@ saddle point into the symmetric positive definite displacement system
 
     (T^T K T + P) v = T^T (f - K t),    P = diag(K_pp) on the pivots (v_p is free: set 0),
 
-and the multipliers follow from the pivot rows of equilibrium, mu_j = (f - K u)_p / c_j. The
-active set changes T, so each active-set step rebuilds T^T K T (one PtAP) and GAMG; the last
-displacement is the initial guess. Near-nullspace: each body's rigid modes, zero on pivots.
+and the multipliers follow from the pivot rows of equilibrium, mu_j = (f - K u)_p / c_j.
+
+The first set builds T^T K T = K + E^T K + K E + E^T K E (E = T - I: a few rows) and GAMG on
+it, with the rigid modes of all bodies (zero on the pivots) as near-nullspace. Later sets
+differ from it by a few pivots, a low-rank change: CG keeps that multigrid and applies the new
+operator matrix-free, from the last displacement, until the pivots have moved too far. The
+loop's solves stop at a loose tolerance (only signs decide the set); the stationary set is
+polished to the final one (`polish`), so the answer does not depend on the loose one.
 """
 
 from __future__ import annotations
@@ -31,6 +36,8 @@ _ADD = cast(Any, PETSc.InsertMode.ADD_VALUES)
 # Entries of B on another active node's dofs larger than this (relative to the row's pivot)
 # mean D is not diagonal: the elimination would couple the pivots.
 _DIAGONAL_TOL = 1e-10
+# Pivot changes since the multigrid was built (summed over ranks) below which it is reused.
+_REBUILD_CHANGES = 64
 
 
 def is_condensed(options: Mapping[str, object]) -> bool:
@@ -58,8 +65,15 @@ class CondensedSolver:
         self._indptr, self._cols, self._vals = B.getValuesCSR()
         self._modes = modes or []
         self._options = PrefixedOptions(
-            {k: v for k, v in options.items() if k != "contactfx_condensed"}
+            {k: v for k, v in options.items() if not k.startswith("contactfx_")}
         )
+        # The loop's solves stop early (the set only needs signs); the one on the set that
+        # turned out stationary is polished to ksp_rtol (`polish`).
+        self._rtol = float(cast(Any, options.get("ksp_rtol", 1e-9)))
+        self._loose_rtol = max(
+            self._rtol, float(cast(Any, options.get("contactfx_loose_rtol", self._rtol)))
+        )
+        self._A: PETSc.Mat | None = None  # the operator the multigrid was built from
         self._ksp = PETSc.KSP().create(self._comm)
         self._ksp.setOptionsPrefix(self._options.prefix)
         self._u = f.duplicate()
@@ -78,8 +92,9 @@ class CondensedSolver:
     def destroy(self) -> None:
         """Free the PETSc objects and remove this solver's options."""
         self._options.remove()
-        for obj in (self._ksp, self._u, self._diag):
-            obj.destroy()
+        for obj in (self._ksp, self._u, self._diag, self._A):
+            if obj is not None:
+                obj.destroy()
 
     def _pivots(self, active: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(owned active rows, their pivot dofs, the pivot coefficients)."""
@@ -112,8 +127,10 @@ class CondensedSolver:
                 )
         return rows, piv, coef
 
-    def _transform(self, rows: np.ndarray, piv: np.ndarray, coef: np.ndarray) -> PETSc.Mat:
-        """T: the identity, except row p(j) = -B_j / c_j off the pivot (0 on it)."""
+    def _transform(
+        self, rows: np.ndarray, piv: np.ndarray, coef: np.ndarray
+    ) -> tuple[PETSc.Mat, PETSc.Mat]:
+        """T (the identity, except row p(j) = -B_j / c_j off the pivot, 0 on it) and T - I."""
         n = self._r1 - self._r0
         nglob = self._K.getSize()[0]
         local = piv - self._r0
@@ -124,44 +141,56 @@ class CondensedSolver:
             keep = (cols != piv[i]) & (vals != 0.0)
             order = np.argsort(cols[keep])
             extra[int(local[i])] = (cols[keep][order], -vals[keep][order] / coef[i])
-        counts = np.ones(n, dtype=np.int64)
-        for r, (c, _) in extra.items():
-            counts[r] = len(c)
-        indptr = np.concatenate([[0], np.cumsum(counts)])
-        cols = np.arange(self._r0, self._r1, dtype=np.int64).repeat(counts)
-        vals = np.ones(indptr[-1])
-        for r, (c, v) in extra.items():
-            cols[indptr[r] : indptr[r + 1]] = c
-            vals[indptr[r] : indptr[r + 1]] = v
-        csr: Any = (
-            indptr.astype(PETSc.IntType),
-            cols.astype(PETSc.IntType),
-            vals.astype(PETSc.ScalarType),
-        )
-        T = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)), csr=csr, comm=self._comm)
-        T.assemble()
-        return T
+
+        def matrix(identity: bool) -> PETSc.Mat:
+            counts = np.full(n, 1 if identity else 0, dtype=np.int64)
+            for r, (c, _) in extra.items():
+                counts[r] = len(c) + (0 if identity else 1)
+            indptr = np.concatenate([[0], np.cumsum(counts)])
+            cols = np.arange(self._r0, self._r1, dtype=np.int64).repeat(counts)
+            vals = np.ones(indptr[-1]) if identity else -np.ones(indptr[-1])
+            for r, (c, v) in extra.items():
+                lo = indptr[r] + (0 if identity else 1)  # E: -1 on the pivot first
+                cols[lo : indptr[r + 1]] = c
+                vals[lo : indptr[r + 1]] = v
+            if not identity:  # sorted columns per row: the pivot's -1 in its place
+                for r in extra:
+                    seg = slice(indptr[r], indptr[r + 1])
+                    order = np.argsort(cols[seg], kind="stable")
+                    cols[seg], vals[seg] = cols[seg][order], vals[seg][order]
+            csr: Any = (
+                indptr.astype(PETSc.IntType),
+                cols.astype(PETSc.IntType),
+                vals.astype(PETSc.ScalarType),
+            )
+            M = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)), csr=csr, comm=self._comm)
+            M.assemble()
+            return M
+
+        return matrix(True), matrix(False)
 
     def solve(
         self, g: np.ndarray, active: np.ndarray, probes: np.ndarray | None = None
     ) -> SaddleResult:
-        """Displacements and multipliers (owned parts) with `active` rows in contact."""
+        """Displacements and multipliers (owned parts), at the loose tolerance of the loop."""
         if probes is not None:
             raise InputError("the condensed solver has no probes (it is not a factorization)")
+        return self._solve(g, active, self._loose_rtol)
+
+    def polish(self, g: np.ndarray, active: np.ndarray) -> SaddleResult:
+        """The same set solved to the final tolerance, from the last (loose) solution."""
+        return self._solve(g, active, self._rtol)
+
+    def _solve(self, g: np.ndarray, active: np.ndarray, rtol: float) -> SaddleResult:
         t0 = time.perf_counter()
         rows, piv, coef = self._pivots(np.asarray(active, dtype=bool))
         # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
         ip: Any = piv.astype(PETSc.IntType)
-        T = self._transform(rows, piv, coef)
-        A = self._K.ptap(T)
-        d = A.createVecLeft()
+        T, E = self._transform(rows, piv, coef)
+        d = self._f.duplicate()
         d.set(0.0)
-        d.setValues(ip, cast(Any, self._diag.getValues(ip)), addv=_ADD)
+        d.setValues(ip, cast(Any, self._diag.getValues(ip)))
         d.assemble()
-        # T^T K T has no entries on the pivot rows: give them the diagonal of K.
-        A.setOption(cast(Any, PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR), False)
-        A.setDiagonal(d, addv=_ADD)
-        A.assemble()
         t = self._f.duplicate()
         t.set(0.0)
         t.setValues(ip, cast(Any, -np.asarray(g)[rows] / coef))
@@ -174,27 +203,37 @@ class CondensedSolver:
         v = self._u.copy()  # warm start: the last displacement, pivots free
         v.setValues(ip, cast(Any, np.zeros(len(piv))))
         v.assemble()
-        ksp = self._ksp
-        # A few pivots more or less change T^T K T by a low-rank term: the multigrid built
-        # for the previous set still preconditions it well (CG needs a few more iterations
-        # instead of a new setup, which costs several solves' worth).
+        # A few pivots more or less change T^T K T by a term of their rank, which costs CG
+        # at most that many extra iterations: the multigrid built for an earlier set keeps
+        # preconditioning it (the new operator applied matrix-free) until the pivots have
+        # moved in more than max(a fifth of the set, `_REBUILD_CHANGES`) places, when a new
+        # setup pays off.
         prev = self._built_for
-        reuse = (
-            self.reuse
-            and prev is not None
-            and self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
-            <= 0.2 * max(self._mpi.allreduce(len(piv)), 1)
-        )
-        if not reuse and self._modes:
-            A.setNearNullSpace(self._near_nullspace(piv))
+        changed = self._mpi.allreduce(int(np.setxor1d(prev, piv).size)) if prev is not None else 0
+        n_piv = self._mpi.allreduce(len(piv))
+        reuse = self.reuse and prev is not None and changed <= max(0.2 * n_piv, _REBUILD_CHANGES)
+        ksp = self._ksp
         try:
-            ksp.getPC().setReusePreconditioner(reuse)
-            ksp.setOperators(A)
-            ksp.setInitialGuessNonzero(True)
-            if not reuse:
+            if reuse:
+                op = _CondensedOperator(self._K, T, d)
+                A = PETSc.Mat().createPython(cast(Any, self._K.getSizes()), op, comm=self._comm)
+                A.setUp()
+                assert self._A is not None
+                ksp.setOperators(A, self._A)
+            else:
+                A = self._condensed_matrix(E, ip)
+                if self._modes:
+                    A.setNearNullSpace(self._near_nullspace(piv))
+                ksp.setOperators(A)
                 ksp.setFromOptions()
-                ksp.setUp()
+                if self._A is not None:
+                    self._A.destroy()
+                self._A = A
                 self._built_for = piv.copy()
+            ksp.getPC().setReusePreconditioner(reuse)
+            ksp.setInitialGuessNonzero(True)
+            ksp.setTolerances(rtol=rtol)
+            ksp.setUp()
             t1 = time.perf_counter()
             ksp.solve(b, v)
         except PETSc.Error as err:
@@ -213,13 +252,43 @@ class CondensedSolver:
         mu[rows] = r.getValues(ip) / coef
         u = self._u.array.copy()
         t2 = time.perf_counter()
-        for obj in (T, A, d, t, r, b, v):
+        for obj in (T, E, d, t, r, b, v):
             obj.destroy()
+        if reuse:
+            A.destroy()
         self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
         return SaddleResult(
             u, mu, its, reason, {"refactored": not reuse, "setup": t1 - t0, "solve": t2 - t1}
         )
+
+    def _condensed_matrix(self, E: PETSc.Mat, ip: Any) -> PETSc.Mat:
+        """T^T K T + P = K + E^T K + K E + E^T K E (E = T - I, nonzero on pivot rows only).
+
+        A general PtAP costs several passes over K and leaves the pivot rows without a
+        diagonal (inserting one reallocates the matrix, once per row). Here E^T K is a few
+        rows of K (the pivots' neighbourhoods); only the final sum passes over K once.
+        """
+        diff = cast(Any, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        Et = E.transpose(PETSc.Mat())  # without `out` petsc4py transposes in place
+        EtK = Et.matMult(self._K)
+        C = EtK.transpose(PETSc.Mat())  # K E (K is symmetric)
+        C.axpy(1.0, EtK, structure=diff)
+        EtKE = EtK.matMult(E)
+        C.axpy(1.0, EtKE, structure=diff)
+        A = self._K.copy()
+        A.axpy(1.0, C, structure=diff)
+        # Round-off leaves ~1e-16 on the pivot rows and columns: zero them, with K_pp on
+        # the diagonal (the decoupled v_p = 0).
+        A.zeroRowsColumns(ip, diag=1.0)
+        diag = A.getDiagonal()
+        diag.setValues(ip, cast(Any, self._diag.getValues(ip)))
+        diag.assemble()
+        A.setDiagonal(diag)
+        A.setBlockSize(2)
+        for obj in (Et, EtK, C, EtKE, diag):
+            obj.destroy()
+        return A
 
     def _near_nullspace(self, piv: np.ndarray) -> PETSc.NullSpace:
         """The rigid-body modes with the (decoupled) pivot entries removed, orthonormal."""
@@ -234,6 +303,22 @@ class CondensedSolver:
         for w in modes:
             w.destroy()
         return nsp
+
+
+class _CondensedOperator:
+    """y = (T^T K T + P) x applied matrix-free (a petsc4py Python matrix context)."""
+
+    def __init__(self, K: PETSc.Mat, T: PETSc.Mat, d: PETSc.Vec) -> None:
+        self._K, self._T, self._d = K, T, d
+        self._w1, self._w2 = K.createVecRight(), K.createVecLeft()
+
+    def mult(self, mat: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """The product with x (the pivots' own diagonal added: they are decoupled)."""
+        self._T.mult(x, self._w1)
+        self._K.mult(self._w1, self._w2)
+        self._T.multTranspose(self._w2, y)
+        self._w1.pointwiseMult(self._d, x)
+        y.axpy(1.0, self._w1)
 
 
 def owned_node_dofs(layout_gblock: np.ndarray, mine: np.ndarray) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Rigid-body modes of each body: the near-nullspace that GAMG needs for elasticity."""
+"""Rigid-body modes: of each body (support checks) and the near-nullspace GAMG needs."""
 
 from __future__ import annotations
 
@@ -10,20 +10,25 @@ from .scenes import Scene
 from .supports import body_blocks
 
 
-def rigid_body_modes(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Vec]:
-    """Three modes per body (x and y translation, rotation), each zero outside its body.
+def rigid_body_modes(V: fem.FunctionSpace, scene: Scene, per_body: bool = True) -> list[PETSc.Vec]:
+    """Three modes (x and y translation, rotation) per body, each zero outside its body.
 
     The vectors are orthonormalized: they span the kernel of each body's unconstrained
-    stiffness matrix separately, which is what aggregation multigrid must interpolate exactly.
+    stiffness matrix separately. `per_body=False` gives the three rigid modes of all bodies
+    together, which is what aggregation multigrid wants: an aggregate lies in one body (or
+    straddles a contact the condensation couples), so per-body copies add only zero columns
+    to its tentative prolongator, which GAMG turns into singular coarse operators.
     """
     imap = V.dofmap.index_map
     bs = V.dofmap.index_map_bs
     nloc = imap.size_local
     comm = V.mesh.comm
     x = V.tabulate_dof_coordinates()[:nloc, :2]
+    groups = [body_blocks(scene, V, body) for body in scene.bodies]
+    if not per_body:
+        groups = [np.unique(np.concatenate(groups))]
     modes: list[PETSc.Vec] = []
-    for body in scene.bodies:
-        blocks = body_blocks(scene, V, body)
+    for blocks in groups:
         blocks = blocks[blocks < nloc]
         # Rotate about the body's centroid: keeps the rotation mode well scaled against the
         # translations before orthonormalization.
@@ -54,8 +59,8 @@ def orthonormalize(vectors: list[PETSc.Vec]) -> None:
 
 
 def near_nullspace(V: fem.FunctionSpace, scene: Scene) -> PETSc.NullSpace:
-    """The rigid-body modes of every body as a PETSc near-nullspace (for GAMG)."""
-    modes = rigid_body_modes(V, scene)
+    """The rigid-body modes of all bodies together as a PETSc near-nullspace (for GAMG)."""
+    modes = rigid_body_modes(V, scene, per_body=False)
     nsp = PETSc.NullSpace().create(vectors=modes, comm=V.mesh.comm)
     for v in modes:
         v.destroy()

@@ -40,7 +40,8 @@ def graded_points(length: float, h0: float, r: float, slope: float, h_far: float
         target * h0,
         np.where(
             target <= n_1,
-            r + h0 * (np.exp(slope * (target - n_r)) - 1.0) / slope,
+            # np.where evaluates every branch: clip so that the uniform part cannot overflow.
+            r + h0 * (np.exp(slope * np.minimum(target - n_r, n_1 - n_r)) - 1.0) / slope,
             s1 + (target - n_1) * h_far,
         ),
     )

@@ -68,6 +68,81 @@ def test_condensed_equals_mumps(small_hertz, method: str, basis: str) -> None:
     assert all(h["linear_iterations"] > 0 for h in sol.history)  # CG really ran
 
 
+def _condensed_solver(scene):
+    """The setup of the NTS Hertz problem and a condensed solver on it."""
+    from contactfx.condensed import CondensedSolver, owned_node_dofs
+    from contactfx.methods import Method
+    from contactfx.nullspace import rigid_body_modes
+    from contactfx.prepare import prepare_contact
+    from contactfx.problem import ActiveSetOptions
+    from contactfx.solvers import SOLVERS
+    from contactfx.timers import Timers
+
+    setup = prepare_contact(
+        scene, Method.NTS.operator, ActiveSetOptions().penetration_tol, Timers()
+    )
+    el = setup.elasticity
+    dofs = owned_node_dofs(setup.layout.gblock, setup.layout.mine)
+    modes = rigid_body_modes(el.V, scene, per_body=False)
+    return setup, CondensedSolver(el.K, setup.B, el.f, SOLVERS["condensed"], dofs, modes)
+
+
+def test_condensed_matrix_equals_ptap(small_hertz) -> None:
+    """K + E^T K + K E + E^T K E with the pivots decoupled is PETSc's PtAP T^T K T + P."""
+    from petsc4py import PETSc
+
+    setup, solver = _condensed_solver(small_hertz)
+    x = setup.layout.x[setup.layout.mine, 0]
+    rows, piv, coef = solver._pivots(x < small_hertz.params["hertz_exact"]["a"])
+    T, E = solver._transform(rows, piv, coef)
+    ip = piv.astype(PETSc.IntType)
+    A = solver._condensed_matrix(E, ip)
+    K = setup.elasticity.K
+    R = K.ptap(T)
+    R.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    d = R.createVecLeft()
+    d.set(0.0)
+    d.setValues(ip, K.getDiagonal().getValues(ip))
+    d.assemble()
+    R.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+    R.assemble()
+    assert len(piv) >= 10
+    R.axpy(-1.0, A, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    assert R.norm() <= 1e-13 * A.norm()
+    for obj in (T, E, A, R, d):
+        obj.destroy()
+    solver.destroy()
+
+
+def test_reused_multigrid_gives_the_fresh_answer(small_hertz) -> None:
+    """A set a few pivots away from the multigrid's (matrix-free operator) is solved exactly."""
+    setup, solver = _condensed_solver(small_hertz)
+    x = setup.layout.x[setup.layout.mine, 0]
+    a = small_hertz.params["hertz_exact"]["a"]
+    first, second = x < 1.2 * a, x < a
+    assert 0 < (first & ~second).sum() <= 64  # within the reuse rule
+    solver.solve(setup.g, first)
+    reused = solver.polish(setup.g, second)
+    assert not reused.info["refactored"]
+    _, fresh_solver = _condensed_solver(small_hertz)
+    fresh = fresh_solver.polish(setup.g, second)
+    assert fresh.info["refactored"]
+    scale = np.abs(fresh.u).max()
+    assert np.abs(reused.u - fresh.u).max() <= 1e-7 * scale
+    assert np.abs(reused.mu - fresh.mu).max() <= 1e-6 * np.abs(fresh.mu).max()
+    solver.destroy()
+    fresh_solver.destroy()
+
+
+def test_loose_solves_then_polish_in_the_log(small_hertz) -> None:
+    """The loop stops its solves early and polishes only the stationary set."""
+    sol = solve(small_hertz, "nts", solver="condensed", predictor="none")
+    its = [h["linear_iterations"] for h in sol.history]
+    assert len(its) >= 2
+    # The last step carries the polish (1e-4 -> 1e-9): more iterations than any loose one.
+    assert its[-1] > max(its[:-1])
+
+
 @pytest.mark.parametrize(("method", "basis"), [("mortar", "standard"), ("sts", "standard")])
 def test_condensed_refuses_a_non_diagonal_d(small_hertz, method: str, basis: str) -> None:
     """Standard mortar and STS couple neighbouring active nodes: a clear error."""

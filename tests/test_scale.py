@@ -138,6 +138,19 @@ def test_near_nullspace_is_the_kernel_of_free_bodies() -> None:
     mode.array[: len(mode.array) // 3] *= 2.0
     K.mult(mode, y)
     assert y.norm() > 1e-6 * K.norm() * mode.norm()
+    # GAMG's near-nullspace: the three rigid modes of all bodies together, in the kernel
+    # too and spanning each body's translations and rotation.
+    joint = rigid_body_modes(V, scene, per_body=False)
+    assert len(joint) == 3
+    gram = np.array([[a.dot(b) for b in joint] for a in joint])
+    np.testing.assert_allclose(gram, np.eye(3), atol=1e-12)
+    for mode in joint:
+        K.mult(mode, y)
+        assert y.norm() <= 1e-10 * K.norm() * mode.norm()
+    per_body = np.array([m.array for m in modes])
+    for mode in joint:
+        coef = np.linalg.lstsq(per_body.T, mode.array, rcond=None)[0]
+        assert np.abs(per_body.T @ coef - mode.array).max() <= 1e-12
     K.destroy()
 
 
