@@ -177,8 +177,8 @@ def targets(data: list[dict[str, Any]]) -> str:
                 + ", ".join(f"{d['ref_its']} at {d['dofs']:,}" for d in ref[1:])
                 + f" (+{100 * growth:.0f} %) | {'yes' if growth <= 0.2 else 'no'} |"
             )
-        c = [d for d in pick(method=method, solver="condensed", ranks=1, **{"h_far/h": 1.0})]
-        m = [d for d in pick(method=method, solver="mumps", ranks=1, **{"h_far/h": 1.0})]
+        c = pick(method=method, solver="condensed", ranks=1, **{"h_far/h": 1.0})
+        m = pick(method=method, solver="mumps", ranks=1, **{"h_far/h": 1.0})
         both = [
             (a, b)
             for a in c

@@ -127,47 +127,43 @@ class CondensedSolver:
                 )
         return rows, piv, coef
 
-    def _transform(
+    def _pivot_rows(
         self, rows: np.ndarray, piv: np.ndarray, coef: np.ndarray
-    ) -> tuple[PETSc.Mat, PETSc.Mat]:
-        """T (the identity, except row p(j) = -B_j / c_j off the pivot, 0 on it) and T - I."""
-        n = self._r1 - self._r0
-        nglob = self._K.getSize()[0]
-        local = piv - self._r0
-        extra: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    ) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+        """Row p(j) of E = T - I per pivot (by local row): -B_j / c_j, -1 on the pivot, sorted."""
+        out: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         for i, j in enumerate(rows):
             lo, hi = self._indptr[j], self._indptr[j + 1]
             cols, vals = self._cols[lo:hi], self._vals[lo:hi]
             keep = (cols != piv[i]) & (vals != 0.0)
-            order = np.argsort(cols[keep])
-            extra[int(local[i])] = (cols[keep][order], -vals[keep][order] / coef[i])
+            c = np.append(cols[keep], piv[i])
+            v = np.append(-vals[keep] / coef[i], -1.0)
+            order = np.argsort(c)
+            out[int(piv[i] - self._r0)] = (c[order], v[order])
+        return out
 
-        def matrix(identity: bool) -> PETSc.Mat:
-            counts = np.full(n, 1 if identity else 0, dtype=np.int64)
-            for r, (c, _) in extra.items():
-                counts[r] = len(c) + (0 if identity else 1)
-            indptr = np.concatenate([[0], np.cumsum(counts)])
-            cols = np.arange(self._r0, self._r1, dtype=np.int64).repeat(counts)
-            vals = np.ones(indptr[-1]) if identity else -np.ones(indptr[-1])
-            for r, (c, v) in extra.items():
-                lo = indptr[r] + (0 if identity else 1)  # E: -1 on the pivot first
-                cols[lo : indptr[r + 1]] = c
-                vals[lo : indptr[r + 1]] = v
-            if not identity:  # sorted columns per row: the pivot's -1 in its place
-                for r in extra:
-                    seg = slice(indptr[r], indptr[r + 1])
-                    order = np.argsort(cols[seg], kind="stable")
-                    cols[seg], vals[seg] = cols[seg][order], vals[seg][order]
-            csr: Any = (
-                indptr.astype(PETSc.IntType),
-                cols.astype(PETSc.IntType),
-                vals.astype(PETSc.ScalarType),
-            )
-            M = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)), csr=csr, comm=self._comm)
-            M.assemble()
-            return M
-
-        return matrix(True), matrix(False)
+    def _matrix(self, prows: dict[int, tuple[np.ndarray, np.ndarray]], identity: bool) -> PETSc.Mat:
+        """T (identity=True: I off the pivot rows, 0 on the pivot itself) or E = T - I."""
+        n = self._r1 - self._r0
+        counts = np.full(n, 1 if identity else 0, dtype=np.int64)
+        for r, (c, _) in prows.items():
+            counts[r] = len(c)
+        indptr = np.concatenate([[0], np.cumsum(counts)])
+        cols = np.arange(self._r0, self._r1, dtype=np.int64).repeat(counts)
+        vals = np.ones(indptr[-1])
+        for r, (c, v) in prows.items():
+            seg = slice(indptr[r], indptr[r + 1])
+            cols[seg] = c
+            vals[seg] = v + (c == self._r0 + r) if identity else v
+        csr: Any = (
+            indptr.astype(PETSc.IntType),
+            cols.astype(PETSc.IntType),
+            vals.astype(PETSc.ScalarType),
+        )
+        nglob = self._K.getSize()[0]
+        M = PETSc.Mat().createAIJ(size=((n, nglob), (n, nglob)), csr=csr, comm=self._comm)
+        M.assemble()
+        return M
 
     def solve(
         self, g: np.ndarray, active: np.ndarray, probes: np.ndarray | None = None
@@ -186,7 +182,8 @@ class CondensedSolver:
         rows, piv, coef = self._pivots(np.asarray(active, dtype=bool))
         # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
         ip: Any = piv.astype(PETSc.IntType)
-        T, E = self._transform(rows, piv, coef)
+        prows = self._pivot_rows(rows, piv, coef)
+        T = self._matrix(prows, identity=True)
         d = self._f.duplicate()
         d.set(0.0)
         d.setValues(ip, cast(Any, self._diag.getValues(ip)))
@@ -221,7 +218,7 @@ class CondensedSolver:
                 assert self._A is not None
                 ksp.setOperators(A, self._A)
             else:
-                A = self._condensed_matrix(E, ip)
+                A = self._condensed_matrix(prows, ip)
                 if self._modes:
                     A.setNearNullSpace(self._near_nullspace(piv))
                 ksp.setOperators(A)
@@ -263,7 +260,7 @@ class CondensedSolver:
         mu[rows] = r.getValues(ip) / coef
         u = self._u.array.copy()
         t2 = time.perf_counter()
-        for obj in (T, E, d, t, r, b, v):
+        for obj in (T, d, t, r, b, v):
             obj.destroy()
         if reuse:
             A.destroy()
@@ -273,7 +270,9 @@ class CondensedSolver:
             u, mu, its, reason, {"refactored": not reuse, "setup": t1 - t0, "solve": t2 - t1}
         )
 
-    def _condensed_matrix(self, E: PETSc.Mat, ip: Any) -> PETSc.Mat:
+    def _condensed_matrix(
+        self, prows: dict[int, tuple[np.ndarray, np.ndarray]], ip: Any
+    ) -> PETSc.Mat:
         """T^T K T + P = K + E^T K + K E + E^T K E (E = T - I, nonzero on pivot rows only).
 
         A general PtAP costs several passes over K and leaves the pivot rows without a
@@ -281,6 +280,7 @@ class CondensedSolver:
         rows of K (the pivots' neighbourhoods); only the final sum passes over K once.
         """
         diff = cast(Any, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        E = self._matrix(prows, identity=False)
         Et = E.transpose(PETSc.Mat())  # without `out` petsc4py transposes in place
         EtK = Et.matMult(self._K)
         C = EtK.transpose(PETSc.Mat())  # K E (K is symmetric)
@@ -297,7 +297,7 @@ class CondensedSolver:
         diag.assemble()
         A.setDiagonal(diag)
         A.setBlockSize(2)
-        for obj in (Et, EtK, C, EtKE, diag):
+        for obj in (E, Et, EtK, C, EtKE, diag):
             obj.destroy()
         return A
 

@@ -227,7 +227,7 @@ def solve_contact(
             "--method mortar --basis dual"
         )
     nullspace = near_nullspace(el.V, scene) if uses_augmentation(options) else None
-    modes = rigid_body_modes(el.V, scene, per_body=False) if condensed else []
+    modes = rigid_body_modes(el.V, scene) if condensed else []
     node_dofs = owned_node_dofs(setup.layout.gblock, setup.layout.mine)
 
     def make_solver(fresh: bool) -> SaddleSolver | CondensedSolver:

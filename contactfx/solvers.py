@@ -44,7 +44,7 @@ _PRESETS: dict[str, dict[str, object]] = {
         "fieldsplit_lambda_pc_type": "jacobi",
     },
     # Iterative path for large meshes: A00 = K + gamma B^T B by one GAMG V-cycle with the
-    # rigid-body modes of each body as near-nullspace, S by the augmented-Lagrangian diagonal
+    # rigid-body modes of all bodies as near-nullspace, S by the augmented-Lagrangian diagonal
     # -I/gamma (see `schur_al_diagonal`), whose quality does not depend on the mesh size.
     "fieldsplit-gamg": {
         "ksp_type": "fgmres",
@@ -68,7 +68,7 @@ _PRESETS: dict[str, dict[str, object]] = {
 }
 
 # The condensed path (contactfx/condensed.py): the active multipliers eliminated (D diagonal:
-# NTS or dual mortar), CG on the SPD displacement system, GAMG with each body's rigid modes.
+# NTS or dual mortar), CG on the SPD displacement system, GAMG with the bodies' rigid modes.
 _PRESETS["condensed"] = {
     "contactfx_condensed": True,
     # The solves before the set is stationary only need the signs of gaps and pressures.

@@ -27,7 +27,7 @@ def body_blocks(scene: Scene, V: fem.FunctionSpace, body: Body) -> np.ndarray:
     return np.unique(V.dofmap.list[cells].ravel())
 
 
-def _modes(x: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
+def rigid_modes_at(x: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
     """(n, 2, 3): the x/y values of the translations and the scaled rotation at points x."""
     r = (x - centre) / size
     out = np.zeros((len(x), 2, 3))
@@ -81,7 +81,7 @@ def _dirichlet_rows(
         here = dofs[np.isin(dofs // 2, b)]
         if not here.size:
             continue
-        m = _modes(x[here // 2], centres[k], sizes[k])
+        m = rigid_modes_at(x[here // 2], centres[k], sizes[k])
         r = np.zeros((len(here), 3 * nb))
         r[:, 3 * k : 3 * k + 3] = m[np.arange(len(here)), here % 2]
         rows.append(r)
@@ -100,8 +100,12 @@ def _contact_rows(
         n = nodal_normals(surf)
         a, q = index[active_body.name], index[passive_body.name]
         r = np.zeros((surf.n_nodes, 3 * len(scene.bodies)))
-        r[:, 3 * a : 3 * a + 3] = np.einsum("nd,ndm->nm", n, _modes(surf.x, centres[a], sizes[a]))
-        r[:, 3 * q : 3 * q + 3] -= np.einsum("nd,ndm->nm", n, _modes(surf.x, centres[q], sizes[q]))
+        r[:, 3 * a : 3 * a + 3] = np.einsum(
+            "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[a], sizes[a])
+        )
+        r[:, 3 * q : 3 * q + 3] -= np.einsum(
+            "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[q], sizes[q])
+        )
         rows.append(r)
     return np.vstack(rows)
 
