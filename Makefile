@@ -11,11 +11,11 @@ PYTHON312 := $(shell python3.12 -c 'import sys' >/dev/null 2>&1 && echo python3.
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: demo test lint bench bench-scale paper clean venv
+.PHONY: demo test bench bench-scale clean venv
 
 venv: $(STAMP)
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py
 	@test -n "$(PYTHON312)" || { echo "python3.12 not found" >&2; exit 1; }
 	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
@@ -29,6 +29,7 @@ test: $(STAMP)
 	$(PY) -m ruff check contactfx meshes tests demos benchmarks
 	$(PY) -m ruff format --check contactfx meshes tests demos benchmarks
 	$(PY) -m mypy
+	$(VENV)/bin/lint-imports
 	$(PY) -m pytest -q tests
 
 bench: $(STAMP)

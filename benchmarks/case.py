@@ -20,10 +20,12 @@ import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 from mpi4py import MPI
 
 from contactfx.api import solve
-from contactfx.hertz import hertz_summary
-from contactfx.methods import Method
+from contactfx.discretize.setup import prepare_contact
+from contactfx.methods.active_set import ActiveSetOptions
+from contactfx.methods.multipliers import reference_solve
+from contactfx.options import Method, SolverSpec, solver_spec
+from contactfx.results.references import hertz_summary
 from contactfx.scenes import HertzParams, hertz
-from contactfx.solvers import SOLVERS
 from contactfx.timers import Timers
 
 
@@ -68,13 +70,7 @@ def main() -> None:
     )
     args = ap.parse_args()
     comm = MPI.COMM_WORLD
-    solver: str | dict[str, object] = args.solver
-    if args.option or args.fixed_set:
-        options = dict(SOLVERS[args.solver])
-        for item in args.option:
-            key, _, value = item.partition("=")
-            options[key] = value
-        solver = options
+    solver = solver_spec(args.solver).with_petsc(args.option)
     edge = args.refine / 4 if args.refine_edge is None else args.refine_edge
     params = HertzParams(
         refine=args.refine,
@@ -102,7 +98,6 @@ def main() -> None:
         timers.seconds["mesh"] = mesh_timers.seconds["mesh"]
         t_run = time.perf_counter()
         if args.fixed_set:
-            assert isinstance(solver, dict)
             record = fixed_set_solve(scene, Method(method), solver, timers)
         else:
             try:
@@ -126,10 +121,9 @@ def main() -> None:
                         flush=True,
                     )
                 continue
-            V = sol.elasticity.V
             record = {
                 "predictor": "predictor" in timers.seconds,
-                "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+                "dofs": sol.dofs,
                 "multipliers": int(sol.layout.size),
                 "active_nodes": int(sol.active.sum()),
                 "iterations": sol.iterations,
@@ -137,7 +131,7 @@ def main() -> None:
                     {k: (float(v) if not isinstance(v, int) else v) for k, v in h.items()}
                     for h in sol.history
                 ],
-                "reference_linear_iterations": sol.info.get("reference_linear_iterations"),
+                "reference_linear_iterations": sol.reference_linear_iterations,
                 "hertz": {
                     k: v
                     for k, v in hertz_summary(sol).items()
@@ -162,33 +156,26 @@ def main() -> None:
             print("RESULT " + json.dumps(record), flush=True)
 
 
-def fixed_set_solve(scene, method: Method, options: dict, timers: Timers) -> dict:
+def fixed_set_solve(scene, method: Method, spec: SolverSpec, timers: Timers) -> dict:
     """Assemble, search, build B, then one fresh solve with x < a (Hertz) active."""
-    from contactfx.nullspace import near_nullspace
-    from contactfx.prepare import prepare_contact
-    from contactfx.problem import ActiveSetOptions
-    from contactfx.saddle import reference_solve
-    from contactfx.solvers import uses_augmentation
-
     comm = scene.mesh.comm
-    setup = prepare_contact(scene, method.operator, ActiveSetOptions().penetration_tol, timers)
-    el, layout = setup.elasticity, setup.layout
-    V = el.V
-    gamma = (
-        max(b.material.E for b in scene.bodies) / setup.h**2 if uses_augmentation(options) else 0.0
-    )
+    setup = prepare_contact(scene, method.kernel, ActiveSetOptions().penetration_tol, timers)
+    layout = setup.layout
     active = layout.x[layout.mine, 0] < scene.params["hertz_exact"]["a"]
-    nsp = near_nullspace(V, scene) if uses_augmentation(options) else None
-    res, seconds = reference_solve(el.K, setup.B, el.f, setup.g, active, options, gamma, nsp)
-    setup.B.destroy()
-    timers.seconds["reference_solve"] = seconds
+    res = reference_solve(setup, spec, scene, active, timers)
+    setup.destroy()
     return {
-        "dofs": V.dofmap.index_map.size_global * V.dofmap.index_map_bs,
+        "dofs": sol_dofs(setup.elasticity.V),
         "multipliers": int(layout.size),
         "active_nodes": comm.allreduce(int(active.sum())),
         "iterations": 1,
         "linear_iterations": res.iterations,
     }
+
+
+def sol_dofs(V) -> int:
+    """Displacement dofs of the space V."""
+    return V.dofmap.index_map.size_global * V.dofmap.index_map_bs
 
 
 if __name__ == "__main__":

@@ -26,11 +26,10 @@ import time
 from pathlib import Path
 from typing import Any
 
+from contactfx.meshes.hertz_structured import hertz_grid
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-sys.path.insert(0, str(ROOT))
-
-from meshes.hertz_structured import hertz_grid  # noqa: E402
 
 PY = sys.executable
 MPIRUN = str(Path(PY).parent / "mpirun")
@@ -70,7 +69,7 @@ def refine_for(dofs: float, mesh: str = "structured", ratio: float = H_RATIO) ->
     return round((lo * hi) ** 0.5, 6)
 
 
-def run_case(
+def run_process(
     mesh: str,
     methods: tuple[str, ...],
     solver: str,
@@ -416,7 +415,7 @@ def update(cases: list[str]) -> None:
         mesh, methods, solver, dofs, ranks, repeats = case.split(":")
         h0 = refine_for(float(dofs), mesh)
         for _ in range(int(repeats)):
-            recs = run_case(mesh, tuple(methods.split(",")), solver, h0, int(ranks))
+            recs = run_process(mesh, tuple(methods.split(",")), solver, h0, int(ranks))
             new += recs
             for rec in recs:
                 print(
@@ -507,7 +506,7 @@ def main() -> None:
             # take turns at being first, over the repeats and over the sizes.
             k = (i + sizes.index(dofs) if dofs in sizes else i) % len(methods)
             order = methods[k:] + methods[:k]
-            recs = run_case(mesh, order, solver, h0, nranks, basis=args.basis)
+            recs = run_process(mesh, order, solver, h0, nranks, basis=args.basis)
             runs += recs
             for rec in recs:
                 status = rec.get("error") or (

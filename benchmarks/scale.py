@@ -22,15 +22,14 @@ import json
 import os
 import platform
 import statistics
-import sys
 import time
 from pathlib import Path
 from typing import Any
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
+# The sweep's helpers (benchmarks/run.py, next to this script: on sys.path as its folder).
+from run import contact_solve, refine_for, run_process
 
-from run import contact_solve, refine_for, run_case  # noqa: E402
+HERE = Path(__file__).resolve().parent
 
 SERIAL = (100e3, 250e3, 500e3, 1e6, 2e6, 4e6)
 GRADED = (100e3, 500e3, 2e6)
@@ -50,7 +49,7 @@ def case(
 ) -> list[dict[str, Any]]:
     """One process: the Hertz mesh of about `dofs` (h_far = ratio * h), each method in turn."""
     h = refine_for(dofs, ratio=ratio)
-    out = run_case(
+    out = run_process(
         "structured",
         methods,
         solver,

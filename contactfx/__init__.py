@@ -1,14 +1,59 @@
 """contactfx: 2D frictionless contact of linear-elastic bodies with Lagrange multipliers.
 
-`Scene` (built-in scenes, scene files or `Scene.from_gmsh`) and `solve(scene, method)` are
+A `Scene` (built-in scenes, scene files or `scene_from_gmsh`) and `solve(scene, method)` are
 the Python API; `python -m contactfx solve ...` is the command line over the same calls.
 """
 
+from importlib.metadata import version as _version
+
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 
-__version__ = "0.2.0"
+from .api import run_case, run_scene, solve
+from .errors import (
+    ActiveSetError,
+    ContactFxError,
+    ConvergenceError,
+    GeometryError,
+    InputError,
+    MeshError,
+    SingularSystemError,
+    SolverError,
+)
+from .methods import SchwarzOptions, Solution
+from .options import SOLVERS, Basis, Method, Predictor, SolverKind, SolverSpec
+from .scenes import (
+    HertzReference,
+    Scene,
+    UniformStress,
+    load_scene_file,
+)
+from .scenes import from_gmsh as scene_from_gmsh
 
-from .api import run_scene, solve
-from .scenes import Scene, load_scene_file
+__version__ = _version("contactfx")
 
-__all__ = ["Scene", "load_scene_file", "run_scene", "solve"]
+__all__ = [
+    "SOLVERS",
+    "ActiveSetError",
+    "Basis",
+    "ContactFxError",
+    "ConvergenceError",
+    "GeometryError",
+    "HertzReference",
+    "InputError",
+    "MeshError",
+    "Method",
+    "Predictor",
+    "Scene",
+    "SchwarzOptions",
+    "SingularSystemError",
+    "Solution",
+    "SolverError",
+    "SolverKind",
+    "SolverSpec",
+    "UniformStress",
+    "load_scene_file",
+    "run_case",
+    "run_scene",
+    "scene_from_gmsh",
+    "solve",
+]

@@ -37,3 +37,20 @@ class ConvergenceError(ContactFxError):
     """
 
     history: list[dict[str, float | None]]
+
+
+def error_type(name: str) -> type[ContactFxError]:
+    """The contactfx error class called `name` (MeshError if there is none by that name).
+
+    Lets a rank that only received an error's name and text (a broadcast from rank 0) raise
+    the same type as the rank where it happened.
+    """
+    found = {cls.__name__: cls for cls in _subclasses(ContactFxError)}
+    return found.get(name, MeshError)
+
+
+def _subclasses(cls: type[ContactFxError]) -> list[type[ContactFxError]]:
+    out = [cls]
+    for sub in cls.__subclasses__():
+        out += _subclasses(sub)
+    return out

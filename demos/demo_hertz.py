@@ -33,7 +33,7 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
-from contactfx.hertz import exact_pressure
+from contactfx.results.references import exact_pressure
 from contactfx.scenes import HertzParams, hertz, hertz_exact
 from contactfx.study import (
     Level,
@@ -105,7 +105,7 @@ assert all(
 ), "the study's levels are not demo's graded() meshes"
 # The paper's uniform sizes are not a geometric sequence: levels given one by one.
 uniform_levels = [
-    Level(k, h, {"refine": h}, lambda h=h: hertz(uniform(h), comm=comm))
+    Level(k, h, {"refine": h}, lambda h=h: hertz(uniform(h), comm=comm), paper_interface=True)
     for k, h in enumerate(UNIFORM)
 ]
 say("graded meshes:")

@@ -32,10 +32,10 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
-from contactfx.hertz import hertz_summary
-from contactfx.methods import Method
-from contactfx.penalty import DEFAULT_FACTOR, condition_estimate, penetration, solve_penalty
-from contactfx.problem import solve_contact
+from contactfx.methods.multipliers import solve_contact
+from contactfx.methods.penalty import DEFAULT_FACTOR, ConditionOptions, penetration, solve_penalty
+from contactfx.options import Method
+from contactfx.results.references import hertz_summary
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene
 
 matplotlib.use("Agg")
@@ -86,9 +86,9 @@ for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
     ref_l2 = hertz_summary(ref)["l2_error"] if kind == "hertz" else 0.0
     for factor in FACTORS:
         eps = factor * eu
-        sol = solve_penalty(scene, eps)
+        sol = solve_penalty(scene, eps, condition=ConditionOptions(max_it=CG_MAX_IT))
         du = comm.allreduce(float(np.abs(sol.u.x.array - u_ref).max()), op=MPI.MAX)
-        cond = condition_estimate(sol, eps, max_it=CG_MAX_IT)
+        cond = sol.penalty.condition
         row = {
             "scene": name,
             "factor": factor,
@@ -223,5 +223,5 @@ if not QUICK:
     assert s3[1e10]["pressure_error_vs_mortar"] > 100 * min(errs)
 assert abs(hz[1e3]["l2_error_vs_exact"] / hz[1e3]["l2_error_mortar"] - 1) < 0.01, hz[1e3]
 for r in rows:
-    assert r["p_max"] == r["p_max"] and r["penetration"] >= 0
+    assert np.isfinite(r["p_max"]) and r["penetration"] >= 0
 say("all checks passed")

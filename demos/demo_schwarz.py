@@ -37,10 +37,10 @@ from mpi4py import MPI
 
 from contactfx.api import run_case
 from contactfx.errors import ConvergenceError
-from contactfx.methods import Method
-from contactfx.postprocess import body_stress_deviation
+from contactfx.methods.schwarz import SchwarzOptions
+from contactfx.options import Method
+from contactfx.results.stress import body_stress_deviation
 from contactfx.scenes import BLOCK_SCENES
-from contactfx.schwarz import SchwarzOptions
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt

@@ -32,12 +32,12 @@ import numpy as np
 from matplotlib.colors import LogNorm
 from mpi4py import MPI
 
-from contactfx.methods import Method
-from contactfx.metrics import mismatch, patch_errors
-from contactfx.penalty import solve_penalty
-from contactfx.postprocess import body_stress_deviation, surface_stress
-from contactfx.postprocess import cartesian_interface as interface
-from contactfx.problem import solve_contact
+from contactfx.methods.multipliers import solve_contact
+from contactfx.methods.penalty import solve_penalty
+from contactfx.options import Method
+from contactfx.results.interface import cartesian_interface as interface
+from contactfx.results.paper import mismatch, patch_errors
+from contactfx.results.stress import body_stress_deviation, surface_stress
 from contactfx.scenes import BLOCK_SCENES, build_scene
 
 matplotlib.use("Agg")

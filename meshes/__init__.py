@@ -1,10 +1,13 @@
 """gmsh scene geometry (blocks S1-S4, Hertz S5) and the structured Hertz grid.
 
-Geometry only: these modules depend on gmsh and numpy, never on contactfx, which loads
-them into DOLFINx (contactfx.scenes). Builders raise ValueError for bad parameters.
+Geometry only: these modules depend on gmsh and numpy, never on the rest of contactfx,
+which loads them into DOLFINx (contactfx.scenes). The folder is installed as the
+subpackage `contactfx.meshes` (pyproject.toml), not as a top-level package. Builders raise
+ValueError for bad parameters.
 """
 
-from meshes.blocks import build_blocks
-from meshes.hertz import build_hertz
+from .blocks import build_blocks
+from .hertz import QUAD4, build_hertz
+from .hertz_structured import hertz_grid
 
-__all__ = ["build_blocks", "build_hertz"]
+__all__ = ["QUAD4", "build_blocks", "build_hertz", "hertz_grid"]

@@ -8,8 +8,8 @@ import gmsh
 # The elastic field decays like 1/r in 2D, so every decade of distance adds about the same
 # discretization error: the slope, not the far size, sets the error in the compliance.
 _SLOPE = 0.1
-# Quad element types of gmsh (4-node quadrangle); anything else is a leftover triangle.
-_QUAD4 = 3
+# gmsh element type of the 4-node quadrangle; anything else is a leftover triangle.
+QUAD4 = 3
 
 
 def build_hertz(
@@ -122,5 +122,5 @@ def build_hertz(
             gmsh.option.setNumber(name, value)
 
     types, _, _ = gmsh.model.mesh.getElements(2)
-    if any(t != _QUAD4 for t in types):
+    if any(t != QUAD4 for t in types):
         raise ValueError(f"Hertz mesh has non-quadrilateral elements (gmsh types {list(types)})")

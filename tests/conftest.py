@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from contactfx.contact import Surface
-from contactfx.methods import Method
+from contactfx.options import Method
 
 ROOT = Path(__file__).resolve().parents[1]
 MPIRUN = str(Path(sys.executable).parent / "mpirun")

@@ -7,8 +7,8 @@ import pytest
 from conftest import MULTIPLIER_METHODS
 
 from contactfx.api import run_case
-from contactfx.metrics import patch_errors
-from contactfx.postprocess import body_stress_deviation
+from contactfx.results.paper import patch_errors
+from contactfx.results.stress import body_stress_deviation
 from contactfx.scenes import BLOCK_SCENES
 
 METHODS = [m.value for m in MULTIPLIER_METHODS]

@@ -47,7 +47,7 @@ def test_registry_and_unknown_method():
     assert set(OPERATORS) == {"nts", "sts", "mortar"}
     op = contact_operator("mortar", active, passive, nd)
     assert isinstance(op, ContactOperator) and op.B.shape == (2, nd)
-    with pytest.raises(ValueError, match="unknown contact method"):
+    with pytest.raises(ValueError, match="not a valid Kernel"):
         contact_operator("penalty", active, passive, nd)
 
 

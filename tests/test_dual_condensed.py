@@ -68,37 +68,55 @@ def test_condensed_equals_mumps(small_hertz, method: str, basis: str) -> None:
     assert all(h["linear_iterations"] > 0 for h in sol.history)  # CG really ran
 
 
-def _condensed_solver(scene):
+def _condensed_solver(scene, reuse: bool = True):
     """The setup of the NTS Hertz problem and a condensed solver on it."""
-    from contactfx.condensed import CondensedSolver, owned_node_dofs
-    from contactfx.methods import Method
-    from contactfx.nullspace import rigid_body_modes
-    from contactfx.prepare import prepare_contact
-    from contactfx.problem import ActiveSetOptions
-    from contactfx.solvers import SOLVERS
+    from contactfx.discretize.setup import prepare_contact
+    from contactfx.discretize.supports import rigid_body_modes
+    from contactfx.linalg import make_solver
+    from contactfx.methods.active_set import ActiveSetOptions
+    from contactfx.options import SOLVERS, Method
     from contactfx.timers import Timers
 
-    setup = prepare_contact(
-        scene, Method.NTS.operator, ActiveSetOptions().penetration_tol, Timers()
-    )
+    setup = prepare_contact(scene, Method.NTS.kernel, ActiveSetOptions().penetration_tol, Timers())
     el = setup.elasticity
-    dofs = owned_node_dofs(setup.layout.gblock, setup.layout.mine)
-    modes = rigid_body_modes(el.V, scene)
-    return setup, CondensedSolver(el.K, setup.B, el.f, SOLVERS["condensed"], dofs, modes)
+    solver = make_solver(
+        SOLVERS["condensed"],
+        el.K,
+        setup.B,
+        el.f,
+        e_max=setup.e_max,
+        h=setup.h,
+        modes=lambda: rigid_body_modes(el.V, scene),
+        node_dofs=setup.node_dofs(),
+        reuse=reuse,
+    )
+    return setup, solver
 
 
 def test_condensed_matrix_equals_ptap(small_hertz) -> None:
     """K + E^T K + K E + E^T K E with the pivots decoupled is PETSc's PtAP T^T K T + P."""
     from petsc4py import PETSc
 
+    from contactfx.linalg.elimination import (
+        LocalRows,
+        condensed_matrix,
+        elimination_matrix,
+        pivot_rows,
+        pivots,
+    )
+
     setup, solver = _condensed_solver(small_hertz)
     x = setup.layout.x[setup.layout.mine, 0]
-    rows, piv, coef = solver._pivots(x < small_hertz.params["hertz_exact"]["a"])
-    prows = solver._pivot_rows(rows, piv, coef)
-    T = solver._matrix(prows, identity=True)
-    ip = piv.astype(PETSc.IntType)
-    A = solver._condensed_matrix(prows, ip)
     K = setup.elasticity.K
+    rows_b = LocalRows.of(setup.B, setup.node_dofs())
+    rows, piv, coef = pivots(rows_b, x < small_hertz.params["hertz_exact"]["a"], setup.comm)
+    r0, r1 = K.getOwnershipRange()
+    prows = pivot_rows(rows_b, rows, piv, coef, r0)
+    T = elimination_matrix(prows, r0, r1, K.getSize()[0], K.getComm(), identity=True)
+    E = elimination_matrix(prows, r0, r1, K.getSize()[0], K.getComm(), identity=False)
+    ip = piv.astype(PETSc.IntType)
+    A = condensed_matrix(K, E, piv, K.getDiagonal())
+    E.destroy()
     R = K.ptap(T)
     R.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
     d = R.createVecLeft()
@@ -122,12 +140,12 @@ def test_reused_multigrid_gives_the_fresh_answer(small_hertz) -> None:
     a = small_hertz.params["hertz_exact"]["a"]
     first, second = x < 1.2 * a, x < a
     assert 0 < (first & ~second).sum() <= 64  # within the reuse rule
-    solver.solve(setup.g, first)
-    reused = solver.polish(setup.g, second)
-    assert not reused.info["refactored"]
-    _, fresh_solver = _condensed_solver(small_hertz)
-    fresh = fresh_solver.polish(setup.g, second)
-    assert fresh.info["refactored"]
+    last = solver.solve(setup.g, first)
+    reused = solver.polish(setup.g, second, last)
+    assert not reused.refactored
+    _, fresh_solver = _condensed_solver(small_hertz, reuse=False)
+    fresh = fresh_solver.solve(setup.g, second)
+    assert fresh.refactored
     scale = np.abs(fresh.u).max()
     assert np.abs(reused.u - fresh.u).max() <= 1e-7 * scale
     assert np.abs(reused.mu - fresh.mu).max() <= 1e-6 * np.abs(fresh.mu).max()

@@ -23,9 +23,9 @@ from contactfx.errors import (
     SingularSystemError,
     SolverError,
 )
-from contactfx.methods import Method
-from contactfx.penalty import solve_penalty
-from contactfx.problem import solve_contact
+from contactfx.methods.multipliers import solve_contact
+from contactfx.methods.penalty import solve_penalty
+from contactfx.options import SOLVERS, Method, SolverKind, SolverSpec
 from contactfx.scenes import BLOCK_SCENES, BlockParams, Groups, Scene, build_scene
 
 COARSE = replace(BLOCK_SCENES["S4"], size1=0.5, size2=0.6)
@@ -193,17 +193,29 @@ def test_no_support_at_all(solve) -> None:
 
 
 def test_linear_solve_not_converging_reports_reason() -> None:
-    opts = {"ksp_type": "gmres", "pc_type": "none", "ksp_max_it": 5}
+    few = ["ksp_max_it=5", "fieldsplit_lambda_ksp_max_it=1"]
     with pytest.raises(SolverError, match=r"reason -3 \(DIVERGED_MAX_IT\) after 5 iterations"):
-        run_case("blocks", COARSE, "mortar", solver=opts, comm=MPI.COMM_SELF)
+        spec = SOLVERS["fieldsplit"].with_petsc(few)
+        run_case("blocks", COARSE, "mortar", solver=spec, comm=MPI.COMM_SELF)
+    plain = SolverSpec(SolverKind.CONDENSED, {"ksp_type": "gmres", "pc_type": "none"})
     with pytest.raises(SolverError, match=r"reason -3 \(DIVERGED_MAX_IT\) after 5 iterations"):
-        run_case("blocks", COARSE, "penalty", solver=opts, comm=MPI.COMM_SELF)
+        run_case("blocks", COARSE, "penalty", solver=plain.with_petsc(few[:1]), comm=MPI.COMM_SELF)
 
 
-@pytest.mark.parametrize("method", ["mortar", "penalty"])
-def test_petsc_error_becomes_solver_error(method: str) -> None:
+@pytest.mark.parametrize(("method", "solver"), [("mortar", "fieldsplit"), ("penalty", "mumps")])
+def test_petsc_error_becomes_solver_error(method: str, solver: str) -> None:
+    bogus = SOLVERS[solver].with_petsc(["ksp_type=bogus"])
     with pytest.raises(SolverError, match=r"PETSc error 86 .*Unable to find requested KSP type"):
-        run_case("blocks", COARSE, method, solver={"ksp_type": "bogus"}, comm=MPI.COMM_SELF)
+        run_case("blocks", COARSE, method, solver=bogus, comm=MPI.COMM_SELF)
+
+
+def test_petsc_options_cannot_change_the_solver_kind() -> None:
+    """The kind is a value of the spec: options that contradict it are refused, not obeyed."""
+    for name, item in [("mumps", "pc_type=fieldsplit"), ("condensed", "pc_type=fieldsplit")]:
+        with pytest.raises(InputError, match="contradicts it"):
+            SOLVERS[name].with_petsc([item])
+    with pytest.raises(InputError, match="contradicts it"):
+        SolverSpec(SolverKind.FIELDSPLIT, {"pc_type": "lu"})
 
 
 def test_penalty_refuses_fieldsplit() -> None:
@@ -254,15 +266,13 @@ S4 = ["blocks", "--preset", "S4", "--size1", "0.5", "--size2", "0.6"]
         (
             [
                 *S4,
-                "--petsc-option",
-                "ksp_type=gmres",
-                "--petsc-option",
-                "pc_type=none",
-                "--petsc-option",
-                "ksp_max_it=5",
+                *("--method", "penalty", "--solver", "condensed"),
+                *("--petsc-option", "pc_type=none", "--petsc-option", "ksp_max_it=5"),
             ],
             "PETSc reason -3 (DIVERGED_MAX_IT)",
         ),
+        # A PETSc option cannot switch the solver's kind (it used to, silently).
+        ([*S4, "--petsc-option", "pc_type=fieldsplit"], "pc_type=fieldsplit contradicts it"),
         (
             [
                 *S4,
@@ -275,7 +285,7 @@ S4 = ["blocks", "--preset", "S4", "--size1", "0.5", "--size2", "0.6"]
             ],
             "did not converge: PETSc reason",
         ),
-        ([*S4, "--petsc-option", "pc_type=bogus"], "PETSc error 86"),
+        ([*S4, "--solver", "fieldsplit", "--petsc-option", "ksp_type=bogus"], "PETSc error 86"),
         ([*S4, "--method", "penalty", "--penalty", "-1"], "penalty parameter must be a positive"),
         ([*S4, "--penalty", "1e6"], "--penalty applies to --method penalty only"),
         (["hertz", "--refine", "0.1", "--max-iterations", "1"], "did not converge in 1 iterations"),

@@ -11,8 +11,8 @@ from mpi4py import MPI
 
 from contactfx.api import run_case
 from contactfx.errors import InputError, SingularSystemError
-from contactfx.hertz import exact_pressure, fit_half_width, l2_error
-from contactfx.problem import lcp_active_set
+from contactfx.methods.active_set import lcp_active_set
+from contactfx.results.references import exact_pressure, fit_half_width, l2_error
 from contactfx.scenes import BlockParams, HertzParams, hertz_exact
 
 # Coarse graded meshes: (size at the contact edge, slope), slope ~ sqrt(h) as in the demo.
@@ -116,8 +116,9 @@ def test_active_set_iterations_bounded(multiplier_method: str) -> None:
 
 def test_plain_update_needs_many_more_iterations() -> None:
     # The predictor is what makes it cheap: without it the same scene takes > 10 solves.
-    from contactfx.methods import Method
-    from contactfx.problem import ActiveSetOptions, solve_contact
+    from contactfx.methods.active_set import ActiveSetOptions
+    from contactfx.methods.multipliers import solve_contact
+    from contactfx.options import Method
     from contactfx.scenes import build_scene
 
     scene = build_scene("hertz", _graded(0.02, 0.2), comm=MPI.COMM_SELF)

@@ -7,12 +7,12 @@ from pathlib import Path
 import dolfinx_solver  # noqa: F401 - orders MPI ahead of the dolfinx bindings
 import numpy as np
 import pytest
+from contactfx.meshes import build_blocks, build_hertz
 from dolfinx.io.gmsh import MeshData
 from dolfinx.mesh import CellType, entities_to_geometry
 from mpi4py import MPI
 
 from contactfx.scenes.gmsh_io import balanced_partitioner, to_dolfinx
-from meshes import build_blocks, build_hertz
 
 NAMES = {"body1", "body2", "contact1", "contact2", "symmetry", "support", "load"}
 # (l1, l2, h1, h2, size1, size2, grading1, grading2) of the block scenes
@@ -154,7 +154,7 @@ import numpy as np
 from functools import partial
 from mpi4py import MPI
 from contactfx.scenes.gmsh_io import balanced_partitioner, to_dolfinx
-from meshes import build_blocks
+from contactfx.meshes import build_blocks
 
 comm = MPI.COMM_WORLD
 md = to_dolfinx(comm, partial(build_blocks, {args}), balanced_partitioner())

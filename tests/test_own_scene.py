@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, run_cli
 
-from contactfx import Scene, load_scene_file, run_scene
+from contactfx import Scene, load_scene_file, run_scene, scene_from_gmsh
 from contactfx.errors import GeometryError, InputError, MeshError, SingularSystemError
 from contactfx.scenes import ContactPair, Dirichlet, Material, Pressure
 
@@ -214,7 +214,7 @@ def test_small_user_scene_point_support_and_cli(tmp_path: Path) -> None:
 
 
 def test_from_gmsh_model_in_python() -> None:
-    """Scene.from_gmsh takes the gmsh module's current model (built with its Python API)."""
+    """scene_from_gmsh takes the gmsh module's current model (built with its Python API)."""
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     try:
@@ -242,7 +242,7 @@ def test_from_gmsh_model_in_python() -> None:
             (1, [l2[2]], "load"),
         ):
             gmsh.model.addPhysicalGroup(dim, ents, name=name)
-        scene = Scene.from_gmsh(
+        scene = scene_from_gmsh(
             gmsh.model,
             bodies={"lower": Material(1000.0, 0.3), "upper": {"E": 500.0, "nu": 0.25}},
             contacts=[ContactPair("bottom", "top")],
@@ -309,7 +309,7 @@ MPI_SCRIPT = textwrap.dedent("""
     import numpy as np
     from mpi4py import MPI
     from contactfx import load_scene_file, run_scene
-    from contactfx.postprocess import u_at_points
+    from contactfx.results.interface import u_at_points
 
     sol, data = run_scene(load_scene_file(sys.argv[1]), sys.argv[2])
     u = u_at_points(sol)

@@ -12,7 +12,7 @@ SCRIPT = textwrap.dedent("""
     import numpy as np
     from mpi4py import MPI
     from contactfx.api import run_case
-    from contactfx.postprocess import u_at_points
+    from contactfx.results.interface import u_at_points
     from contactfx.scenes import BLOCK_SCENES
 
     scene, method, active, solver, out = sys.argv[1:6]

@@ -16,9 +16,10 @@ from conftest import ENV, MPIRUN
 from mpi4py import MPI
 
 from contactfx.api import run_case
-from contactfx.metrics import patch_errors
-from contactfx.penalty import DEFAULT_FACTOR, penetration
-from contactfx.postprocess import body_stress_deviation, u_at_points
+from contactfx.methods.penalty import DEFAULT_FACTOR, penetration
+from contactfx.results.interface import u_at_points
+from contactfx.results.paper import patch_errors
+from contactfx.results.stress import body_stress_deviation
 from contactfx.scenes import BLOCK_SCENES, HertzParams
 
 S4 = replace(BLOCK_SCENES["S4"], size1=0.3, size2=0.4)

@@ -10,24 +10,28 @@ import textwrap
 import numpy as np
 import pytest
 from conftest import run_cli
+from contactfx.meshes.hertz_structured import graded_points, hertz_grid
 from mpi4py import MPI
 
-from contactfx.elasticity import material_fields, sigma
-from contactfx.methods import Method
-from contactfx.nullspace import rigid_body_modes
-from contactfx.prepare import prepare_contact
-from contactfx.problem import ActiveSetOptions, solve_contact
-from contactfx.saddle import SaddleSolver, solve_saddle
+from contactfx.contact import Kernel
+from contactfx.discretize.elasticity import material_fields, sigma
+from contactfx.discretize.setup import prepare_contact
+from contactfx.discretize.supports import rigid_body_modes
+from contactfx.errors import InputError
+from contactfx.linalg.policy import FactorizationPolicy, ReuseMode
+from contactfx.linalg.saddle import SaddleSolver
+from contactfx.methods.active_set import ActiveSetOptions
+from contactfx.methods.multipliers import solve_contact
+from contactfx.options import SOLVERS, Method, Predictor
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
 from contactfx.timers import Timers
-from meshes.hertz_structured import graded_points, hertz_grid
 
 
 @pytest.fixture(scope="module")
 def hertz_system():
     """K, B, f and the weighted gaps of the default Hertz scene with mortar (small)."""
     scene = build_scene("hertz", HertzParams())
-    setup = prepare_contact(scene, "mortar", ActiveSetOptions().penetration_tol, Timers())
+    setup = prepare_contact(scene, Kernel.MORTAR, ActiveSetOptions().penetration_tol, Timers())
     yield setup.elasticity, setup.B, setup.g, setup.layout.x[setup.layout.mine, 0]
     setup.B.destroy()
 
@@ -43,6 +47,20 @@ def _close(res, ref) -> None:
     assert du <= 1e-8 and dmu <= 1e-8, (du, dmu)
 
 
+MUMPS = SOLVERS["mumps"].petsc
+
+
+def _saddle(el, B, policy=None, gamma: float = 0.0) -> SaddleSolver:
+    """A MUMPS saddle-point solver on K, B, f (policy None: a throwaway one)."""
+    return SaddleSolver(el.K, B, el.f, MUMPS, direct=True, gamma=gamma, policy=policy)
+
+
+def _fresh(el, B, g, active):
+    """One fresh factorization and solve of `active`: the reference of every reuse path."""
+    with _saddle(el, B) as solver:
+        return solver.solve(g, active)
+
+
 def test_probe_responses_do_not_depend_on_augmentation(hertz_system) -> None:
     """Probe responses with A00 = K + gamma B^T B equal those of the plain saddle point."""
     el, B, g, x = hertz_system
@@ -50,11 +68,11 @@ def test_probe_responses_do_not_depend_on_augmentation(hertz_system) -> None:
     probes = np.zeros((len(x), 3))
     rows = np.flatnonzero(active)[:3]
     probes[rows, np.arange(len(rows))] = 1.0
-    mumps = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
     out = []
     for gamma in (0.0, 7000.0 / 0.02**2):
-        with SaddleSolver(el.K, B, el.f, mumps, gamma) as solver:
-            out.append(solver.solve(g, active, probes).info["probes"])
+        with _saddle(el, B, FactorizationPolicy(), gamma) as solver:
+            solver.solve(g, active, fresh=True)
+            out.append(solver.responses(probes, active))
     scale = np.abs(out[0]).max()
     assert scale > 0 and np.abs(out[1] - out[0]).max() <= 1e-8 * scale
 
@@ -63,35 +81,15 @@ def test_persistent_solver_equals_fresh_solves(hertz_system) -> None:
     """Every reuse path (refactor, lagged LU + GMRES, released-row capacitance) is exact."""
     el, B, g, x = hertz_system
     sets = [x < 1.0, x < 1.3, x < 1.2, (x < 1.1) | ((x > 1.4) & (x < 1.5)), x < 0.9]
-    with SaddleSolver(
-        el.K,
-        B,
-        el.f,
-        {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
-    ) as solver:
-        solver.policy = "reuse"
+    with _saddle(el, B, FactorizationPolicy(mode=ReuseMode.REUSE)) as solver:
         paths = []
         for active in sets:
             res = solver.solve(g, active)
-            _close(
-                res,
-                solve_saddle(
-                    el.K,
-                    B,
-                    el.f,
-                    g,
-                    active,
-                    {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
-                ),
-            )
+            _close(res, _fresh(el, B, g, active))
             paths.append(
-                "released"
-                if "released" in res.info
-                else "factorized"
-                if res.info["refactored"]
-                else "lagged"
+                "released" if res.released else "factorized" if res.refactored else "lagged"
             )
-        assert solver.stats["factorizations"] == 1
+        assert solver.factored.count == 1
     # The factorized set stays x < 1: the next three add rows to it, so GMRES runs on the
     # lagged factorization (a low-rank change); the last only releases rows (capacitance).
     assert paths == ["factorized", "lagged", "lagged", "lagged", "released"]
@@ -100,13 +98,12 @@ def test_persistent_solver_equals_fresh_solves(hertz_system) -> None:
 def test_released_rows_use_capacitance(hertz_system) -> None:
     """A subset of the factorized set is solved without a new factorization, exactly."""
     el, B, g, x = hertz_system
-    opts = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-    with SaddleSolver(el.K, B, el.f, opts) as solver:
+    with _saddle(el, B, FactorizationPolicy()) as solver:
         first = solver.solve(g, x < 2.0)
-        assert first.info["refactored"]
+        assert first.refactored
         res = solver.solve(g, x < 1.2)
-        assert res.info.get("released", 0) > 0 and solver.stats["factorizations"] == 1
-        _close(res, solve_saddle(el.K, B, el.f, g, x < 1.2, opts))
+        assert res.released > 0 and solver.factored.count == 1
+        _close(res, _fresh(el, B, g, x < 1.2))
         assert np.all(res.mu[~(x < 1.2)] == 0.0)
 
 
@@ -228,8 +225,8 @@ MPI_SCRIPT = textwrap.dedent("""
     import sys
     import numpy as np
     from mpi4py import MPI
-    from contactfx.methods import Method
-    from contactfx.problem import solve_contact
+    from contactfx.options import Method
+    from contactfx.methods.multipliers import solve_contact
     from contactfx.scenes import HertzParams
     from contactfx.scenes import hertz
 
@@ -266,7 +263,7 @@ def structured_pair():
 @pytest.mark.parametrize("method", [Method.MORTAR, Method.NTS, Method.STS])
 def test_coarse_predictor_same_answer_one_factorization(structured_pair, method) -> None:
     """A coarse solve's zone as the first set: the same converged set and fields, one LU."""
-    from contactfx.problem import coarse_initial_set
+    from contactfx.methods.predictor import coarse_initial_set
 
     fine, coarse = structured_pair
     # The plain loop: from the touching nodes (the default now starts from every row).
@@ -307,24 +304,34 @@ def test_start_from_every_row_same_answer_one_factorization(structured_pair, met
 
 
 def test_selected_inverse_responses_equal_dense_solves(hertz_system) -> None:
-    """Probe responses from MUMPS' selected inverse entries equal multi-RHS solves."""
+    """Probe responses from MUMPS' selected inverse entries equal solves with f = 0, g = -e_j.
+
+    Column j of the responses is mu of the saddle point with no load and the weighted gap
+    of row j opened by 1: solved here column by column on the same factorization.
+    """
     el, B, g, x = hertz_system
     active = x < 1.6
     rows = np.flatnonzero(active)
     probes = np.zeros((len(x), len(rows)))
     probes[rows, np.arange(len(rows))] = 1.0
-    opts = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-    with SaddleSolver(el.K, B, el.f, opts) as solver:
+    zero = el.f.duplicate()
+    zero.set(0.0)
+    with _saddle(el, B, FactorizationPolicy()) as solver:
         assert solver.cheap_responses
-        res = solver.solve(g, active, probes)
-        dense = np.zeros_like(probes)
-        solver._dense_responses(probes, active, dense)
-        selected = res.info["probes"]
-        scale = np.abs(dense).max()
-        assert scale > 0 and np.abs(selected - dense).max() <= 1e-10 * scale
+        solver.solve(g, active, fresh=True)
+        selected = solver.responses(probes, active)
         # MUMPS is back to ordinary solves afterwards: a released set, then a refactored one.
-        _close(solver.solve(g, x < 1.2), solve_saddle(el.K, B, el.f, g, x < 1.2, opts))
-        _close(solver.solve(g, x < 1.8), solve_saddle(el.K, B, el.f, g, x < 1.8, opts))
+        _close(solver.solve(g, x < 1.2), _fresh(el, B, g, x < 1.2))
+        _close(solver.solve(g, x < 1.8), _fresh(el, B, g, x < 1.8))
+    picked = np.linspace(0, len(rows) - 1, 5).astype(int)
+    with SaddleSolver(el.K, B, zero, MUMPS, direct=True, policy=FactorizationPolicy()) as ref:
+        for j in picked:
+            unit = np.zeros(len(x))
+            unit[rows[j]] = -1.0
+            dense = ref.solve(unit, active).mu
+            scale = np.abs(dense).max()
+            assert scale > 0 and np.abs(selected[:, j] - dense).max() <= 1e-10 * scale
+    zero.destroy()
 
 
 @pytest.mark.parametrize("guess", ["inside", "far", "nothing"])
@@ -342,7 +349,8 @@ def test_any_initial_set_converges_to_the_same_answer(structured_pair, guess) ->
 
 def test_run_case_coarse_predictor() -> None:
     """run_case's coarse predictor: timed apart, same contact zone and force as without it."""
-    from contactfx.api import run_case, use_coarse
+    from contactfx.api import run_case
+    from contactfx.methods.predictor import use_coarse
 
     params = HertzParams(refine=0.025, mesh="structured")
     base, s_base = run_case("hertz", params, "mortar", predictor="none")
@@ -352,6 +360,6 @@ def test_run_case_coarse_predictor() -> None:
     assert np.abs(sol.pressure - base.pressure).max() <= 1e-8 * np.abs(base.pressure).max()
     assert sum(h["factorized"] for h in sol.history) == 1
     # "auto" leaves small meshes alone.
-    assert not use_coarse("auto", sol.scene, {"ksp_type": "preonly", "pc_type": "lu"})
-    with pytest.raises(ValueError):
-        use_coarse("sometimes", sol.scene, {})
+    assert not use_coarse(Predictor.AUTO, sol.scene, SOLVERS["fieldsplit"])
+    with pytest.raises(InputError):
+        Predictor.parse("sometimes")

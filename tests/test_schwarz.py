@@ -13,9 +13,10 @@ from conftest import run_cli
 
 from contactfx.api import run_case
 from contactfx.errors import ConvergenceError, InputError
-from contactfx.postprocess import body_stress_deviation, u_at_points
+from contactfx.methods.schwarz import SchwarzOptions, solve_schwarz
+from contactfx.results.interface import u_at_points
+from contactfx.results.stress import body_stress_deviation
 from contactfx.scenes import BLOCK_SCENES, build_scene
-from contactfx.schwarz import SchwarzOptions, solve_schwarz
 
 
 def _arr(data: dict, key: str) -> np.ndarray:
@@ -184,7 +185,7 @@ SCRIPT = textwrap.dedent("""
     import numpy as np
     from mpi4py import MPI
     from contactfx.api import run_case
-    from contactfx.postprocess import u_at_points
+    from contactfx.results.interface import u_at_points
     from contactfx.scenes import BLOCK_SCENES
 
     scene, active, out = sys.argv[1:4]

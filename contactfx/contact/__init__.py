@@ -3,30 +3,39 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from enum import StrEnum
 
 from . import mortar, nts, sts
 from .geometry import Surface
-from .operator import ContactOperator
+from .operator import ContactOperator, overlap_tolerance
 
-__all__ = ["OPERATORS", "ContactOperator", "Surface", "contact_operator"]
+__all__ = [
+    "OPERATORS",
+    "ContactOperator",
+    "Kernel",
+    "Surface",
+    "contact_operator",
+    "overlap_tolerance",
+]
 
-OPERATORS: dict[str, Callable[..., ContactOperator]] = {
-    "nts": nts.contact_operator,
-    "sts": sts.contact_operator,
-    "mortar": mortar.contact_operator,
+
+class Kernel(StrEnum):
+    """The discrete contact operators: node-to-surface, surface-to-surface (Gauss), mortar."""
+
+    NTS = "nts"
+    STS = "sts"
+    MORTAR = "mortar"
+
+
+OPERATORS: dict[Kernel, Callable[..., ContactOperator]] = {
+    Kernel.NTS: nts.contact_operator,
+    Kernel.STS: sts.contact_operator,
+    Kernel.MORTAR: mortar.contact_operator,
 }
 
 
 def contact_operator(
-    method: str, active: Surface, passive: Surface, ndofs: int, **options: object
+    kernel: Kernel, active: Surface, passive: Surface, ndofs: int, **options: object
 ) -> ContactOperator:
-    """Build the contact operator of the named method ("nts", "sts" or "mortar").
-
-    `options` go to the kernel (e.g. the mortar multiplier basis).
-    """
-    try:
-        build = OPERATORS[method]
-    except KeyError:
-        known = ", ".join(OPERATORS)
-        raise ValueError(f"unknown contact method {method!r} (known: {known})") from None
-    return build(active, passive, ndofs, **options)
+    """Build the contact operator of `kernel`; `options` go to it (e.g. mortar's basis)."""
+    return OPERATORS[Kernel(kernel)](active, passive, ndofs, **options)

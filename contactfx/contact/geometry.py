@@ -275,3 +275,48 @@ def chains(surface: Surface) -> Chains:
         closed[ids] = is_loop
         offset += len(ids)
     return Chains(order=order, position=position, start=start, length=length, closed=closed)
+
+
+def arc_length(surface: Surface) -> tuple[np.ndarray, np.ndarray]:
+    """(s, t): arc length and unit tangent of every node along the surface's polylines.
+
+    Each polyline starts at its end with the smallest (x, y) so that s does not depend on
+    the node numbering (and hence not on the number of ranks); polylines follow one
+    another in that order, s continuing from one to the next.
+    """
+    ch = chains(surface)
+    seg = surface.segments
+    s = np.full(surface.n_nodes, np.nan)
+    t = np.zeros((surface.n_nodes, 2))
+    runs = [
+        ch.order[st : st + ln]
+        for st, ln in sorted({(int(a), int(b)) for a, b in zip(ch.start, ch.length, strict=True)})
+    ]
+    walks = []
+    for run in runs:
+        # Node sequence along the run, from the first segment's free end.
+        a, b = seg[run[0]]
+        if len(run) > 1 and a in seg[run[1]]:
+            a, b = b, a
+        nodes: list[np.integer] | np.ndarray
+        nodes = [a, b]
+        for e in run[1:]:
+            p, q = seg[e]
+            nodes.append(q if p == nodes[-1] else p)
+        nodes = np.array(nodes)
+        xa, xb = surface.x[nodes[0]], surface.x[nodes[-1]]
+        if (xb[0], xb[1]) < (xa[0], xa[1]):
+            nodes = nodes[::-1]
+        walks.append(nodes)
+    walks.sort(key=lambda w: (surface.x[w[0], 0], surface.x[w[0], 1]))
+    start = 0.0
+    for nodes in walks:
+        d = np.diff(surface.x[nodes], axis=0)
+        ds = np.hypot(d[:, 0], d[:, 1])
+        s[nodes] = start + np.concatenate([[0.0], np.cumsum(ds)])
+        start = float(s[nodes[-1]])
+        tang = np.zeros((len(nodes), 2))
+        tang[:-1] += d / ds[:, None]
+        tang[1:] += d / ds[:, None]
+        t[nodes] = tang / np.linalg.norm(tang, axis=1)[:, None]
+    return s, t

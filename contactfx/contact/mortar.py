@@ -1,8 +1,5 @@
 """Segment-based mortar: active segments cut into sub-segments each facing one passive segment.
 
-(One module of ~330 lines: the sub-segment clipping, the quadrature and both multiplier
-bases are one kernel; the dual basis is computed on the same sub-segments.)
-
 Multiplier bases (`basis=`): "standard" weights row j with the active shape function N_j;
 "dual" weights it with the biorthogonal function psi_j (Wohlmuth's dual mortar), which makes
 D = int psi_j N_k diagonal so that a solver can eliminate the multipliers.

@@ -23,6 +23,16 @@ class ContactOperator:
         """Active nodes with a non-empty constraint (weights > 0); the others are all zero."""
         return np.flatnonzero(self.weights > 0)
 
+    @property
+    def overlapping(self) -> np.ndarray:
+        """Rows whose weight is above round-off of the largest: they face the passive surface."""
+        return self.weights > overlap_tolerance(self.weights)
+
+
+def overlap_tolerance(weights: np.ndarray) -> float:
+    """Weights at or below this are round-off: the row's node does not face the other surface."""
+    return 1e-12 * max(float(np.max(weights, initial=0.0)), 1e-300)
+
 
 def gauss_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
     """n-point Gauss-Legendre points and weights on [0, 1]."""

@@ -4,6 +4,7 @@ from .builtin import (
     BLOCK_SCENES,
     MESHERS,
     BlockParams,
+    BuiltinRecipe,
     HertzParams,
     blocks,
     build_scene,
@@ -11,6 +12,7 @@ from .builtin import (
     hertz_exact,
     validate,
 )
+from .gmsh_io import GeoRecipe, SceneParts, from_gmsh
 from .model import (
     Body,
     ContactPair,
@@ -20,34 +22,41 @@ from .model import (
     Load,
     Material,
     Pressure,
+    Recipe,
     Reference,
     Scene,
     Traction,
     UniformStress,
 )
-from .scene_file import load_scene_file
+from .scene_file import load_scene_file, parse_scene_file
 
 __all__ = [
     "BLOCK_SCENES",
     "MESHERS",
     "BlockParams",
     "Body",
+    "BuiltinRecipe",
     "ContactPair",
     "Dirichlet",
+    "GeoRecipe",
     "Groups",
     "HertzParams",
     "HertzReference",
     "Load",
     "Material",
     "Pressure",
+    "Recipe",
     "Reference",
     "Scene",
+    "SceneParts",
     "Traction",
     "UniformStress",
     "blocks",
     "build_scene",
+    "from_gmsh",
     "hertz",
     "hertz_exact",
     "load_scene_file",
+    "parse_scene_file",
     "validate",
 ]

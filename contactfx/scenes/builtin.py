@@ -5,13 +5,14 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, replace
 from functools import partial
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from dolfinx.io.gmsh import MeshData
 from mpi4py import MPI
 
-from meshes import build_blocks, build_hertz
-
 from ..errors import InputError
+from ..meshes import build_blocks, build_hertz
+from .checks import check_scene
 from .gmsh_io import balanced_partitioner, to_dolfinx
 from .model import (
     Body,
@@ -25,11 +26,7 @@ from .model import (
     Scene,
     UniformStress,
 )
-
-if TYPE_CHECKING:
-    from dolfinx.io.gmsh import MeshData
-
-    from .structured import StructuredMesh
+from .structured import build_hertz_structured
 
 
 @dataclass(frozen=True)
@@ -124,9 +121,38 @@ def validate(params: BlockParams | HertzParams) -> None:
             raise InputError(f"h_far must be >= 0 (got {params.h_far})")
 
 
+@dataclass(frozen=True)
+class BuiltinRecipe:
+    """A built-in scene by its parameters: remade by scaling its mesh sizes."""
+
+    params: BlockParams | HertzParams
+    active: int = 2
+
+    def resized(self, factor: float) -> BuiltinRecipe:
+        """Blocks: both element sizes times f; Hertz: contact, edge and far sizes times f."""
+        p = self.params
+        if isinstance(p, BlockParams):
+            scaled: BlockParams | HertzParams = replace(
+                p, size1=p.size1 * factor, size2=p.size2 * factor
+            )
+        else:
+            scaled = replace(
+                p,
+                refine=p.refine * factor,
+                refine_edge=p.refine_edge * factor,
+                h_far=p.h_far * factor,
+            )
+        return replace(self, params=scaled)
+
+    def build(self, comm: MPI.Comm) -> Scene:
+        """Mesh the scene."""
+        if isinstance(self.params, BlockParams):
+            return blocks(self.params, self.active, comm)
+        return hertz(self.params, self.active, comm)
+
+
 def _two_body_scene(
-    data: Any,
-    groups: dict[str, tuple[int, int]],
+    data: MeshData,
     params: BlockParams | HertzParams,
     load: float,
     active: int,
@@ -144,12 +170,13 @@ def _two_body_scene(
     pair = ContactPair(f"contact{active}", f"contact{3 - active}")
     # Rollers, as in the paper: u_x = 0 on the symmetry axis, u_y = 0 on the base only.
     supports = (Dirichlet("symmetry", ux=0.0), Dirichlet("support", uy=0.0))
-    return Scene(
+    assert data.cell_tags is not None  # both meshers tag every cell with its body
+    scene = Scene(
         data.mesh,
         data.cell_tags,
         data.facet_tags,
         None,
-        Groups(groups),
+        Groups.of(data.physical_groups),
         bodies,
         (pair,),
         supports,
@@ -157,8 +184,9 @@ def _two_body_scene(
         references,
         name=name,
         params={**asdict(params), "active": active, **extra},
-        cartesian_interface=True,
+        recipe=BuiltinRecipe(params, active),
     )
+    return check_scene(scene)
 
 
 def blocks(
@@ -169,16 +197,11 @@ def blocks(
     p = params
     build = partial(build_blocks, p.l1, p.l2, p.h1, p.h2, p.size1, p.size2, p.grading1, p.grading2)
     data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
-    groups = {k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()}
     # Equal widths make the stress uniaxial and uniform: the contact patch test.
     refs: tuple[Reference, ...] = (
         (UniformStress(((0.0, 0.0), (0.0, -p.p))),) if p.l1 == p.l2 else ()
     )
-    scene = _two_body_scene(data, groups, p, p.p, active, "blocks", refs, {})
-    return replace(
-        scene,
-        resize=lambda f: blocks(replace(p, size1=p.size1 * f, size2=p.size2 * f), active, comm),
-    )
+    return _two_body_scene(data, p, p.p, active, "blocks", refs, {})
 
 
 def hertz(
@@ -192,16 +215,11 @@ def hertz(
         params = replace(params, r_refine=round(1.4 * exact["a"], 6))
     h = params
     h_far = h.h_far or None
-    extra: dict[str, Any] = {"hertz_exact": exact}
-    data: StructuredMesh | MeshData
     if h.mesh == "structured":
         # Built directly in DOLFINx: gmsh's quad mesher is too slow for millions of DOFs.
-        from .structured import build_hertz_structured
-
         data = build_hertz_structured(
             comm, h.R, h.width, h.height, h.refine, h.r_refine, h_far, h.slope
         )
-        groups = data.physical_groups
     else:
         # The edge grading targets the Hertz estimate of a, as a user would plan a mesh.
         edge = (exact["a"], h.refine_edge) if h.refine_edge > 0 else None
@@ -217,17 +235,9 @@ def hertz(
             edge=edge,
         )
         data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
-        groups = {k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()}
     ref = (HertzReference(pair=0, R=h.R, P=h.P, symmetric=True),)
-    scene = _two_body_scene(data, groups, h, h.P / (2 * h.R), active, "hertz", ref, extra)
-    return replace(
-        scene,
-        resize=lambda f: hertz(
-            replace(h, refine=h.refine * f, refine_edge=h.refine_edge * f, h_far=h.h_far * f),
-            active,
-            comm,
-        ),
-    )
+    extra: dict[str, Any] = {"hertz_exact": exact}
+    return _two_body_scene(data, h, h.P / (2 * h.R), active, "hertz", ref, extra)
 
 
 def build_scene(

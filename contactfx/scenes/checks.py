@@ -6,14 +6,12 @@ All checks are collective and raise the same typed error on every rank.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from dataclasses import replace
 
 import numpy as np
 
 from ..errors import InputError, MeshError
-
-if TYPE_CHECKING:
-    from .model import Body, Scene
+from .model import Body, Scene
 
 
 def _global_count(scene: Scene, local: int) -> int:
@@ -68,17 +66,21 @@ def _check_bodies(scene: Scene) -> None:
         )
 
 
-def _check_pairs(scene: Scene) -> None:
+def _check_pairs(scene: Scene) -> dict[str, str]:
+    """Check every pair joins two bodies; return each contact curve's body name."""
     if not scene.contacts:
         raise InputError("the scene has no contact pair (add a [[contact]] entry)")
+    found: dict[str, str] = {}
     for k, pair in enumerate(scene.contacts):
-        a = body_of_curve(scene, pair.active)
-        p = body_of_curve(scene, pair.passive)
-        if a == p:
+        for curve in (pair.active, pair.passive):
+            if curve not in found:
+                found[curve] = body_of_curve(scene, curve).name
+        if found[pair.active] == found[pair.passive]:
             raise InputError(
                 f"contact pair {k}: '{pair.active}' and '{pair.passive}' lie on "
-                f"the same body '{a.name}' (self-contact is not supported)"
+                f"the same body '{found[pair.active]}' (self-contact is not supported)"
             )
+    return found
 
 
 def _check_conditions(scene: Scene) -> None:
@@ -107,10 +109,14 @@ def _check_conditions(scene: Scene) -> None:
             )
 
 
-def check_scene(scene: Scene) -> None:
-    """Raise InputError/MeshError naming the first inconsistency between scene and mesh."""
+def check_scene(scene: Scene) -> Scene:
+    """The scene with its contact curves' bodies found, once checked against its mesh.
+
+    Raises InputError/MeshError naming the first inconsistency between scene and mesh.
+    """
     for body in scene.bodies:
         body.material.check(f"body '{body.name}'")
     _check_bodies(scene)
-    _check_pairs(scene)
+    curve_bodies = _check_pairs(scene)
     _check_conditions(scene)
+    return replace(scene, curve_bodies=curve_bodies)

@@ -7,7 +7,8 @@ typed error (no rank is left waiting in a collective call).
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -20,11 +21,12 @@ from mpi4py import MPI
 from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
-from ..errors import ContactFxError, InputError, MeshError
-from .model import ContactPair, Dirichlet, Groups, Load, Material, Reference, Scene
+from ..errors import ContactFxError, InputError, MeshError, error_type
+from ..meshes import QUAD4
+from .checks import check_scene
+from .model import Body, ContactPair, Dirichlet, Groups, Load, Material, Reference, Scene
 
-# gmsh element type of the 4-node quadrangle; the other 2D types named for the error message.
-QUAD4 = 3
+# The other 2D element types of gmsh, named for the error message.
 _GMSH_2D_NAMES = {
     2: "3-node triangles",
     9: "6-node triangles",
@@ -121,7 +123,7 @@ def _run_on_root(
         if comm.rank == 0 and own_session:
             _close(fresh, previous)
         kind, _, text = error.partition(":")
-        raise {"InputError": InputError}.get(kind, MeshError)(text)
+        raise error_type(kind)(text)  # the type raised on rank 0, on every rank
     return fresh, previous
 
 
@@ -196,52 +198,116 @@ def load_meshdata(model_or_path: Any, comm: MPI.Comm, size_factor: float = 1.0) 
     return to_dolfinx(comm, mesh_model, balanced_partitioner(), own_session=False)
 
 
+@dataclass(frozen=True)
+class SceneParts:
+    """What a scene is made of besides its mesh: bodies, pairs, supports, loads, references."""
+
+    bodies: Mapping[str, Material]
+    contacts: tuple[ContactPair, ...]
+    dirichlet: tuple[Dirichlet, ...] = ()
+    loads: tuple[Load, ...] = ()
+    references: tuple[Reference, ...] = ()
+    name: str = "scene"
+
+
+@dataclass(frozen=True)
+class GeoRecipe:
+    """A scene whose mesh gmsh makes from a .geo file, with Mesh.MeshSizeFactor scaled."""
+
+    path: Path
+    parts: SceneParts
+    size_factor: float = 1.0
+    params: Mapping[str, Any] | None = None
+
+    def resized(self, factor: float) -> GeoRecipe:
+        """The same .geo meshed with every size times `factor`."""
+        return replace(self, size_factor=self.size_factor * factor)
+
+    def build(self, comm: MPI.Comm) -> Scene:
+        """Mesh the .geo and return the checked Scene."""
+        return scene_from_gmsh(self.path, self.parts, comm, self.size_factor, self.params)
+
+
 def scene_from_gmsh(
     model_or_path: Any,
-    bodies: dict[str, Material],
-    contacts: list[ContactPair],
-    dirichlet: list[Dirichlet],
-    loads: list[Load],
-    references: list[Reference],
+    parts: SceneParts,
     comm: MPI.Comm,
-    name: str,
     size_factor: float = 1.0,
+    params: Mapping[str, Any] | None = None,
 ) -> Scene:
     """Load the mesh, build the Scene and check it against the mesh's groups."""
-    from .checks import check_scene
-    from .model import Body
-
-    for body, mat in bodies.items():
+    for body, mat in parts.bodies.items():
         mat.check(f"body '{body}'")
     data = load_meshdata(model_or_path, comm, size_factor)
     assert data.cell_tags is not None  # one cell type (all quads, checked on rank 0): tagged
-    groups = Groups({k: (int(g.dim), int(g.tag)) for k, g in data.physical_groups.items()})
-    path = model_or_path if isinstance(model_or_path, str | Path) else None
-
-    def resize(factor: float) -> Scene:
-        if path is None:
-            raise InputError("a scene built from an in-memory gmsh model cannot be remeshed")
-        return scene_from_gmsh(
-            path, bodies, contacts, dirichlet, loads, references, comm, name, size_factor * factor
-        )
-
+    path = Path(model_or_path) if isinstance(model_or_path, str | Path) else None
+    recipe = (
+        GeoRecipe(path, parts, size_factor, params)
+        if path is not None and path.suffix.lower() == ".geo"
+        else None
+    )
     scene = Scene(
         data.mesh,
         data.cell_tags,
         data.facet_tags,
         data.ridge_tags,
-        groups,
-        tuple(Body(k, m) for k, m in bodies.items()),
-        tuple(contacts),
-        tuple(dirichlet),
-        tuple(loads),
-        tuple(references),
-        name=name,
+        Groups.of(data.physical_groups),
+        tuple(Body(k, m) for k, m in parts.bodies.items()),
+        parts.contacts,
+        parts.dirichlet,
+        parts.loads,
+        parts.references,
+        name=parts.name,
         params={
             "mesh": str(path) if path is not None else "gmsh model",
             "size_factor": size_factor,
+            **(params or {}),
         },
-        resize=resize if path is not None and Path(path).suffix == ".geo" else None,
+        recipe=recipe,
     )
-    check_scene(scene)
-    return scene
+    return check_scene(scene)
+
+
+def from_gmsh(
+    model_or_path: Any,
+    *,
+    bodies: Mapping[str, Material | Mapping[str, float]],
+    contacts: list[tuple[str, str]] | list[ContactPair],
+    dirichlet: list[Dirichlet] | None = None,
+    loads: list[Load] | None = None,
+    references: list[Reference] | None = None,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    name: str | None = None,
+) -> Scene:
+    """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path.
+
+    Args:
+        model_or_path: A .msh or .geo path, or anything else for gmsh's current model
+            (meshed in 2D here if it has no 2D elements yet).
+        bodies: Material (or {"E": ..., "nu": ...}) per physical surface group.
+        contacts: (active, passive) curve groups of every contact pair.
+        dirichlet: Prescribed displacement components on curve or point groups.
+        loads: Pressures and tractions on curve groups.
+        references: Analytic references (HertzReference, UniformStress) to report.
+        comm: The communicator the mesh is distributed over.
+        name: The scene's label (default: the file's stem, or "gmsh-model").
+
+    Returns:
+        The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
+    """
+    mats = {
+        k: v if isinstance(v, Material) else Material(float(v["E"]), float(v["nu"]))
+        for k, v in bodies.items()
+    }
+    label = name or (
+        Path(model_or_path).stem if isinstance(model_or_path, str | Path) else "gmsh-model"
+    )
+    parts = SceneParts(
+        mats,
+        tuple(p if isinstance(p, ContactPair) else ContactPair(*p) for p in contacts),
+        tuple(dirichlet or ()),
+        tuple(loads or ()),
+        tuple(references or ()),
+        label,
+    )
+    return scene_from_gmsh(model_or_path, parts, comm)

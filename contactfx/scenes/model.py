@@ -7,12 +7,13 @@ scene's name is a label for the JSON and never steers the computation.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import dolfinx
+import numpy as np
+from dolfinx.io.gmsh import PhysicalGroup
 from mpi4py import MPI
 
 from ..errors import InputError, MeshError
@@ -86,14 +87,14 @@ class HertzReference:
     """Plane-strain Hertz line contact on one pair: effective radius R, full line load P.
 
     `symmetric`: the model is a half model cut through the contact centre (which is then the
-    end of the active surface nearest the symmetry line); otherwise the centre is the
-    pressure's centroid.
+    end of the active surface nearest the symmetry line); otherwise (the default, in Python
+    and in scene files alike) the centre is the pressure's centroid.
     """
 
     pair: int
     R: float
     P: float
-    symmetric: bool = True
+    symmetric: bool = False
 
 
 @dataclass(frozen=True)
@@ -108,28 +109,64 @@ Reference = HertzReference | UniformStress
 
 @dataclass(frozen=True)
 class Groups:
-    """Physical groups of the mesh by name: (dimension, tag)."""
+    """Physical groups of the mesh by name (dolfinx's PhysicalGroup: dimension and tag)."""
 
-    by_name: dict[str, tuple[int, int]]
+    by_name: Mapping[str, PhysicalGroup]
+
+    def __post_init__(self) -> None:
+        # Plain (dim, tag) pairs are accepted and stored as PhysicalGroups.
+        groups = {k: PhysicalGroup(int(g[0]), int(g[1])) for k, g in self.by_name.items()}
+        object.__setattr__(self, "by_name", groups)
+
+    @classmethod
+    def of(cls, groups: Mapping[str, Any]) -> Groups:
+        """Groups from a name -> (dim, tag) mapping (PhysicalGroups or plain pairs)."""
+        return cls(dict(groups))
+
+    def dim(self, name: str) -> int | None:
+        """The dimension of group `name`, or None if the mesh has no such group."""
+        group = self.by_name.get(name)
+        return None if group is None else group.dim
 
     def tag(self, name: str, dim: int, what: str) -> int:
         """The tag of group `name`, which must have dimension `dim`; MeshError otherwise."""
         if name not in self.by_name:
             have = ", ".join(sorted(self.by_name)) or "none"
             raise MeshError(f"{what}: the mesh has no physical group '{name}' (it has: {have})")
-        gdim, tag = self.by_name[name]
-        if gdim != dim:
+        group = self.by_name[name]
+        if group.dim != dim:
             kinds = {0: "point", 1: "curve", 2: "surface"}
             raise MeshError(
-                f"{what}: physical group '{name}' is a {kinds.get(gdim, gdim)} "
+                f"{what}: physical group '{name}' is a {kinds.get(group.dim, group.dim)} "
                 f"group, a {kinds[dim]} group is needed"
             )
-        return tag
+        return group.tag
+
+
+class Recipe(Protocol):
+    """How a scene's mesh was made, as data: remade with every mesh size times a factor.
+
+    Built-in scenes keep their parameters (scenes/builtin.py), scene files their .geo
+    (scenes/gmsh_io.py); the coarse predictor and refinement studies call `resized`.
+    """
+
+    def resized(self, factor: float) -> Recipe:
+        """The same recipe with every mesh size times `factor`."""
+        ...
+
+    def build(self, comm: MPI.Comm) -> Scene:
+        """Mesh and return the scene (collective)."""
+        ...
 
 
 @dataclass(frozen=True)
 class Scene:
-    """A scene ready to solve: the distributed mesh with its tags, and the problem as data."""
+    """A scene ready to solve: the distributed mesh with its tags, and the problem as data.
+
+    `curve_bodies` maps every contact curve group to the body it lies on (found once, when
+    the scene is checked against its mesh: scenes.checks.check_scene). `params` are labels
+    for the JSON summary and never steer the computation.
+    """
 
     mesh: dolfinx.mesh.Mesh
     cell_tags: dolfinx.mesh.MeshTags
@@ -142,75 +179,49 @@ class Scene:
     loads: tuple[Load, ...] = ()
     references: tuple[Reference, ...] = ()
     name: str = "scene"
-    params: dict[str, Any] = field(default_factory=dict)
-    # Built-in scenes with one horizontal contact line also write the paper's x-sorted
-    # `interface` block (sigma_yy of both bodies), which their charts and tests read.
-    cartesian_interface: bool = False
-    # The same scene with every mesh size times a factor (None: cannot be remeshed). Used
-    # by the coarse predictor and by refinement studies.
-    resize: Callable[[float], Scene] | None = field(default=None, compare=False, repr=False)
-    # Which body each curve group lies on, found once (a collective pass over the mesh);
-    # not an init field, so dataclasses.replace (other groups) starts a fresh one.
-    _curve_bodies: dict[str, Body] = field(
-        default_factory=dict, init=False, compare=False, repr=False
-    )
+    params: Mapping[str, Any] = field(default_factory=dict)
+    recipe: Recipe | None = field(default=None, compare=False, repr=False)
+    curve_bodies: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def comm(self) -> MPI.Comm:
         """The scene's communicator."""
         return self.mesh.comm
 
+    @property
+    def e_max(self) -> float:
+        """The largest Young's modulus of the bodies."""
+        return max(b.material.E for b in self.bodies)
+
     def body_tag(self, body: Body) -> int:
         """Cell tag of `body`."""
         return self.groups.tag(body.name, 2, f"body '{body.name}'")
+
+    def body_cells(self, body: Body) -> np.ndarray:
+        """Local cells (owned and ghost) of `body`."""
+        return self.cell_tags.find(self.body_tag(body))
 
     def curve_tag(self, name: str, what: str) -> int:
         """Facet tag of the curve group `name`."""
         return self.groups.tag(name, 1, what)
 
+    @property
+    def can_remesh(self) -> bool:
+        """Whether the scene knows how its mesh was made (a built-in scene or a .geo)."""
+        return self.recipe is not None
+
+    def remeshed(self, factor: float) -> Scene:
+        """The same scene with every mesh size times `factor` (InputError if it cannot be)."""
+        if self.recipe is None:
+            raise InputError(
+                f"scene '{self.name}' cannot be remeshed: only built-in scenes and .geo "
+                "meshes can (a .msh or an in-memory gmsh model has no geometry to remesh)"
+            )
+        return self.recipe.resized(factor).build(self.comm)
+
     def body_of_curve(self, name: str) -> Body:
-        """The body whose cells own the facets of curve group `name` (MeshError if several)."""
-        from .checks import body_of_curve
-
-        if name not in self._curve_bodies:
-            self._curve_bodies[name] = body_of_curve(self, name)
-        return self._curve_bodies[name]
-
-    def params_dict(self) -> dict[str, Any]:
-        """Parameters for the JSON summary."""
-        return dict(self.params)
-
-    @classmethod
-    def from_gmsh(
-        cls,
-        model_or_path: Any,
-        *,
-        bodies: dict[str, Material | dict[str, float]],
-        contacts: list[tuple[str, str]] | list[ContactPair],
-        dirichlet: list[Dirichlet] | None = None,
-        loads: list[Load] | None = None,
-        references: list[Reference] | None = None,
-        comm: MPI.Comm = MPI.COMM_WORLD,
-        name: str | None = None,
-    ) -> Scene:
-        """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path."""
-        from .gmsh_io import scene_from_gmsh
-
-        mats = {
-            k: v if isinstance(v, Material) else Material(float(v["E"]), float(v["nu"]))
-            for k, v in bodies.items()
-        }
-        pairs = [p if isinstance(p, ContactPair) else ContactPair(*p) for p in contacts]
-        label = name or (
-            Path(model_or_path).stem if isinstance(model_or_path, str | Path) else "gmsh-model"
-        )
-        return scene_from_gmsh(
-            model_or_path,
-            mats,
-            pairs,
-            list(dirichlet or []),
-            list(loads or []),
-            list(references or []),
-            comm,
-            label,
-        )
+        """The body that the contact curve group `name` lies on."""
+        body = self.curve_bodies.get(name)
+        if body is None:
+            raise MeshError(f"curve group '{name}' is not a contact surface of this scene")
+        return next(b for b in self.bodies if b.name == body)

@@ -14,6 +14,7 @@ from typing import Any
 from mpi4py import MPI
 
 from ..errors import InputError
+from .gmsh_io import SceneParts, scene_from_gmsh
 from .model import (
     ContactPair,
     Dirichlet,
@@ -86,13 +87,14 @@ def _reference(k: int, entry: Any) -> Reference:
         pair = e.get("pair", 0)
         if isinstance(pair, bool) or not isinstance(pair, int):
             raise InputError(f"{where}: pair must be an integer index into [[contact]]")
-        symmetric = e.get("symmetric", False)
-        if not isinstance(symmetric, bool):
+        # An omitted `symmetric` takes the dataclass's default: one default for both APIs.
+        flags = {"symmetric": e["symmetric"]} if "symmetric" in e else {}
+        if not all(isinstance(v, bool) for v in flags.values()):
             raise InputError(f"{where}: symmetric must be true or false")
         R, P = _number(f"{where}.R", e["R"]), _number(f"{where}.P", e["P"])
         if R <= 0 or P <= 0:
             raise InputError(f"{where}: R and P must be positive")
-        return HertzReference(pair, R, P, symmetric)
+        return HertzReference(pair, R, P, **flags)
     e = _keys(where, entry, SECTION_KEYS["reference.uniform_stress"], {"type", "sigma"})
     s = e["sigma"]
     if not (
@@ -171,12 +173,7 @@ def load_scene_file(
     path: str | Path, comm: MPI.Comm = MPI.COMM_WORLD, size_factor: float = 1.0
 ) -> Scene:
     """The Scene of a TOML scene file (mesh path relative to the file)."""
-    from .gmsh_io import scene_from_gmsh
-
     path = Path(path)
     mesh, name, bodies, pairs, bcs, loads, refs = parse_scene_file(path)
-    scene = scene_from_gmsh(mesh, bodies, pairs, bcs, loads, refs, comm, name, size_factor)
-    params = {**scene.params, "scene_file": str(path)}
-    from dataclasses import replace
-
-    return replace(scene, params=params)
+    parts = SceneParts(bodies, tuple(pairs), tuple(bcs), tuple(loads), tuple(refs), name)
+    return scene_from_gmsh(mesh, parts, comm, size_factor, {"scene_file": str(path)})

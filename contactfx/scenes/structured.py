@@ -2,39 +2,27 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import basix.ufl
 import numpy as np
 import ufl
 from dolfinx import mesh as dmesh
+from dolfinx.io.gmsh import MeshData, PhysicalGroup
 from mpi4py import MPI
 
-from meshes.hertz_structured import hertz_grid
-
 from ..errors import InputError
+from ..meshes import hertz_grid
 from .gmsh_io import balanced_partitioner
 
 # Physical groups, named like the gmsh scene's (the numbers themselves are free).
 TAGS = {
-    "body1": (2, 1),
-    "body2": (2, 2),
-    "contact1": (1, 3),
-    "contact2": (1, 4),
-    "symmetry": (1, 5),
-    "support": (1, 6),
-    "load": (1, 7),
+    "body1": PhysicalGroup(2, 1),
+    "body2": PhysicalGroup(2, 2),
+    "contact1": PhysicalGroup(1, 3),
+    "contact2": PhysicalGroup(1, 4),
+    "symmetry": PhysicalGroup(1, 5),
+    "support": PhysicalGroup(1, 6),
+    "load": PhysicalGroup(1, 7),
 }
-
-
-@dataclass(frozen=True)
-class StructuredMesh:
-    """A distributed mesh with its cell and facet tags (names in `physical_groups`)."""
-
-    mesh: dmesh.Mesh
-    cell_tags: dmesh.MeshTags
-    facet_tags: dmesh.MeshTags
-    physical_groups: dict[str, tuple[int, int]]
 
 
 def build_hertz_structured(
@@ -47,8 +35,12 @@ def build_hertz_structured(
     h_far: float | None = None,
     slope: float = 0.1,
     contact_extent: float | None = None,
-) -> StructuredMesh:
-    """The Hertz half model (quarter disc on a block) as a distributed structured quad mesh."""
+) -> MeshData:
+    """The Hertz half model (quarter disc on a block) as a distributed structured quad mesh.
+
+    Returned as gmsh's MeshData (no ridge or peak tags), so that both meshers feed the same
+    scene construction.
+    """
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
     if min(R, width, height, h_contact, h_far, slope) <= 0.0 or r_refine < 0.0:
@@ -84,10 +76,10 @@ def build_hertz_structured(
         (fbody == 2, (xf[:, :, 1] == yc).all(axis=1), "load"),
     ]
     for in_body, cond, name in rules:
-        values[(values == 0) & in_body & cond] = TAGS[name][1]
+        values[(values == 0) & in_body & cond] = TAGS[name].tag
     keep = values > 0
     order = np.argsort(facets[keep])
     facet_tags = dmesh.meshtags(
         msh, tdim - 1, facets[keep][order].astype(np.int32), values[keep][order]
     )
-    return StructuredMesh(msh, cell_tags, facet_tags, dict(TAGS))
+    return MeshData(msh, cell_tags, facet_tags, None, None, dict(TAGS))

@@ -1,6 +1,6 @@
 """Convergence studies: every method on a sequence of refined meshes of one scene.
 
-`python -m contactfx study SCENE ...` (contactfx.study.command) and demos/demo_hertz.py are
+`python -m contactfx study SCENE ...` (contactfx/cli/study.py) and demos/demo_hertz.py are
 thin layers over `run_study` and `write_outputs`; docs/study.md says what is measured.
 """
 
@@ -9,10 +9,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from .core import Run, Study, run_study
+from .core import Study, run_study
 from .levels import Level, builtin_levels, hertz_at, scene_file_levels, size_factors
 from .measures import fit_rate
-from .report import level_lines, table_lines, write_csv, write_json
+from .report import level_lines, table_lines, write_study_csv, write_study_json
+from .runs import Run
 
 __all__ = [
     "Level",
@@ -39,8 +40,8 @@ def write_outputs(study: Study, out: Path, extra: Sequence[tuple[str, Study]] = 
 
     out.mkdir(parents=True, exist_ok=True)
     return [
-        write_json(study, out / "study.json"),
-        write_csv(study, out / "study.csv"),
+        write_study_json(study, out / "study.json"),
+        write_study_csv(study, out / "study.csv"),
         plot_convergence(study, out / "convergence.png", extra),
         plot_time(study, out / "accuracy_vs_time.png", extra),
     ]

@@ -17,54 +17,25 @@ from mpi4py import MPI
 
 from ..api import run_scene
 from ..errors import ContactFxError
-from ..methods import Method
+from ..options import Method, SolverSpec
 from ..scenes import HertzReference, Scene, UniformStress
 from ..timers import Timers
 from .levels import Level
 from .measures import (
-    Profiles,
     contact_size,
     fit_rate,
     fit_rate_to_reference,
     hertz_errors,
-    patch_errors,
+    patch_error,
     profiles,
 )
 from .measures import self_errors as compare_profiles
 from .progress import Progress
+from .runs import Run
 
 # Most accurate first: the self-convergence reference is the finest level of the first of
 # these that the study ran (mortar passes the patch test on non-matching meshes).
 ACCURACY_ORDER = ("mortar", "sts", "nts", "penalty", "schwarz")
-
-
-@dataclass
-class Run:
-    """One method on one level: sizes, cost, errors, or why it failed."""
-
-    method: str
-    level: int
-    factor: float
-    status: str = "ok"
-    message: str | None = None
-    dofs: int | None = None
-    elements: int | None = None
-    h: float | None = None
-    iterations: int | None = None
-    times: dict[str, float] = field(default_factory=dict)
-    errors: dict[str, float | None] = field(default_factory=dict)
-    summary: dict[str, Any] | None = field(default=None, repr=False)
-    profiles: Profiles | None = field(default=None, repr=False)
-
-    @property
-    def ok(self) -> bool:
-        """Whether the run finished."""
-        return self.status == "ok"
-
-    @property
-    def after_mesh(self) -> float | None:
-        """Wall time after meshing: assembly, search and the active-set solves (s)."""
-        return self.times["total"] - self.times["mesh"] if self.ok else None
 
 
 @dataclass
@@ -95,7 +66,7 @@ def reference_kind(scene: Scene) -> str:
 
 def exact_errors(kind: str, summary: dict[str, Any]) -> dict[str, float | None]:
     """Errors of one run against the scene's exact solution."""
-    return hertz_errors(summary) if kind == "hertz" else patch_errors(summary)
+    return hertz_errors(summary) if kind == "hertz" else patch_error(summary)
 
 
 def solve_one(
@@ -104,14 +75,22 @@ def solve_one(
     level: Level,
     mesh_time: float,
     kind: str,
-    solver: str | dict[str, object],
+    solver: SolverSpec | str,
     options: dict[str, Any],
 ) -> Run:
     """Solve one level with one method; a ContactFxError makes a failed Run."""
     run = Run(method, level.index, level.factor)
     t0 = time.perf_counter()
     try:
-        sol, data = run_scene(scene, method, solver=solver, t_start=t0, timers=Timers(), **options)
+        sol, data = run_scene(
+            scene,
+            method,
+            solver=solver,
+            t_start=t0,
+            timers=Timers(),
+            paper_interface=level.paper_interface,
+            **options,
+        )
     except ContactFxError as err:
         run.status, run.message = "failed", f"{type(err).__name__}: {err}"
         return run
@@ -220,7 +199,7 @@ def run_study(
     levels: list[Level],
     methods: list[str],
     *,
-    solver: str | dict[str, object] = "mumps",
+    solver: SolverSpec | str = "mumps",
     ratio: float = 2.0,
     options: dict[str, Any] | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,

@@ -37,6 +37,8 @@ class Level:
     factor: float
     sizes: dict[str, float]
     build: Callable[[], Scene] = field(compare=False, repr=False)
+    # The paper's x-sorted `interface` block in the summaries (built-in scenes).
+    paper_interface: bool = False
 
 
 def size_factors(levels: int, ratio: float, size_factor: float = 1.0) -> list[float]:
@@ -102,7 +104,13 @@ def builtin_levels(
     for k, f in enumerate(factors):
         p = at(params, f)  # type: ignore[arg-type]
         out.append(
-            Level(k, f, builtin_sizes(p), partial(build_scene, kind, p, active=active, comm=comm))
+            Level(
+                k,
+                f,
+                builtin_sizes(p),
+                partial(build_scene, kind, p, active=active, comm=comm),
+                paper_interface=True,
+            )
         )
     return out
 

@@ -12,9 +12,9 @@ from typing import Any
 import numpy as np
 from mpi4py import MPI
 
-from ..postprocess import arc_length
-from ..solution import Solution
-from ..surfaces import GatheredSurface
+from ..contact.geometry import arc_length
+from ..discretize.surfaces import GatheredSurface
+from ..methods.solution import Solution
 
 # Relative errors below this are round-off (e.g. mortar on a patch test): a rate fitted
 # through them would be the slope of noise, so such points are left out of the fit.
@@ -123,7 +123,7 @@ def hertz_errors(summary: dict[str, Any]) -> dict[str, float | None]:
     return out
 
 
-def patch_errors(summary: dict[str, Any]) -> dict[str, float | None]:
+def patch_error(summary: dict[str, Any]) -> dict[str, float | None]:
     """stress: the patch test's max stress/pressure error relative to the exact uniform stress."""
     return {"stress": float(summary["patch"]["max"])}
 
@@ -142,7 +142,7 @@ class Profiles:
 
 def surface_displacement(sol: Solution, side: GatheredSurface) -> np.ndarray:
     """The displacement (n, 2) at every node of a gathered surface, on all ranks."""
-    imap = sol.elasticity.V.dofmap.index_map
+    imap = sol.fields.V.dofmap.index_map
     lo, hi = imap.local_range
     mine = (side.gblock >= lo) & (side.gblock < hi)
     u = np.zeros((len(side.gblock), 2))

@@ -9,13 +9,11 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from .core import Run
-    from .levels import Level
+from .levels import Level
+from .runs import Run
 
 
 def format_seconds(t: float) -> str:

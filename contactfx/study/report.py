@@ -58,13 +58,13 @@ def study_json(study: Study) -> dict[str, Any]:
     }
 
 
-def write_json(study: Study, path: Path) -> Path:
+def write_study_json(study: Study, path: Path) -> Path:
     """Write study.json."""
     path.write_text(json.dumps(study_json(study), indent=1) + "\n")
     return path
 
 
-def write_csv(study: Study, path: Path) -> Path:
+def write_study_csv(study: Study, path: Path) -> Path:
     """Write study.csv: one row per run, sizes, times and every error as columns."""
     size_keys = list(dict.fromkeys(k for lv in study.levels for k in lv.sizes))
     head = [

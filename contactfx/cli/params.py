@@ -1,0 +1,130 @@
+"""What the command line's arguments mean: scene parameters, the solver spec, the Scene.
+
+Shared by `solve` and `study` (cli/solve.py, cli/study.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+from pathlib import Path
+
+from mpi4py import MPI
+
+from ..errors import InputError
+from ..options import SolverSpec, solver_spec
+from ..scenes import BLOCK_SCENES, BlockParams, HertzParams, Scene, build_scene, load_scene_file
+
+BLOCK_KEYS = (
+    "l1",
+    "l2",
+    "h1",
+    "h2",
+    "E1",
+    "E2",
+    "nu1",
+    "nu2",
+    "p",
+    "size1",
+    "size2",
+    "grading1",
+    "grading2",
+)
+HERTZ_KEYS = (
+    "R",
+    "P",
+    "E1",
+    "E2",
+    "nu1",
+    "nu2",
+    "refine",
+    "r_refine",
+    "refine_edge",
+    "slope",
+    "width",
+    "height",
+    "h_far",
+)
+
+PARAM_HELP = {
+    "l1": "blocks: full width of the base B1 (cm, default 10)",
+    "l2": "blocks: full width of the top block B2 (cm, default 6)",
+    "h1": "blocks: height of B1 (cm, default 3)",
+    "h2": "blocks: height of B2 (cm, default 3)",
+    "E1": "Young's modulus of body 1 (MPa; blocks 70000, hertz 7000)",
+    "E2": "Young's modulus of body 2 (MPa; blocks 70000, hertz 7000)",
+    "nu1": "Poisson ratio of body 1 (blocks 0.3, hertz 0.23)",
+    "nu2": "Poisson ratio of body 2 (blocks 0.3, hertz 0.23)",
+    "p": "blocks: pressure on the top of B2 (MPa, default 50)",
+    "size1": "blocks: element size in B1 (cm, default 0.125)",
+    "size2": "blocks: element size in B2 (cm, default 0.125)",
+    "grading1": "blocks: element-size ratio of neighbours along x in B1 (1 = uniform)",
+    "grading2": "blocks: element-size ratio of neighbours along x in B2 (1 = uniform)",
+    "R": "hertz: cylinder radius (cm, default 60)",
+    "P": "hertz: load per unit thickness, full model (MPa*cm, default 100)",
+    "refine": "hertz: element size on the contact zone (cm, default 0.02)",
+    "r_refine": "hertz: extent of the refined zone (cm; default 1.4 x Hertz's a)",
+    "refine_edge": "hertz, gmsh mesh: element size at the edge of contact (cm, 0 = off)",
+    "slope": "hertz: growth of the element size per cm of distance (default 0.1)",
+    "width": "hertz: half width of the block (cm, default 60)",
+    "height": "hertz: height of the block (cm, default 60)",
+    "h_far": "hertz: largest element size, far from the contact (cm; default R / 6)",
+}
+
+
+def is_scene_file(scene: str) -> bool:
+    """Whether the SCENE argument names a scene file rather than a built-in scene."""
+    return scene.endswith(".toml")
+
+
+def reject_builtin_options(args: argparse.Namespace) -> None:
+    """InputError if a scene file comes with options that only the built-in scenes take."""
+    given = [k for k in (*BLOCK_KEYS, *HERTZ_KEYS) if getattr(args, k) is not None]
+    given += [k for k in ("preset", "mesh", "active") if getattr(args, k) is not None]
+    if given:
+        raise InputError(
+            f"option --{given[0].replace('_', '-')} applies to the built-in "
+            "scenes only (a scene file sets everything itself)"
+        )
+
+
+def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
+    """Scene parameters from the paper's defaults, a preset, and the options given."""
+    base: BlockParams | HertzParams
+    if args.scene == "blocks":
+        base, keys = BLOCK_SCENES[args.preset or "S1"], BLOCK_KEYS
+    elif args.scene == "hertz":
+        if args.preset:
+            raise InputError("--preset applies to the blocks scene only")
+        base, keys = HertzParams(), HERTZ_KEYS
+    else:
+        raise InputError(
+            f"unknown scene '{args.scene}' (choose blocks, hertz or a .toml scene file)"
+        )
+    given = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    if args.mesh is not None:
+        if args.scene != "hertz":
+            raise InputError("option --mesh applies to the hertz scene only")
+        given["mesh"] = args.mesh
+    unused = [
+        k
+        for k in set(BLOCK_KEYS) | set(HERTZ_KEYS)
+        if k not in keys and getattr(args, k) is not None
+    ]
+    if unused:
+        raise InputError(f"option --{unused[0]} does not apply to the {args.scene} scene")
+    return replace(base, **given)
+
+
+def spec_from_args(args: argparse.Namespace) -> SolverSpec:
+    """The spec of --solver with every --petsc-option applied (checked against its kind)."""
+    return solver_spec(args.solver).with_petsc(args.petsc_option)
+
+
+def build_from_args(args: argparse.Namespace) -> Scene:
+    """The Scene the arguments describe (a built-in scene or a scene file)."""
+    comm = MPI.COMM_WORLD
+    if is_scene_file(args.scene):
+        reject_builtin_options(args)
+        return load_scene_file(Path(args.scene), comm)
+    return build_scene(args.scene, scene_params(args), active=args.active or 2, comm=comm)

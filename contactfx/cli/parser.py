@@ -1,0 +1,183 @@
+"""The argument parser of `contactfx solve|study` (option groups shared by both commands)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from ..options import SOLVERS, Basis, Method, Predictor
+from ..scenes import BLOCK_SCENES, MESHERS
+from .params import BLOCK_KEYS, HERTZ_KEYS, PARAM_HELP
+
+
+def _builtin_scene_options(p: argparse.ArgumentParser) -> None:
+    """The options of the built-in scenes (blocks, hertz), shared by solve and study."""
+    g = p.add_argument_group("built-in scenes (blocks, hertz)")
+    g.add_argument(
+        "--preset",
+        choices=list(BLOCK_SCENES),
+        help="block scene of the paper to start from (other options override it)",
+    )
+    for key in sorted(set(BLOCK_KEYS) | set(HERTZ_KEYS)):
+        g.add_argument(
+            f"--{key.replace('_', '-')}",
+            dest=key,
+            type=float,
+            default=None,
+            help=PARAM_HELP.get(key, key),
+        )
+    g.add_argument(
+        "--mesh",
+        choices=list(MESHERS),
+        default=None,
+        help="hertz only: gmsh graded quads (default) or a structured graded mesh "
+        "built in DOLFINx (fast to make for millions of DOFs)",
+    )
+    g.add_argument(
+        "--active",
+        type=int,
+        default=None,
+        choices=[1, 2],
+        help="which body is active (slave, carries the multipliers; default 2)",
+    )
+
+
+def _study_parser(sub: Any) -> None:
+    s = sub.add_parser(
+        "study",
+        help="convergence study: every method on refined meshes, errors, rates, charts",
+        description="Run a convergence study of one scene: every method on "
+        "LEVELS meshes, each with all mesh sizes 1/RATIO of the previous one, "
+        "against the exact solution where the scene has one, else against the "
+        "finest level of mortar. Writes study.json, study.csv, "
+        "convergence.png and accuracy_vs_time.png to --out (docs/study.md).",
+    )
+    s.add_argument("scene", help="blocks, hertz or a scene .toml file whose mesh is a .geo")
+    _builtin_scene_options(s)
+    st = s.add_argument_group("study")
+    st.add_argument(
+        "--methods",
+        default="nts,sts,mortar",
+        help="comma-separated methods (default nts,sts,mortar)",
+    )
+    st.add_argument("--levels", type=int, default=4, help="number of meshes (default 4)")
+    st.add_argument(
+        "--ratio", type=float, default=2.0, help="mesh-size ratio of consecutive levels (default 2)"
+    )
+    st.add_argument(
+        "--size-factor",
+        type=float,
+        default=1.0,
+        metavar="F",
+        help="mesh sizes of the first (coarsest) level relative to the scene's "
+        "(default 1: the scene as given; e.g. 8 to start coarser)",
+    )
+    st.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    _solver_options(s)
+    o = s.add_argument_group("output")
+    o.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="directory for study.json, study.csv and the two charts",
+    )
+    o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
+    o.add_argument(
+        "-v",
+        "--verbose",
+        action="store_true",
+        help="also log every active-set iteration (default: one line per run)",
+    )
+
+
+def _solver_options(p: argparse.ArgumentParser) -> Any:
+    """The linear-solver option group, shared by solve and study."""
+    v = p.add_argument_group("linear solver")
+    v.add_argument(
+        "--solver",
+        default="mumps",
+        help=f"one of {', '.join(SOLVERS)}: mumps (default) factorizes the saddle point, "
+        "condensed eliminates the multipliers (CG + GAMG; needs --method nts or mortar "
+        "--basis dual)",
+    )
+    v.add_argument(
+        "--petsc-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="extra PETSc option for the solver's KSP (no leading dash); it cannot change "
+        "the solver's kind (choose that with --solver)",
+    )
+    return v
+
+
+def _solve_parser(sub: Any) -> None:
+    s = sub.add_parser(
+        "solve",
+        help="solve a scene, print a summary, optionally write JSON",
+        description="Solve one contact scene. SCENE is blocks (the paper's S1-S4), "
+        "hertz (S5) or a scene file SCENE.toml (see README, 'Your own scene').",
+    )
+    s.add_argument("scene", help="blocks, hertz or a path to a scene .toml file")
+    _builtin_scene_options(s)
+    m = s.add_argument_group("method")
+    m.add_argument(
+        "--method",
+        default=Method.MORTAR.value,
+        choices=[m.value for m in Method],
+        help="contact discretization (default mortar: the only one that passes the "
+        "patch test on non-matching meshes)",
+    )
+    m.add_argument(
+        "--penalty",
+        type=float,
+        default=None,
+        metavar="EPS",
+        help="penalty normal stiffness (pressure = EPS * penetration) for --method "
+        "penalty; default 1e3 * max E / h, h the median contact element size",
+    )
+    m.add_argument(
+        "--basis",
+        choices=[b.value for b in Basis],
+        default=Basis.STANDARD.value,
+        help="mortar multiplier basis: standard (N_j) or dual (biorthogonal, D "
+        "diagonal: what --solver condensed needs)",
+    )
+    m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    m.add_argument(
+        "--predictor",
+        choices=[v.value for v in Predictor],
+        default=Predictor.AUTO.value,
+        help="first active set from a coarser solve of the same scene: auto = above "
+        "200k DOFs on several ranks, always for --solver condensed, never for serial MUMPS "
+        "(which probes every row from its selected inverse); the answer does not depend "
+        "on it",
+    )
+    v = _solver_options(s)
+    v.add_argument(
+        "--reference-timing",
+        action="store_true",
+        help="also time a fresh solve of the final saddle-point system (the cost "
+        "floor) and report it as times.reference_solve",
+    )
+    o = s.add_argument_group("output")
+    o.add_argument("--json", type=Path, help="write the JSON summary here")
+    o.add_argument(
+        "--out",
+        type=Path,
+        help="directory for XDMF fields, contact surfaces (VTK) "
+        "and one interface figure per contact pair",
+    )
+    o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
+
+
+def parser() -> argparse.ArgumentParser:
+    """The argument parser (defaults of scene parameters are the paper's, filled in later)."""
+    ap = argparse.ArgumentParser(
+        prog="contactfx", description="2D frictionless contact of elastic bodies"
+    )
+    sub = ap.add_subparsers(dest="command", required=True)
+    _solve_parser(sub)
+    _study_parser(sub)
+    return ap

@@ -1,0 +1,94 @@
+"""`contactfx solve SCENE ...`: one solve, its summary on the terminal, its files."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import time
+from typing import Any
+
+from mpi4py import MPI
+
+from ..api import run_scene
+from ..errors import InputError
+from ..options import Method
+from ..results.figures import plot_interface, plot_pair
+from ..results.files import write_contact_surfaces, write_fields, write_json
+from ..timers import Timers
+from .params import build_from_args, is_scene_file, spec_from_args
+
+
+def terminal_summary(data: dict[str, Any]) -> list[str]:
+    """What a user came for, last: each pair's force, and the errors against references."""
+    lines = [
+        f"{data['scene']} / {data['method']}: {data['dofs']} dofs, "
+        f"{data['multipliers']} multipliers, {data['iterations']} iterations, "
+        f"total {data['times']['total']:.2f} s"
+    ]
+    for k, c in enumerate(data["contacts"]):
+        f = c["force"]
+        lines.append(
+            f"pair {k} ({c['active']} on {c['passive']}): force ({f[0]:.6g}, "
+            f"{f[1]:.6g}), balance {c['balance']:.1e}, {c['active_nodes']} active nodes"
+        )
+    if "patch" in data:
+        lines.append(
+            f"patch test: max stress/pressure error {data['patch']['max']:.2e} "
+            "(relative to the exact uniform stress)"
+        )
+    for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else []):
+        a = h["a"]
+        a_err = f"{100 * (a / h['a_exact'] - 1):+.2f} %" if a else "n/a"
+        lines.append(
+            f"Hertz, pair {h['pair']}: a = {a or float('nan'):.4g} (exact "
+            f"{h['a_exact']:.4g}, {a_err}), p0 = {h['p0']:.4g} (exact "
+            f"{h['p0_exact']:.4g}, {100 * (h['p0'] / h['p0_exact'] - 1):+.2f} %), "
+            f"L2 error {100 * h['l2_error']:.2f} %"
+        )
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run one solve and write its outputs; return the exit code."""
+    comm = MPI.COMM_WORLD
+    method = Method(args.method)
+    spec = spec_from_args(args)
+    if args.penalty is not None and method is not Method.PENALTY:
+        raise InputError("--penalty applies to --method penalty only")
+    t_start = time.perf_counter()
+    timers = Timers()
+    with timers("mesh"):
+        scene = build_from_args(args)
+    sol, data = run_scene(
+        scene,
+        method,
+        solver=spec,
+        paper_interface=not is_scene_file(args.scene),
+        t_start=t_start,
+        timers=timers,
+        max_iterations=args.max_iterations,
+        penalty=args.penalty,
+        reference_timing=args.reference_timing,
+        predictor=args.predictor,
+        basis=args.basis,
+    )
+    data["solver"] = "mumps (each body)" if method is Method.SCHWARZ else args.solver
+    if args.out is not None:
+        write_fields(sol, args.out)
+    log = logging.getLogger("contactfx")
+    if comm.rank == 0:
+        if args.json is not None:
+            write_json(args.json, data)
+            log.info("wrote %s", args.json)
+        if args.out is not None:
+            written = write_contact_surfaces(data, args.out)
+            written += [
+                plot_pair(data, k, args.out / f"interface_pair{k}.png")
+                for k in range(len(data["contacts"]))
+            ]
+            if "interface" in data:
+                written.append(plot_interface(data, args.out / "interface.png"))
+            log.info("wrote fields (XDMF), %s to %s", ", ".join(p.name for p in written), args.out)
+        for line in terminal_summary(data):
+            print(line)
+    return 0

@@ -1,0 +1,84 @@
+"""`contactfx study SCENE ...`: levels from the command line, the study, its files and table."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from pathlib import Path
+
+from mpi4py import MPI
+
+from ..errors import InputError
+from ..options import SOLVERS, Method
+from ..study import builtin_levels, run_study, scene_file_levels, size_factors, write_outputs
+from ..study.levels import Level
+from ..study.report import level_lines, table_lines
+from .params import is_scene_file, reject_builtin_options, scene_params, spec_from_args
+
+
+def parse_methods(text: str) -> list[str]:
+    """--methods nts,sts,mortar -> ["nts", "sts", "mortar"] (InputError on unknown names)."""
+    names = [m.strip() for m in text.split(",") if m.strip()]
+    known = [m.value for m in Method]
+    bad = [m for m in names if m not in known]
+    if bad or not names:
+        raise InputError(
+            f"--methods: unknown method '{bad[0] if bad else text}' (choose from "
+            f"{', '.join(known)}, comma-separated)"
+        )
+    if len(set(names)) != len(names):
+        raise InputError(f"--methods lists a method twice: {text}")
+    return names
+
+
+def levels_from_args(args: argparse.Namespace, comm: MPI.Comm) -> list[Level]:
+    """The levels of the SCENE argument (built-in scene with its options, or a scene file)."""
+    factors = size_factors(args.levels, args.ratio, args.size_factor)
+    if is_scene_file(args.scene):
+        reject_builtin_options(args)
+        return scene_file_levels(Path(args.scene), factors, comm)
+    return builtin_levels(args.scene, scene_params(args), factors, args.active or 2, comm)
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """Run the study the arguments describe, write its files on rank 0 and print the table."""
+    comm = MPI.COMM_WORLD
+    if not args.verbose:
+        # One progress line per run is the display; the solver's per-iteration log is noise.
+        logging.getLogger("contactfx").setLevel(logging.WARNING)
+    methods = parse_methods(args.methods)
+    spec = spec_from_args(args)
+    if "schwarz" in methods and spec != SOLVERS["mumps"]:
+        raise InputError(
+            "schwarz factorizes each body with MUMPS: --solver and --petsc-option "
+            "do not apply to it"
+        )
+    levels = levels_from_args(args, comm)
+    say = print if comm.rank == 0 else (lambda *a, **k: None)
+    say(
+        f"study {args.scene}: {len(methods)} methods x {len(levels)} levels (ratio "
+        f"{args.ratio:g}), solver {args.solver}, {comm.size} rank{'s' * (comm.size > 1)}",
+        flush=True,
+    )
+    study = run_study(
+        levels,
+        methods,
+        solver=spec,
+        ratio=args.ratio,
+        options={"max_iterations": args.max_iterations},
+        comm=comm,
+        say=lambda line: say(line, flush=True),
+        settings={
+            "scene_arg": args.scene,
+            "ratio": args.ratio,
+            "size_factor": args.size_factor,
+            "solver": args.solver,
+            "petsc_options": list(args.petsc_option),
+        },
+    )
+    if comm.rank == 0:
+        written = write_outputs(study, args.out)
+        for line in ["", *level_lines(study), "", *table_lines(study)]:
+            print(line)
+        print("wrote " + ", ".join(str(p) for p in written))
+    return 0

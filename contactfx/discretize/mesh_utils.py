@@ -1,0 +1,49 @@
+"""DOLFINx mesh helpers the surface, stress and support code share (Q1 quadrilaterals)."""
+
+from __future__ import annotations
+
+import dolfinx.mesh
+import numpy as np
+from dolfinx import fem
+
+from ..scenes import Scene
+
+
+def vertex_to_block(V: fem.FunctionSpace) -> np.ndarray:
+    """Local dof block of every local vertex (Q1: one block per vertex)."""
+    msh = V.mesh
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim, 0)
+    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
+    ncells = c2v.shape[0]
+    v2b = np.full(
+        msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts,
+        -1,
+        dtype=np.int32,
+    )
+    # For Q1 the dofs of a cell are listed in the order of its vertices.
+    v2b[c2v.ravel()] = V.dofmap.list[:ncells].ravel()
+    return v2b
+
+
+def owned_facets(scene: Scene, name: str) -> np.ndarray:
+    """Owned facets of the curve group `name`."""
+    msh = scene.mesh
+    tdim = msh.topology.dim
+    tag = scene.curve_tag(name, "contact")
+    assert scene.facet_tags is not None  # curve_tag found the group
+    facets = scene.facet_tags.find(tag)
+    return facets[facets < msh.topology.index_map(tdim - 1).size_local]
+
+
+def vertex_coordinates(msh: dolfinx.mesh.Mesh) -> np.ndarray:
+    """Coordinates (x, y) of every local vertex."""
+    tdim = msh.topology.dim
+    nv = msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts
+    msh.topology.create_connectivity(tdim, 0)
+    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
+    geo = msh.geometry.dofmaps[0]
+    xv = np.zeros((nv, 2))
+    # Q1 geometry: the cell's geometry nodes are its vertices, in the same order.
+    xv[c2v.ravel()] = msh.geometry.x[geo[: c2v.shape[0]].ravel(), :2]
+    return xv

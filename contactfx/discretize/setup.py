@@ -1,0 +1,200 @@
+"""Prepare a contact problem: assemble K and f, gather every pair, build B, check geometry."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from ..contact import ContactOperator, Kernel
+from ..errors import GeometryError, SingularSystemError
+from ..options import Basis
+from ..scenes import Body, Scene
+from ..timers import Timers
+from .coupling import (
+    Multipliers,
+    constrained_rows,
+    global_dirichlet_dofs,
+    multiplier_layout,
+    petsc_constraint,
+)
+from .elasticity import Elasticity, assemble_elasticity
+from .pairs import GatheredPair, PairData, build_pairs, gather_pairs, stack
+from .supports import check_held
+from .surfaces import check_facing
+
+
+@dataclass
+class ContactSetup:
+    """What every contact solver needs before its first solve: K, f, B, gaps, the layout."""
+
+    comm: MPI.Comm
+    e_max: float  # the largest Young's modulus (scales gamma, the penalty and c)
+    elasticity: Elasticity
+    pairs: list[PairData]
+    operator: ContactOperator  # stacked over the pairs
+    layout: Multipliers
+    order: np.ndarray
+    B: PETSc.Mat
+    g: np.ndarray  # weighted gaps of the rows owned here
+    w: np.ndarray  # weights of the rows owned here
+    h: float  # median contact weight (about the contact element size)
+    needs_contact: list[Body]  # bodies whose supports alone leave a rigid mode free
+
+    def normalized_gap(self, u: fem.Function) -> np.ndarray:
+        """Nodal gap (weighted gap / weight) of the owned rows at displacement u."""
+        y = self.B.createVecLeft()
+        self.B.mult(u.x.petsc_vec, y)
+        gap = (self.g + y.array_r) / self.w
+        y.destroy()
+        return gap
+
+    def initial_active(self, tol: float) -> np.ndarray:
+        """Touching nodes; in a pair with none that holds a loose body, its closest node(s)."""
+        comm = self.comm
+        gap = self.g / self.w
+        active = gap <= tol
+        loose = {b.name for b in self.needs_contact}
+        pair_of = self.layout.pair[self.layout.mine]
+        for p in self.pairs:
+            if not ({p.active_body.name, p.passive_body.name} & loose):
+                continue
+            rows = pair_of == p.index
+            if comm.allreduce(int(active[rows].sum())) == 0:
+                gmin = comm.allreduce(float(gap[rows].min(initial=np.inf)), op=MPI.MIN)
+                active |= rows & (gap <= gmin + tol)
+        return active
+
+    def check_not_floating(self, n_active: int) -> None:
+        """Raise SingularSystemError if a body held only by contact has lost every contact."""
+        if n_active == 0 and self.needs_contact:
+            raise SingularSystemError(
+                f"body '{self.needs_contact[0].name}' is not held by its supports alone and no "
+                "node is in contact (empty active set): the load pulls the bodies apart"
+            )
+
+    def destroy(self) -> None:
+        """Free B (K and f belong to the elasticity, which the solution keeps for its fields)."""
+        self.B.destroy()
+
+    def node_dofs(self) -> np.ndarray:
+        """(m, 2) global dofs (x, y) of the active node of each owned multiplier row."""
+        g = np.asarray(self.layout.gblock)[self.layout.mine].astype(np.int64)
+        return np.column_stack([2 * g, 2 * g + 1])
+
+
+def assemble_and_gather(scene: Scene, timers: Timers) -> tuple[Elasticity, int, list[GatheredPair]]:
+    """Assemble K and f, and gather both surfaces of every contact pair."""
+    with timers("assemble"):
+        el = assemble_elasticity(scene)
+    V = el.V
+    ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+    with timers("search"):
+        gathered = gather_pairs(scene, V)
+    return el, ndofs, gathered
+
+
+def prescribed_gap_shift(
+    scene: Scene, el: Elasticity, op: ContactOperator, surface_dofs: np.ndarray
+) -> np.ndarray:
+    """B[:, D] u_D: the weighted gap that nonzero prescribed displacements add.
+
+    B's Dirichlet columns are removed (K has identity rows there), so a prescribed value on a
+    contact surface must enter the gap instead. Zero when every prescribed value is zero.
+    """
+    V = el.V
+    if not any(v != 0.0 for bc in scene.dirichlet for _, v in bc.components()):
+        return np.zeros(op.B.shape[0])
+    ub = fem.Function(V)
+    for bc in el.bcs:
+        bc.set(ub.x.array)
+    imap = V.dofmap.index_map
+    start, nloc = imap.local_range[0], imap.size_local
+    dofs = np.unique(surface_dofs.ravel())
+    blocks = dofs // 2 - start
+    mine = (blocks >= 0) & (blocks < nloc)
+    vals = np.zeros(len(dofs))
+    vals[mine] = ub.x.array[2 * blocks[mine] + dofs[mine] % 2]
+    V.mesh.comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.SUM)
+    ud = sp.csc_matrix(
+        (vals, (dofs, np.zeros(len(dofs), dtype=np.int64))), shape=(op.B.shape[1], 1)
+    )
+    return np.asarray((op.B @ ud).todense()).ravel()
+
+
+def prepare_contact(
+    scene: Scene,
+    kernel: Kernel,
+    penetration_tol: float,
+    timers: Timers,
+    basis: Basis = Basis.STANDARD,
+) -> ContactSetup:
+    """Assemble K and f, build every pair's operator and B, and check the geometry."""
+    comm = scene.comm
+    el, ndofs, gathered = assemble_and_gather(scene, timers)
+    V = el.V
+    dual = basis is Basis.DUAL
+    with timers("contact"):
+        pairs = build_pairs(gathered, kernel, ndofs, **({"basis": basis} if dual else {}))
+        for p in pairs:
+            if not p.operator.overlapping.any():
+                raise GeometryError(
+                    f"contact pair {p.index}: the active surface "
+                    f"'{p.pair.active}' does not overlap the passive surface "
+                    f"'{p.pair.passive}'"
+                )
+            check_facing(p.active.surface, p.passive.surface, p.operator, p.label)
+        active_union, op, pair_of_row = stack(pairs)
+        shift = prescribed_gap_shift(
+            scene,
+            el,
+            op,
+            np.vstack([active_union.surface.dofs] + [p.passive.surface.dofs for p in pairs]),
+        )
+        if np.any(shift):
+            op = ContactOperator(op.B, op.gap + shift, op.weights)
+        dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
+        layout, order = multiplier_layout(
+            comm, active_union, op, pair_of_row, constrained_rows(op, dirichlet)
+        )
+        B = petsc_constraint(V, op, order, layout, dirichlet)
+    w_all = layout.weights
+    g_all = op.gap[order] / w_all
+    if dual:
+        # A dual (sign-changing) weighting averages the gap with negative weights: check
+        # for overlap with the standard, positive weights (geometry, not the multipliers).
+        std = stack(build_pairs(gathered, kernel, ndofs))[1]
+        g_all = (std.gap[order] + shift[order]) / std.weights[order]
+    h = float(np.median(w_all))
+    for p in pairs:
+        rows = np.flatnonzero(layout.pair == p.index)
+        j = rows[int(np.argmin(g_all[rows]))]
+        if g_all[j] < -penetration_tol * h:
+            raise GeometryError(
+                f"bodies '{p.active_body.name}' and '{p.passive_body.name}' "
+                f"overlap: initial penetration {-g_all[j]:.3e} at ("
+                f"{layout.x[j, 0]:.4g}, {layout.x[j, 1]:.4g}) exceeds the "
+                f"tolerance {penetration_tol * h:.1e}"
+            )
+    needs_contact = check_held(
+        scene, V, el.bc_dofs, [(p.active_body, p.passive_body, p.active) for p in pairs]
+    )
+    mine = layout.mine
+    return ContactSetup(
+        comm,
+        scene.e_max,
+        el,
+        pairs,
+        op,
+        layout,
+        order,
+        B,
+        op.gap[order][mine],
+        w_all[mine],
+        h,
+        needs_contact,
+    )

@@ -1,0 +1,186 @@
+"""Which rigid motions the supports and the contact pairs leave free, body by body.
+
+Each body has three rigid modes (two translations, a rotation about its centroid). A
+Dirichlet dof of the body and a contact-surface normal of a pair (taken as bilateral, the
+most the contact can hold) each give one linear condition on the modes; the modes in the
+null space of all these conditions make K + contact singular, whatever the load.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from ..contact.geometry import nodal_normals
+from ..errors import SingularSystemError
+from ..linalg.nullspace import orthonormalize
+from ..scenes import Body, Scene
+from .surfaces import GatheredSurface
+
+# A contact pair as the check needs it: (active body, passive body, active surface).
+Contact = tuple[Body, Body, GatheredSurface]
+
+
+def body_blocks(V: fem.FunctionSpace, cells: np.ndarray) -> np.ndarray:
+    """Local dof blocks (nodes, owned and ghost) of the cells `cells` (a body's)."""
+    return np.unique(V.dofmap.list[cells].ravel())
+
+
+def rigid_body_modes(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Vec]:
+    """The three rigid modes of all bodies together (x, y translation, rotation), orthonormal.
+
+    What aggregation multigrid wants as near-nullspace: an aggregate lies in one body (or
+    straddles a contact the condensation couples), so per-body copies of the modes would only
+    add zero columns to its tentative prolongator, which GAMG turns into singular coarse
+    operators (measured in docs/condensed.md).
+    """
+    bs = V.dofmap.index_map_bs
+    nloc = V.dofmap.index_map.size_local
+    comm = V.mesh.comm
+    x = V.tabulate_dof_coordinates()[:nloc, :2]
+    blocks = np.unique(np.concatenate([body_blocks(V, scene.body_cells(b)) for b in scene.bodies]))
+    blocks = blocks[blocks < nloc]
+    # Rotate about the centroid: keeps the rotation well scaled against the translations.
+    centre = np.array([comm.allreduce(float(x[blocks, d].sum())) for d in (0, 1)])
+    centre /= max(comm.allreduce(len(blocks)), 1)
+    values = rigid_modes_at(x[blocks], centre, 1.0)  # (n, 2, 3)
+    modes: list[PETSc.Vec] = []
+    for k in range(3):
+        v = PETSc.Vec().createMPI((nloc * bs, PETSc.DETERMINE), bsize=bs, comm=comm)
+        v.set(0.0)
+        v.array[bs * blocks] = values[:, 0, k]
+        v.array[bs * blocks + 1] = values[:, 1, k]
+        modes.append(v)
+    orthonormalize(modes)
+    return modes
+
+
+def rigid_modes_at(x: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
+    """(n, 2, 3): the x/y values of the translations and the scaled rotation at points x."""
+    r = (x - centre) / size
+    out = np.zeros((len(x), 2, 3))
+    out[:, 0, 0] = 1.0
+    out[:, 1, 1] = 1.0
+    out[:, 0, 2] = -r[:, 1]
+    out[:, 1, 2] = r[:, 0]
+    return out
+
+
+def _body_frames(
+    scene: Scene, V: fem.FunctionSpace
+) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
+    """Owned blocks of each body, and each body's centroid and size (global)."""
+    comm = scene.comm
+    nloc = V.dofmap.index_map.size_local
+    x = V.tabulate_dof_coordinates()[:nloc, :2]
+    owned, centres, sizes = [], [], []
+    for body in scene.bodies:
+        b = body_blocks(V, scene.body_cells(body))
+        b = b[b < nloc]
+        owned.append(b)
+        n = comm.allreduce(len(b))
+        c = np.array([comm.allreduce(float(x[b, d].sum())) for d in (0, 1)]) / max(n, 1)
+        lo = np.array(
+            [comm.allreduce(float(x[b, d].min(initial=np.inf)), op=MPI.MIN) for d in (0, 1)]
+        )
+        hi = np.array(
+            [comm.allreduce(float(x[b, d].max(initial=-np.inf)), op=MPI.MAX) for d in (0, 1)]
+        )
+        centres.append(c)
+        sizes.append(max(float(np.max(hi - lo)), 1e-300))
+    return owned, np.array(centres), np.array(sizes)
+
+
+def _dirichlet_rows(
+    scene: Scene,
+    V: fem.FunctionSpace,
+    bc_dofs: np.ndarray,
+    owned: list[np.ndarray],
+    centres: np.ndarray,
+    sizes: np.ndarray,
+) -> np.ndarray:
+    """One row per owned Dirichlet dof (all ranks' rows gathered): the modes it fixes."""
+    nloc = V.dofmap.index_map.size_local
+    x = V.tabulate_dof_coordinates()[:nloc, :2]
+    nb = len(scene.bodies)
+    dofs = bc_dofs[bc_dofs < 2 * nloc]
+    rows = []
+    for k, b in enumerate(owned):
+        here = dofs[np.isin(dofs // 2, b)]
+        if not here.size:
+            continue
+        m = rigid_modes_at(x[here // 2], centres[k], sizes[k])
+        r = np.zeros((len(here), 3 * nb))
+        r[:, 3 * k : 3 * k + 3] = m[np.arange(len(here)), here % 2]
+        rows.append(r)
+    local = np.vstack(rows) if rows else np.zeros((0, 3 * nb))
+    return np.vstack(scene.comm.allgather(local))
+
+
+def _contact_rows(
+    scene: Scene, pairs: list[Contact], centres: np.ndarray, sizes: np.ndarray
+) -> np.ndarray:
+    """Rows n . (m_active - m_passive) at the active nodes of every pair (gathered data)."""
+    index = {b.name: k for k, b in enumerate(scene.bodies)}
+    rows = []
+    for active_body, passive_body, active in pairs:
+        surf = active.surface
+        n = nodal_normals(surf)
+        a, q = index[active_body.name], index[passive_body.name]
+        r = np.zeros((surf.n_nodes, 3 * len(scene.bodies)))
+        r[:, 3 * a : 3 * a + 3] = np.einsum(
+            "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[a], sizes[a])
+        )
+        r[:, 3 * q : 3 * q + 3] -= np.einsum(
+            "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[q], sizes[q])
+        )
+        rows.append(r)
+    return np.vstack(rows)
+
+
+def _free_modes(rows: np.ndarray, ncols: int) -> np.ndarray:
+    """Orthonormal basis (k, ncols) of the modes that every row leaves free."""
+    if rows.shape[0] == 0:
+        return np.eye(ncols)
+    # Duplicate rows (many nodes of one straight edge) add nothing: an SVD of the Gram
+    # matrix keeps this cheap however many rows there are.
+    gram = rows.T @ rows
+    w, v = np.linalg.eigh(gram)
+    return v[:, w <= 1e-10 * max(float(w.max()), 1e-300)].T
+
+
+def _describe(mode: np.ndarray) -> str:
+    if abs(mode[2]) >= np.hypot(mode[0], mode[1]):
+        return "rotation"
+    d = mode[:2] / np.hypot(mode[0], mode[1])
+    if abs(d[0]) > 0.999:
+        return "translation along x"
+    if abs(d[1]) > 0.999:
+        return "translation along y"
+    return f"translation along ({d[0]:.3g}, {d[1]:.3g})"
+
+
+def check_held(
+    scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray, pairs: list[Contact]
+) -> list[Body]:
+    """Raise SingularSystemError if a body can move freely; return those needing contact."""
+    owned, centres, sizes = _body_frames(scene, V)
+    nb = len(scene.bodies)
+    rows_d = _dirichlet_rows(scene, V, bc_dofs, owned, centres, sizes)
+    free_d = _free_modes(rows_d, 3 * nb)
+    free = _free_modes(np.vstack([rows_d, _contact_rows(scene, pairs, centres, sizes)]), 3 * nb)
+    if free.shape[0]:
+        mode = free[0]
+        k = int(np.argmax([np.linalg.norm(mode[3 * i : 3 * i + 3]) for i in range(nb)]))
+        raise SingularSystemError(
+            f"body '{scene.bodies[k].name}' can still move freely after its supports and "
+            f"contacts ({_describe(mode[3 * k : 3 * k + 3])}): add a [[dirichlet]] support or a "
+            "contact pair that holds it"
+        )
+    return [
+        b
+        for k, b in enumerate(scene.bodies)
+        if free_d.size and np.abs(free_d[:, 3 * k : 3 * k + 3]).max() > 1e-6
+    ]

@@ -1,0 +1,15 @@
+"""PETSc linear algebra of the contact saddle points; it knows no Scene and no DOLFINx object."""
+
+from .factory import augmentation, make_solver
+from .policy import Decision, FactorizationPolicy, ReuseMode
+from .protocol import LinearSolver, SaddleResult
+
+__all__ = [
+    "Decision",
+    "FactorizationPolicy",
+    "LinearSolver",
+    "ReuseMode",
+    "SaddleResult",
+    "augmentation",
+    "make_solver",
+]

@@ -1,0 +1,228 @@
+"""The condensed solver: the active multipliers eliminated, CG + GAMG on the displacements.
+
+The elimination itself is `linalg/elimination.py`. The first set builds T^T K T and GAMG on
+it, with the rigid modes of all bodies (zero on the pivots) as near-nullspace. Later sets
+differ from it by a few pivots, a low-rank change: CG keeps that multigrid and applies the
+new operator matrix-free, from the last displacement, until the pivots have moved too far.
+The loop's solves stop at a loose tolerance (only signs decide the set); the stationary set
+is polished to the final one (`polish`), so the answer does not depend on the loose one.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from typing import Any, cast
+
+import numpy as np
+from petsc4py import PETSc
+
+from ..errors import SolverError
+from .elimination import (
+    CondensedOperator,
+    LocalRows,
+    condensed_matrix,
+    elimination_matrix,
+    pivot_rows,
+    pivots,
+)
+from .nullspace import orthonormalize
+from .petsc_options import PrefixedOptions, petsc_error_message, reason_name
+from .protocol import SaddleResult
+
+# Pivot changes since the multigrid was built (summed over ranks) below which it is reused.
+REBUILD_CHANGES = 64
+# ... or below this fraction of the pivots.
+REBUILD_FRACTION = 0.2
+
+
+class CondensedSolver:
+    """Solve K u + B^T mu = f, B_A u = -g_A by elimination: a LinearSolver without probes.
+
+    `node_dofs` (m, 2): global dofs of each owned row's active node. `rtol`: the final
+    tolerance (`polish`); `loose_rtol`: the relative reduction of the loop's solves.
+    `reuse` False: a throwaway solver (a new multigrid for every set).
+    """
+
+    def __init__(
+        self,
+        K: PETSc.Mat,
+        B: PETSc.Mat,
+        f: PETSc.Vec,
+        options: Mapping[str, object],
+        node_dofs: np.ndarray,
+        modes: list[PETSc.Vec],
+        *,
+        rtol: float,
+        loose_rtol: float | None = None,
+        reuse: bool = True,
+    ) -> None:
+        self._K, self._f = K, f
+        self._comm = K.getComm()
+        self._mpi = self._comm.tompi4py()
+        self._rows = LocalRows.of(B, node_dofs)
+        self._modes = modes
+        self._options = PrefixedOptions(options)
+        self._rtol = rtol
+        self._loose_rtol = max(rtol, loose_rtol if loose_rtol is not None else rtol)
+        self._A: PETSc.Mat | None = None  # the operator the multigrid was built from
+        self._ksp = PETSc.KSP().create(self._comm)
+        self._ksp.setOptionsPrefix(self._options.prefix)
+        self._u = f.duplicate()
+        self._u.set(0.0)
+        self._diag = K.getDiagonal()
+        self._r0, self._r1 = K.getOwnershipRange()
+        self.stats = {"factorizations": 0.0, "reused": 0.0, "setup_time": 0.0}
+        self._built_for: np.ndarray | None = None  # the pivots the multigrid was built with
+        self.reuse = reuse
+
+    exact = False  # the loop's solves stop at loose_rtol: a stationary set is polished
+    can_probe = False  # no factorization: no exact responses
+    cheap_responses = False
+
+    def destroy(self) -> None:
+        """Free the PETSc objects."""
+        for obj in (self._ksp, self._u, self._diag, self._A):
+            if obj is not None:
+                obj.destroy()
+
+    def solve(self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False) -> SaddleResult:
+        """Displacements and multipliers (owned parts), at the loose tolerance of the loop.
+
+        A throwaway solver (`reuse` False: a reference solve) solves to the final one.
+        """
+        return self._solve(g, active, self._loose_rtol if self.reuse else self._rtol)
+
+    def polish(self, g: np.ndarray, active: np.ndarray, last: SaddleResult) -> SaddleResult:
+        """The same set solved to the final tolerance, from the last (loose) solution."""
+        return self._solve(g, active, self._rtol)
+
+    def responses(self, rhs: np.ndarray, active: np.ndarray) -> np.ndarray:
+        """Not available: the condensed solver has no factorization (can_probe is False)."""
+        raise SolverError("the condensed solver has no probe responses (it is not a factorization)")
+
+    def _solve(self, g: np.ndarray, active: np.ndarray, rtol: float) -> SaddleResult:
+        t0 = time.perf_counter()
+        rows, piv, coef = pivots(self._rows, np.asarray(active, dtype=bool), self._mpi)
+        # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
+        ip: Any = piv.astype(PETSc.IntType)
+        prows = pivot_rows(self._rows, rows, piv, coef, self._r0)
+        nglob = self._K.getSize()[0]
+        T = elimination_matrix(prows, self._r0, self._r1, nglob, self._comm, identity=True)
+        d, t, r, b = (self._f.duplicate() for _ in range(4))
+        d.set(0.0)
+        d.setValues(ip, cast(Any, self._diag.getValues(ip)))
+        d.assemble()
+        t.set(0.0)
+        t.setValues(ip, cast(Any, -np.asarray(g)[rows] / coef))
+        t.assemble()
+        self._K.mult(t, r)
+        r.aypx(-1.0, self._f)  # f - K t
+        T.multTranspose(r, b)
+        v = self._u.copy()  # warm start: the last displacement, pivots free
+        v.setValues(ip, cast(Any, np.zeros(len(piv))))
+        v.assemble()
+        reuse = self._keeps_multigrid(piv)
+        ksp = self._ksp
+        try:
+            with self._options.inserted():  # read lazily at setup and solve (GAMG levels)
+                A = self._operator(reuse, T, d, prows, piv)
+                ksp.getPC().setReusePreconditioner(reuse)
+                ksp.setInitialGuessNonzero(True)
+                ksp.setTolerances(rtol=self._relative_to_b(A, v, b, rtol))
+                ksp.setUp()
+                t1 = time.perf_counter()
+                ksp.solve(b, v)
+        except PETSc.Error as err:
+            raise SolverError(petsc_error_message(err, "condensed solve")) from None
+        reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
+        if reason <= 0 or not np.isfinite(v.norm()):
+            raise SolverError(
+                f"condensed solve ({ksp.getType()}) did not converge: PETSc "
+                f"reason {reason} ({reason_name(reason)}) after {its} iterations"
+            )
+        T.mult(v, self._u)
+        self._u.axpy(1.0, t)
+        self._K.mult(self._u, r)
+        r.aypx(-1.0, self._f)  # f - K u: the contact force on the pivots
+        mu = np.zeros(len(active))
+        mu[rows] = r.getValues(ip) / coef
+        u = self._u.array.copy()
+        t2 = time.perf_counter()
+        for obj in (T, d, t, r, b, v):
+            obj.destroy()
+        if reuse:
+            A.destroy()
+        self.stats["reused" if reuse else "factorizations"] += 1
+        self.stats["setup_time"] += t1 - t0
+        return SaddleResult(u, mu, its, reason, not reuse, -1, 0, t1 - t0, t2 - t1)
+
+    def _keeps_multigrid(self, piv: np.ndarray) -> bool:
+        """Whether the multigrid of an earlier set still preconditions this one.
+
+        A few pivots more or less change T^T K T by a term of their rank, which costs CG at
+        most that many extra iterations: the multigrid is kept until the pivots have moved
+        in more than max(REBUILD_FRACTION of the set, REBUILD_CHANGES) places.
+        """
+        prev = self._built_for
+        if not self.reuse or prev is None:
+            return False
+        changed = self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
+        n_piv = self._mpi.allreduce(len(piv))
+        return changed <= max(REBUILD_FRACTION * n_piv, REBUILD_CHANGES)
+
+    def _operator(
+        self, reuse: bool, T: PETSc.Mat, d: PETSc.Vec, prows: dict[int, Any], piv: np.ndarray
+    ) -> PETSc.Mat:
+        """The KSP's operator: matrix-free on the kept multigrid, or a new matrix and setup."""
+        ksp = self._ksp
+        if reuse:
+            A = PETSc.Mat().createPython(
+                cast(Any, self._K.getSizes()), CondensedOperator(self._K, T, d), comm=self._comm
+            )
+            A.setUp()
+            assert self._A is not None
+            ksp.setOperators(A, self._A)
+            return A
+        E = elimination_matrix(prows, self._r0, self._r1, self._K.getSize()[0], self._comm, False)
+        A = condensed_matrix(self._K, E, piv, self._diag)
+        E.destroy()
+        if self._modes:
+            A.setNearNullSpace(self._near_nullspace(piv))
+        ksp.setOperators(A)
+        ksp.setFromOptions()
+        if self._A is not None:
+            self._A.destroy()
+        self._A = A
+        self._built_for = piv.copy()
+        return A
+
+    def _relative_to_b(self, A: PETSc.Mat, v: PETSc.Vec, b: PETSc.Vec, rtol: float) -> float:
+        """The rtol (PETSc's, relative to ||b||) that reduces this solve's own residual by rtol.
+
+        From a warm start already within rtol of ||b|| a loose solve would not iterate at
+        all, and the set would be judged on the previous set's displacements (which made the
+        default Hertz scene cycle). The final tolerance stays relative to ||b||.
+        """
+        if rtol <= self._rtol:
+            return rtol
+        res0 = b.duplicate()
+        A.mult(v, res0)
+        res0.aypx(-1.0, b)
+        r0, b0 = float(cast(Any, res0.norm())), float(cast(Any, b.norm()))
+        res0.destroy()
+        return max(self._rtol, rtol * r0 / max(b0, 1e-300))
+
+    def _near_nullspace(self, piv: np.ndarray) -> PETSc.NullSpace:
+        """The rigid-body modes with the (decoupled) pivot entries removed, orthonormal."""
+        modes = []
+        for m in self._modes:
+            w = m.copy()
+            w.setValues(cast(Any, piv.astype(PETSc.IntType)), cast(Any, np.zeros(len(piv))))
+            w.assemble()
+            modes.append(w)
+        orthonormalize(modes)
+        nsp = PETSc.NullSpace().create(vectors=modes, comm=self._comm)
+        for w in modes:
+            w.destroy()
+        return nsp

@@ -1,0 +1,233 @@
+"""The active-set (semi-smooth Newton) loop shared by every method, and its helpers.
+
+`run_active_set` is the one loop: visit a set (cycle detection), solve on it, count the nodes
+that enter and leave, record and log the iteration, stop when the set is stationary (checking
+the complementarity residual) or raise at the limit. What differs between the multiplier
+methods and penalty is the `Iteration` they pass: how a set is solved and, for the multiplier
+methods with a direct solver, which set to try next (probes and the small LCP predictor).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+from mpi4py import MPI
+
+from ..discretize.setup import ContactSetup
+from ..errors import ActiveSetError
+from ..timers import Timers
+from .solution import History
+
+log = logging.getLogger("contactfx")
+
+
+@dataclass(frozen=True)
+class ActiveSetOptions:
+    """Controls of the primal-dual active-set iteration."""
+
+    max_iterations: int = 50
+    penetration_tol: float = 1e-6  # allowed initial penetration relative to the element size
+    tolerance: float = 1e-6  # complementarity residual (relative) required at the end
+    predictor: bool = True  # probe candidate sets with multi-RHS solves (direct solvers)
+    max_probes: int = 2000  # largest candidate set probed
+    # With cheap probe responses (serial MUMPS: selected entries of the inverse), start from
+    # every multiplier row in contact and probe them all: one factorization, the predicted
+    # set by the small complementarity problem, then one solve that only releases rows.
+    start_all: bool = True
+
+
+@dataclass(frozen=True)
+class InitialSet:
+    """A first active set by position: `active(x)` in contact, `uncertain(x)` worth probing.
+
+    Both map (n, 2) node coordinates to (n,) bools. A superset of the converged set makes the
+    loop factorize once and then only release rows (solved without refactoring); probing only
+    the uncertain band keeps the multi-right-hand-side solve small.
+    """
+
+    active: Callable[[np.ndarray], np.ndarray]
+    uncertain: Callable[[np.ndarray], np.ndarray] | None = None
+
+
+class SetHistory:
+    """Bookkeeping of the active-set iteration: visited sets, probes, the small predictor."""
+
+    def __init__(self, comm: MPI.Comm, mine: np.ndarray, size: int) -> None:
+        self.comm, self.mine, self.size = comm, np.asarray(mine), size
+        self.seen: set[bytes] = set()
+        self.last = b""
+
+    def to_global(self, local: np.ndarray) -> np.ndarray:
+        """A per-row local array in the global multiplier order."""
+        out = np.zeros((self.size, *local.shape[1:]), dtype=local.dtype)
+        for idx, vals in self.comm.allgather((self.mine, local)):
+            out[idx] = vals
+        return out
+
+    def visit(self, active: np.ndarray, it: int, n_active: int, probing: bool) -> None:
+        """Record a set about to be solved; raise if it was solved before (a cycle)."""
+        key = self.to_global(active).tobytes()
+        repeat = probing and key == self.last  # the same set again, now with probes
+        self.last = key
+        if key in self.seen and not repeat:
+            raise ActiveSetError(f"active set cycles at iteration {it} ({n_active} active nodes)")
+        self.seen.add(key)
+
+    def global_indices(self, local_mask: np.ndarray) -> np.ndarray:
+        """Global multiplier indices of a local row mask."""
+        return np.flatnonzero(self.to_global(local_mask))
+
+    def probe_rhs(self, probe: np.ndarray) -> np.ndarray:
+        """Unit right-hand sides (local rows x candidates): open one weighted gap each."""
+        rhs = np.zeros((len(self.mine), len(probe)))
+        rows = np.flatnonzero(np.isin(self.mine, probe))
+        rhs[rows, np.searchsorted(probe, self.mine[rows])] = 1.0
+        return rhs
+
+    def predict(
+        self, probe: np.ndarray, lam: np.ndarray, dmu: np.ndarray, active: np.ndarray
+    ) -> np.ndarray | None:
+        """Active set (local mask) solving the complementarity problem restricted to `probe`.
+
+        Rows of `active` (local mask) outside `probe` stay as they are.
+        """
+        lam0 = self.to_global(lam)[probe]
+        # Column j: change of the tractions when the weighted gap of candidate j opens by 1.
+        kq = -self.to_global(dmu)[probe]
+        kq = 0.5 * (kq + kq.T)
+        act = lcp_active_set(kq, lam0)
+        if act is None:
+            return None
+        mask = self.to_global(np.asarray(active, dtype=bool))
+        mask[probe] = False
+        mask[probe[act]] = True
+        return mask[self.mine]
+
+
+def lcp_active_set(k: np.ndarray, lam0: np.ndarray, max_iterations: int = 100) -> np.ndarray | None:
+    """Active set of lam = lam0 + k s >= 0, s >= 0, lam s = 0 by dense primal-dual steps.
+
+    Starts from everything in contact (lam0 itself); returns None on cycling, on an empty
+    set (the body would float: left to the full solve to report) or a singular block.
+    """
+    n = len(lam0)
+    act = np.ones(n, dtype=bool)
+    seen: set[bytes] = set()
+    for _ in range(max_iterations):
+        seen.add(act.tobytes())
+        ina = ~act
+        s = np.zeros(n)
+        if ina.any():
+            if not act.any():
+                return None
+            try:
+                s[ina] = np.linalg.solve(k[np.ix_(ina, ina)], -lam0[ina])
+            except np.linalg.LinAlgError:
+                return None
+        lam = lam0 + k @ s
+        lam[ina] = 0.0
+        new = np.where(act, lam > 0.0, s < 0.0)
+        if np.array_equal(new, act):
+            return act
+        act = new
+        if act.tobytes() in seen:
+            return None
+    return None
+
+
+@dataclass
+class Step:
+    """One solve on a given set: owned-row tractions and gaps, the updated set, what it cost."""
+
+    lam: np.ndarray  # contact traction per owned row (compression > 0)
+    gap: np.ndarray  # normalized gap per owned row at the solution
+    new_active: np.ndarray  # the semi-smooth Newton update of the set
+    residual: float  # relative complementarity residual (0 where not defined)
+    record: dict[str, float] = field(default_factory=dict)  # extra history columns
+    text: str = ""  # extra words for the log line
+
+
+class Iteration(Protocol):
+    """What a method gives the loop: a solve on a set and, optionally, a better next set."""
+
+    label: str
+
+    @property
+    def probing(self) -> bool:
+        """Whether the next solve repeats the current set with probes (not a cycle)."""
+        ...
+
+    def solve(self, active: np.ndarray, it: int) -> Step:
+        """Solve with `active` (owned rows) in contact."""
+        ...
+
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
+        """The set to solve next instead of `step.new_active` (None: take the update)."""
+        ...
+
+
+def run_active_set(
+    setup: ContactSetup,
+    iteration: Iteration,
+    active: np.ndarray,
+    aso: ActiveSetOptions,
+    timers: Timers,
+) -> tuple[Step, np.ndarray, History]:
+    """Iterate until the active set is stationary; return the last step, set and history."""
+    comm = setup.comm
+    state = SetHistory(comm, setup.layout.mine, setup.layout.size)
+    history: History = []
+    entered = left = 0
+    resid = np.nan
+    for it in range(1, aso.max_iterations + 1):
+        n_active = comm.allreduce(int(active.sum()))
+        setup.check_not_floating(n_active)
+        state.visit(active, it, n_active, iteration.probing)
+        t0 = time.perf_counter()
+        with timers("solve"):
+            step = iteration.solve(active, it)
+        t_solve = time.perf_counter() - t0
+        resid = step.residual
+        entered = comm.allreduce(int(np.sum(step.new_active & ~active)))
+        left = comm.allreduce(int(np.sum(active & ~step.new_active)))
+        history.append(
+            {
+                "iteration": it,
+                "active": n_active,
+                "entered": entered,
+                "left": left,
+                "residual": resid,
+                **step.record,
+                "solve_time": t_solve,
+            }
+        )
+        if comm.rank == 0:
+            log.info(
+                "%s %2d: %5d active, +%d -%d, %s%.3f s",
+                iteration.label,
+                it,
+                n_active,
+                entered,
+                left,
+                step.text,
+                t_solve,
+            )
+        if entered == 0 and left == 0:
+            if resid > aso.tolerance:
+                raise ActiveSetError(
+                    f"active set is stationary at iteration {it} but the "
+                    f"complementarity residual {resid:.2e} exceeds "
+                    f"{aso.tolerance:.1e}: the linear solves are too inexact"
+                )
+            return step, active, history
+        proposed = iteration.next_set(active, step, entered)
+        active = step.new_active if proposed is None else proposed
+    raise ActiveSetError(
+        f"active set did not converge in {aso.max_iterations} iterations "
+        f"(last change: +{entered} -{left}, residual {resid:.2e})"
+    )

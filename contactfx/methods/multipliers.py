@@ -1,0 +1,276 @@
+"""The multiplier methods (NTS, STS, mortar): saddle-point solves inside the active-set loop.
+
+With a solver that holds an exact inverse the loop is helped by probes: the union of the
+current and the updated set is solved once more with one right-hand side per candidate node,
+and the small complementarity problem on the candidates predicts the converged set
+(`active_set`).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from ..discretize.setup import ContactSetup, prepare_contact
+from ..discretize.supports import rigid_body_modes
+from ..errors import InputError
+from ..linalg import LinearSolver, SaddleResult, make_solver
+from ..options import Basis, Method, SolverKind, SolverSpec, solver_spec
+from ..scenes import Scene
+from ..timers import Timers
+from .active_set import ActiveSetOptions, InitialSet, SetHistory, Step, run_active_set
+from .solution import Solution, finish
+
+log = logging.getLogger("contactfx")
+
+DEFAULT_OPTIONS = ActiveSetOptions()
+
+
+class MultiplierIteration:
+    """Saddle-point solves on a set, the semi-smooth Newton update, and the probe policy."""
+
+    def __init__(
+        self,
+        setup: ContactSetup,
+        solver: LinearSolver,
+        aso: ActiveSetOptions,
+        given_start: bool,
+        label: str = "active set",
+    ) -> None:
+        self.setup, self.solver, self.aso = setup, solver, aso
+        # Semi-smooth Newton on min(lambda, c g): c = E / h makes both terms tractions.
+        self.c = setup.e_max / setup.h
+        # Probes need the exact inverse: only a factorization of the whole saddle point.
+        self.direct = solver.can_probe
+        self.given_start, self.label = given_start, label
+        layout = setup.layout
+        self.state = SetHistory(setup.comm, layout.mine, layout.size)
+        self.u = fem.Function(setup.elasticity.V, name="u")
+        self.probe: np.ndarray | None = None  # global indices of the candidates probed
+        self.band = np.zeros(len(layout.mine), dtype=bool)  # rows the first set is unsure of
+        self._probes: np.ndarray | None = None
+
+    @property
+    def probing(self) -> bool:
+        """Whether the next solve is a probing one (it may repeat the last set)."""
+        return self.probe is not None
+
+    def start(self, active: np.ndarray, guess: InitialSet | None) -> np.ndarray:
+        """Add a given first set (and probe its uncertain band) to the touching nodes.
+
+        Without one, and when probe responses are cheap (`SaddleSolver.cheap_responses`),
+        every row is put in contact and probed (`ActiveSetOptions.start_all`): a superset of
+        any converged set, so the loop factorizes once and then only releases rows. Rows of
+        a node that several pairs constrain keep their touching status (two such rows may be
+        dependent: the saddle point would be singular).
+        """
+        comm = self.setup.comm
+        if guess is None:
+            layout = self.setup.layout
+            size = layout.size
+            if not (
+                self.aso.start_all
+                and self.aso.predictor
+                and self.direct
+                and self.solver.cheap_responses
+                and 0 < size
+            ):
+                return active
+            if size > self.aso.max_probes:
+                self._say(f"{size} rows exceed max_probes {self.aso.max_probes}: no start_all")
+                return active
+            node = np.asarray(layout.gblock)
+            counts = np.unique(node, return_counts=True)
+            shared = np.isin(node, counts[0][counts[1] > 1])[layout.mine]
+            every = active | ~shared
+            self.band = every.copy()
+            self.probe = self.state.global_indices(every)
+            self.given_start = True
+            return every
+        x_mine = self.setup.layout.x[self.setup.layout.mine]
+        active = active | np.asarray(guess.active(x_mine), dtype=bool)
+        if guess.uncertain is not None and self.aso.predictor and self.direct:
+            # Probe only the band where the guess is unsure: the rest of it stays in contact.
+            self.band = np.asarray(guess.uncertain(x_mine), dtype=bool)
+            if 0 < comm.allreduce(int((active & self.band).sum())) <= self.aso.max_probes:
+                self.probe = self.state.global_indices(active & self.band)
+        return active
+
+    def solve(self, active: np.ndarray, it: int) -> Step:
+        """One saddle-point solve on `active`, with the probe responses if probing."""
+        comm = self.setup.comm
+        g = self.setup.g
+        res = self.solver.solve(g, active, fresh=self.probe is not None)
+        self._probes = None
+        if self.probe is not None:
+            self._probes = self.solver.responses(self.state.probe_rhs(self.probe), active)
+        lam, gap, new_active = self._update(res.u, res.mu)
+        its = res.iterations
+        if not self.solver.exact and not comm.allreduce(
+            bool(np.any(new_active != active)), op=MPI.LOR
+        ):
+            # The loose solve says the set is stationary: only a solve to the final
+            # tolerance may say so (the loop goes on if its signs differ).
+            res = self.solver.polish(g, active, res)
+            lam, gap, new_active = self._update(res.u, res.mu)
+            its += res.iterations
+        c, w = self.c, self.setup.w
+        ncp = np.where(active, np.minimum(lam, c * gap), np.minimum(0.0, c * gap))
+        lam_max = comm.allreduce(float(np.abs(lam).max(initial=0.0)), op=MPI.MAX)
+        resid = np.sqrt(comm.allreduce(float(np.sum(w * ncp**2)), op=MPI.SUM))
+        resid /= max(lam_max * np.sqrt(comm.allreduce(float(w.sum()))), 1e-300)
+        n_probes = 0 if self.probe is None else len(self.probe)
+        record: dict[str, float] = {
+            "linear_iterations": its,
+            "probes": n_probes,
+            "factorized": int(res.refactored),
+        }
+        text = f"complementarity {resid:.2e}, {its} linear its, " + (
+            f"{n_probes} probes, " if n_probes else ""
+        )
+        return Step(lam, gap, new_active, float(resid), record, text)
+
+    def _update(self, u: np.ndarray, mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(lambda, normalized gap, the updated set) of a solve's u and multipliers."""
+        self.u.x.petsc_vec.array[:] = u
+        self.u.x.scatter_forward()
+        lam = -mu
+        gap = self.setup.normalized_gap(self.u)
+        # Semi-smooth Newton on min(lambda, c g): with the active gaps solved exactly, c only
+        # scales the test, so the update is lambda > 0 on active, penetration on inactive.
+        return lam, gap, lam - self.c * gap > 0
+
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
+        """The predicted set after a probing solve, or the union to probe; None otherwise."""
+        comm = self.setup.comm
+        if self.probe is not None:
+            # The set probed holds every candidate (rows outside it keep their status): the
+            # small complementarity problem on it predicts the converged set; the next solve
+            # checks it like any other iterate.
+            assert self._probes is not None  # the probing solve returned its responses
+            predicted = self.state.predict(self.probe, step.lam, self._probes, active)
+            self.probe = None
+            if predicted is None:
+                self._say("the probes' complementarity problem has no solution: plain update")
+                return None
+            return None if np.array_equal(predicted, active) else predicted
+        if self.aso.predictor and self.direct and not (entered == 0 and self.given_start):
+            # Probe the union of the current and the updated set: on the Hertz scene the plain
+            # update adds every penetrating node and then drops one or two edge nodes per
+            # iteration; one multi-right-hand-side solve replaces those iterations. If nodes
+            # only leave, the union is the current set, solved again with probes. (Not after
+            # a given first set, a superset: releasing rows costs two back-substitutions.)
+            new = step.new_active
+            union = active | new
+            # After a given first set only its uncertain band and the rows that change.
+            cand = union if not self.given_start else union & (self.band | (new != active))
+            n_new = comm.allreduce(int(new.sum()))
+            n_cand = comm.allreduce(int(cand.sum()))
+            if 0 < n_new and n_cand <= self.aso.max_probes:
+                self.probe = self.state.global_indices(cand)
+                return union
+            if n_cand > self.aso.max_probes:
+                self._say(f"{n_cand} candidates exceed max_probes: plain update")
+        return None
+
+    def _say(self, text: str) -> None:
+        """A log line for a fallback of the probe policy (rank 0)."""
+        if self.setup.comm.rank == 0:
+            log.info("%s: %s", self.label, text)
+
+
+def _solver(setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool) -> LinearSolver:
+    """The loop's solver (reuse: it keeps its setup across sets) or a throwaway one."""
+    el = setup.elasticity
+    return make_solver(
+        spec,
+        el.K,
+        setup.B,
+        el.f,
+        e_max=setup.e_max,
+        h=setup.h,
+        modes=lambda: rigid_body_modes(el.V, scene),
+        node_dofs=setup.node_dofs(),
+        reuse=reuse,
+    )
+
+
+def check_solver(method: Method, basis: Basis, spec: SolverSpec) -> None:
+    """InputError if the solver cannot handle the method's multipliers."""
+    diagonal = method is Method.NTS or (method is Method.MORTAR and basis is Basis.DUAL)
+    if spec.kind is SolverKind.CONDENSED and not diagonal:
+        raise InputError(
+            "the condensed solver needs a diagonal D: use --method nts or "
+            "--method mortar --basis dual"
+        )
+
+
+def reference_solve(
+    setup: ContactSetup, spec: SolverSpec, scene: Scene, active: np.ndarray, timers: Timers
+) -> SaddleResult:
+    """The cost floor: one fresh solve of the final system by the same solver, timed."""
+    setup.comm.Barrier()
+    t0 = time.perf_counter()
+    fresh = _solver(setup, spec, scene, reuse=False)
+    try:
+        return fresh.solve(setup.g, active, fresh=True)
+    finally:
+        fresh.destroy()
+        timers.seconds["reference_solve"] = time.perf_counter() - t0
+
+
+def solve_contact(
+    scene: Scene,
+    method: Method,
+    solver: SolverSpec | str = "mumps",
+    aso: ActiveSetOptions = DEFAULT_OPTIONS,
+    timers: Timers | None = None,
+    reference_timing: bool = False,
+    initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None,
+    basis: Basis = Basis.STANDARD,
+    label: str = "active set",
+) -> Solution:
+    """Solve the frictionless unilateral contact problem of `scene` with `method`.
+
+    `initial_active` (node coordinates -> bool, or an InitialSet) adds nodes to the first
+    active set; only the loop's cost depends on it, never the converged solution. `basis`
+    dual takes mortar's biorthogonal multipliers (D diagonal). `label` heads the log lines.
+    """
+    if not method.has_multipliers:
+        raise InputError(
+            f"the {method.value} method has no saddle-point multipliers: call "
+            "contactfx.solve (it dispatches every method)"
+        )
+    if basis is not Basis.STANDARD and method is not Method.MORTAR:
+        raise InputError(f"the {basis.value} multiplier basis applies to the mortar method only")
+    spec = solver_spec(solver)
+    check_solver(method, basis, spec)
+    timers = timers or Timers()
+    setup = prepare_contact(scene, method.kernel, aso.penetration_tol, timers, basis)
+    try:
+        # One solver for the whole loop: fixed matrix pattern, reused analysis and setup.
+        linear = _solver(setup, spec, scene, reuse=True)
+        guess = (
+            initial_active
+            if isinstance(initial_active, InitialSet) or initial_active is None
+            else InitialSet(initial_active)
+        )
+        iteration = MultiplierIteration(setup, linear, aso, guess is not None, label)
+        active = iteration.start(setup.initial_active(aso.penetration_tol * setup.h), guess)
+        try:
+            step, active, history = run_active_set(setup, iteration, active, aso, timers)
+        finally:
+            linear.destroy()
+        ref = reference_solve(setup, spec, scene, active, timers) if reference_timing else None
+        sol = finish(setup, method, scene, iteration.u, step.lam, step.gap, active, history, timers)
+    finally:
+        setup.destroy()
+    sol.basis = basis
+    if ref is not None:
+        sol.reference_linear_iterations = ref.iterations
+    return sol

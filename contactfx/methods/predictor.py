@@ -1,0 +1,120 @@
+"""The coarse predictor: a first active set from a solve of the same scene on a coarser mesh.
+
+A superset of the converged set makes the loop factorize once and then only release rows;
+for the condensed solver (no probes) every ring of nodes it need not add or release saves a
+whole solve. Whether it pays is `use_coarse`'s rule (measured in docs/scale.md).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..errors import InputError
+from ..options import Basis, Method, Predictor, SolverKind, SolverSpec
+from ..scenes import Scene
+from ..timers import Timers
+from .active_set import ActiveSetOptions, InitialSet
+from .multipliers import solve_contact
+from .solution import Solution
+
+log = logging.getLogger("contactfx")
+
+# Above this many DOFs, "auto" starts from a coarser solve (direct solvers on several ranks,
+# fieldsplit): one factorization then suffices.
+COARSE_PREDICTOR_DOFS = 200_000
+# Mesh sizes of the coarse solve relative to the fine one (1/64 of the DOFs): its zone edge
+# is good to a coarse element, which the band probes cover.
+COARSE_FACTOR = 8.0
+# The condensed loop pays a whole solve per ring of nodes it adds or releases: a sharper
+# prediction (1/16 of the DOFs) pays for itself.
+CONDENSED_COARSE_FACTOR = 4.0
+
+
+def scene_dofs(scene: Scene) -> int:
+    """Displacement dofs of `scene` (P1 vector: two per vertex)."""
+    return 2 * scene.mesh.topology.index_map(0).size_global
+
+
+def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
+    """Whether `predictor` asks for a coarse solve of `scene` with this solver.
+
+    auto: never for serial direct solves (their probes are selected entries of the inverse,
+    so the loop starts from every row), always for the condensed solver (no probes at all),
+    above COARSE_PREDICTOR_DOFS otherwise.
+    """
+    if predictor is Predictor.AUTO:
+        if spec.kind is SolverKind.DIRECT and scene.comm.size == 1:
+            return False
+        if spec.kind is SolverKind.CONDENSED:
+            return True
+        return scene_dofs(scene) >= COARSE_PREDICTOR_DOFS
+    return predictor is Predictor.COARSE
+
+
+def coarse_factor(spec: SolverSpec) -> float:
+    """How much coarser the predictor's mesh is (every size times this)."""
+    return CONDENSED_COARSE_FACTOR if spec.kind is SolverKind.CONDENSED else COARSE_FACTOR
+
+
+def coarse_margin(spec: SolverSpec) -> float:
+    """Coarse elements of margin around the coarse zone.
+
+    A direct solver probes the uncertain band, so a generous superset costs it nothing; the
+    condensed loop pays a solve per ring it must release (463k DOFs: 6 -> 4 steps).
+    """
+    return 0.5 if spec.kind is SolverKind.CONDENSED else 1.5
+
+
+def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0) -> InitialSet:
+    """An InitialSet from the solution of the same scene on a coarser mesh.
+
+    In contact: nodes within `margin` coarse elements of a coarse active node; uncertain:
+    those within `band` coarse elements of a coarse inactive node (the zone's edge, wider
+    inwards: a coarse node-to-segment zone overshoots the fine one by up to two elements).
+    The coarse element size is the largest node spacing in the coarse contact zone.
+    """
+    x = np.asarray(coarse.layout.x)[:, :2]
+    act = np.asarray(coarse.active, dtype=bool)
+    if not act.any():
+        return InitialSet(lambda p: np.zeros(len(p), dtype=bool))
+    spacing = cKDTree(x).query(x[act], k=2)[0][:, 1] if len(x) > 1 else np.zeros(1)
+    r = margin * float(spacing.max())
+    tree_a = cKDTree(x[act])
+    tree_i = cKDTree(x[~act]) if (~act).any() else None
+
+    def near(tree: cKDTree | None, p: np.ndarray, d: float) -> np.ndarray:
+        if tree is None or len(p) == 0:
+            return np.zeros(len(p), dtype=bool)
+        return tree.query(np.asarray(p)[:, :2], distance_upper_bound=d * (1 + 1e-9))[0] <= d
+
+    return InitialSet(lambda p: near(tree_a, p, r), lambda p: near(tree_i, p, r * band / margin))
+
+
+def predict(
+    scene: Scene,
+    method: Method,
+    spec: SolverSpec,
+    predictor: Predictor,
+    aso: ActiveSetOptions,
+    basis: Basis,
+    timers: Timers,
+) -> InitialSet | None:
+    """The coarse predictor's first set for `scene`, or None where it is not used."""
+    if not use_coarse(predictor, scene, spec):
+        return None
+    if not scene.can_remesh:
+        if predictor is Predictor.COARSE:
+            raise InputError(
+                f"--predictor coarse: scene '{scene.name}' cannot be remeshed (a .msh or an "
+                "in-memory gmsh model): use --predictor auto or none"
+            )
+        if scene.comm.rank == 0:
+            log.info("coarse predictor: the scene cannot be remeshed, starting without it")
+        return None
+    with timers("predictor"):
+        coarse = scene.remeshed(coarse_factor(spec))
+        sol = solve_contact(coarse, method, spec, aso, basis=basis, label="predictor")
+        return coarse_initial_set(sol, margin=coarse_margin(spec))

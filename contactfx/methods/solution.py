@@ -1,0 +1,204 @@
+"""What a solve produces: the displacement, the multipliers of every pair and what it cost."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from dolfinx import fem
+from mpi4py import MPI
+
+from ..contact.geometry import arc_length, nodal_normals
+from ..discretize.coupling import Multipliers
+from ..discretize.pairs import PairData
+from ..discretize.setup import ContactSetup
+from ..discretize.surfaces import GatheredSurface
+from ..options import Basis, Method
+from ..scenes import Body, ContactPair, Scene
+from ..timers import Timers
+
+# One record per active-set (or Schwarz) iteration; None where a value is undefined.
+History = list[dict[str, float | None]]
+
+
+@dataclass(frozen=True)
+class Fields:
+    """The solved displacement and the material fields the stresses need."""
+
+    V: fem.FunctionSpace
+    u: fem.Function
+    E: fem.Function
+    nu: fem.Function
+
+
+@dataclass
+class PairView:
+    """One contact pair of a solution: its surfaces, multiplier rows and their geometry.
+
+    Row i of `B` is the pair's multiplier row `rows[i]` (layout order): the weighted gap's
+    linearization, whose transpose spreads the multipliers into nodal forces.
+    """
+
+    index: int
+    pair: ContactPair
+    active_body: Body
+    passive_body: Body
+    active: GatheredSurface
+    passive: GatheredSurface
+    rows: np.ndarray  # layout rows of the pair's multipliers
+    gblock: np.ndarray  # global node (dof block) of each of those rows
+    B: sp.csr_matrix
+
+    @property
+    def label(self) -> str:
+        """How messages name the pair."""
+        return f"pair {self.index} ({self.pair.active} on {self.pair.passive})"
+
+    @cached_property
+    def nodes(self) -> np.ndarray:
+        """The active-surface node of each multiplier row."""
+        return np.searchsorted(self.active.gblock, self.gblock)
+
+    @cached_property
+    def arc(self) -> tuple[np.ndarray, np.ndarray]:
+        """(s, t): arc length and unit tangent at every node of the active surface."""
+        return arc_length(self.active.surface)
+
+    @property
+    def s(self) -> np.ndarray:
+        """Arc length of each multiplier row's node."""
+        return self.arc[0][self.nodes]
+
+    @property
+    def t(self) -> np.ndarray:
+        """Unit tangent (direction of increasing s) at each multiplier row's node."""
+        return self.arc[1][self.nodes]
+
+    @cached_property
+    def n(self) -> np.ndarray:
+        """Outward normal of the active surface at each multiplier row's node."""
+        return nodal_normals(self.active.surface)[self.nodes]
+
+    @property
+    def x(self) -> np.ndarray:
+        """Coordinates of each multiplier row's node."""
+        return self.active.surface.x[self.nodes]
+
+
+@dataclass
+class PenaltyResult:
+    """What the penalty method adds: its stiffness and the penetration it leaves."""
+
+    eps: float  # normal stiffness (MPa/cm)
+    penetration: float  # largest penetration (cm)
+    condition: dict[str, float] | None = None  # CG + Jacobi Lanczos estimate, if asked for
+
+
+@dataclass
+class Cache:
+    """Post-processing computed once per solution, shared by the summary and the charts.
+
+    `stress`: (global node, x, sigma) by curve group; `interface`: the JSON block by pair.
+    """
+
+    stress: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=dict)
+    interface: dict[int, dict[str, Any]] = field(default_factory=dict)
+
+
+@dataclass
+class Solution:
+    """A solved scene; multiplier arrays are in the global layout order (all pairs)."""
+
+    scene: Scene
+    method: Method
+    fields: Fields
+    layout: Multipliers
+    pressure: np.ndarray  # (n,) contact traction per multiplier node, compression > 0
+    gap: np.ndarray  # (n,) normalized gap (weighted gap / weight) at the solution
+    active: np.ndarray  # (n,) bool, converged active set
+    pairs: list[PairView]
+    history: History = field(default_factory=list)
+    timers: Timers = field(default_factory=Timers)
+    basis: Basis = Basis.STANDARD
+    penalty: PenaltyResult | None = None
+    schwarz_dirichlet_body: str | None = None  # Schwarz: the body that took Dirichlet data
+    reference_linear_iterations: int | None = None  # of the fresh solve (reference timing)
+    cache: Cache = field(default_factory=Cache, repr=False)
+
+    @property
+    def iterations(self) -> int:
+        """Outer iterations (active-set or Schwarz) the solve took."""
+        return len(self.history)
+
+    @property
+    def u(self) -> fem.Function:
+        """The displacement."""
+        return self.fields.u
+
+    @property
+    def dofs(self) -> int:
+        """Displacement dofs of the whole mesh."""
+        imap = self.fields.V.dofmap.index_map
+        return imap.size_global * self.fields.V.dofmap.index_map_bs
+
+    def rows_of(self, pair: int) -> np.ndarray:
+        """Layout rows of contact pair `pair`."""
+        return self.pairs[pair].rows
+
+
+def gather_all(comm: MPI.Comm, local: np.ndarray) -> np.ndarray:
+    """Concatenate every rank's rows (in rank order), on every rank."""
+    return np.concatenate(comm.allgather(np.asarray(local)))
+
+
+def pair_views(
+    setup_pairs: list[PairData], layout: Multipliers, B: sp.csr_matrix, order: np.ndarray
+) -> list[PairView]:
+    """One PairView per pair: its layout rows and their rows of the stacked operator B."""
+    out = []
+    for p in setup_pairs:
+        rows = np.flatnonzero(layout.pair == p.index)
+        view = PairView(
+            p.index,
+            p.pair,
+            p.active_body,
+            p.passive_body,
+            p.active,
+            p.passive,
+            rows,
+            layout.gblock[rows],
+            B[order[rows]].tocsr(),
+        )
+        out.append(view)
+    return out
+
+
+def finish(
+    setup: ContactSetup,
+    method: Method,
+    scene: Scene,
+    u: fem.Function,
+    pressure: np.ndarray,
+    gap: np.ndarray,
+    active: np.ndarray,
+    history: History,
+    timers: Timers,
+) -> Solution:
+    """Gather the owned rows of a converged loop into a Solution."""
+    comm = setup.comm
+    el = setup.elasticity
+    return Solution(
+        scene,
+        method,
+        Fields(el.V, u, el.E, el.nu),
+        setup.layout,
+        pressure=gather_all(comm, np.where(active, pressure, 0.0)),
+        gap=gather_all(comm, gap),
+        active=gather_all(comm, active),
+        pairs=pair_views(setup.pairs, setup.layout, setup.operator.B, setup.order),
+        history=history,
+        timers=timers,
+    )

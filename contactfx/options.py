@@ -1,0 +1,256 @@
+"""The choices a user makes, as typed values validated once: method, basis, predictor, solver.
+
+A `SolverSpec` says which linear solver runs (`kind`), the PETSc options it is configured
+with (PETSc keys only) and the tolerances the code itself applies. Nothing infers the kind
+from the PETSc options: a spec whose options contradict its kind is refused when it is made.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from enum import StrEnum
+from types import MappingProxyType
+
+from .contact import Kernel
+from .errors import InputError
+
+
+def _unknown(enum: type[StrEnum], value: object, what: str) -> InputError:
+    """The error for a value that is not a member of `enum`, naming the choices."""
+    choices = ", ".join(m.value for m in enum)
+    return InputError(f"unknown {what} '{value}' (choose {choices})")
+
+
+class Method(StrEnum):
+    """Contact enforcement methods."""
+
+    NTS = "nts"
+    STS = "sts"
+    MORTAR = "mortar"
+    PENALTY = "penalty"
+    SCHWARZ = "schwarz"
+
+    @property
+    def kernel(self) -> Kernel:
+        """The discrete contact operator (B, weighted gap) this method is built on."""
+        return {
+            Method.NTS: Kernel.NTS,
+            Method.STS: Kernel.STS,
+        }.get(self, Kernel.MORTAR)
+
+    @property
+    def has_multipliers(self) -> bool:
+        """Whether the method solves saddle points with Lagrange multipliers."""
+        return self in (Method.NTS, Method.STS, Method.MORTAR)
+
+    @classmethod
+    def parse(cls, value: Method | str) -> Method:
+        """The method named `value` (InputError listing the methods otherwise)."""
+        try:
+            return cls(value)
+        except ValueError:
+            raise _unknown(cls, value, "method") from None
+
+
+class Basis(StrEnum):
+    """Mortar multiplier bases: the shape functions N_j, or the biorthogonal (dual) ones."""
+
+    STANDARD = "standard"
+    DUAL = "dual"
+
+    @classmethod
+    def parse(cls, value: Basis | str) -> Basis:
+        """The basis named `value`."""
+        try:
+            return cls(value)
+        except ValueError:
+            raise _unknown(cls, value, "multiplier basis") from None
+
+
+class Predictor(StrEnum):
+    """Where the active-set loop starts: a coarser solve of the same scene, or not."""
+
+    AUTO = "auto"  # the policy of methods/predictor.py decides
+    COARSE = "coarse"
+    NONE = "none"
+
+    @classmethod
+    def parse(cls, value: Predictor | str) -> Predictor:
+        """The predictor named `value`."""
+        try:
+            return cls(value)
+        except ValueError:
+            raise _unknown(cls, value, "predictor") from None
+
+
+class SolverKind(StrEnum):
+    """Which linear solver handles the saddle points."""
+
+    DIRECT = "direct"  # a factorization of the whole [[K, B^T], [B, C]] (MUMPS)
+    FIELDSPLIT = "fieldsplit"  # PCFIELDSPLIT Schur on A00 = K + gamma B^T B
+    CONDENSED = "condensed"  # active multipliers eliminated (D diagonal), CG on u
+
+    @property
+    def augmented(self) -> bool:
+        """Whether A00 = K + gamma B^T B (a fieldsplit's A00 must be invertible alone)."""
+        return self is SolverKind.FIELDSPLIT
+
+
+@dataclass(frozen=True)
+class SolverSpec:
+    """A linear solver: its kind, its PETSc options and the tolerances the code applies.
+
+    `petsc` holds PETSc keys only (no leading dash). `rtol` is the final relative tolerance
+    of an iterative solver (the condensed solver's CG); `loose_rtol` the relative reduction
+    the condensed loop's solves stop at before the set is stationary (None: solve to rtol).
+    """
+
+    kind: SolverKind
+    petsc: Mapping[str, object] = field(default_factory=dict)
+    rtol: float = 1e-9
+    loose_rtol: float | None = None
+    name: str = "custom"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "petsc", MappingProxyType(dict(self.petsc)))
+        self._check()
+
+    def _check(self) -> None:
+        """Refuse PETSc options that contradict the kind (they would change the code path)."""
+        pc = self.petsc.get("pc_type")
+        bad = {
+            SolverKind.DIRECT: pc not in ("lu", "cholesky"),
+            SolverKind.FIELDSPLIT: pc != "fieldsplit",
+            SolverKind.CONDENSED: pc == "fieldsplit",
+        }[self.kind]
+        if bad:
+            fix = {
+                SolverKind.DIRECT: "a direct solver factorizes (pc_type lu or cholesky)",
+                SolverKind.FIELDSPLIT: "a fieldsplit solver needs pc_type fieldsplit",
+                SolverKind.CONDENSED: "the condensed system has no multiplier block to split",
+            }[self.kind]
+            raise InputError(
+                f"solver '{self.name}' ({self.kind.value}): PETSc option pc_type={pc} "
+                f"contradicts it: {fix}; choose the solver with --solver instead"
+            )
+        if not (0.0 < self.rtol < 1.0) or (
+            self.loose_rtol is not None and not 0.0 < self.loose_rtol < 1.0
+        ):
+            raise InputError(f"solver '{self.name}': tolerances must lie in (0, 1)")
+
+    @property
+    def augmented(self) -> bool:
+        """Whether A00 = K + gamma B^T B."""
+        return self.kind.augmented
+
+    def with_petsc(self, items: Iterable[str]) -> SolverSpec:
+        """The spec with PETSc options KEY=VALUE added (checked against the kind).
+
+        For the condensed solver `ksp_rtol` is the tolerance the code applies itself (its
+        final solves), so it sets `rtol` rather than a PETSc option that would be overridden.
+        """
+        petsc = dict(self.petsc)
+        rtol = self.rtol
+        for item in items:
+            key, sep, value = item.partition("=")
+            key = key.strip().lstrip("-")
+            if not sep or not key:
+                raise InputError(f"--petsc-option expects KEY=VALUE, got '{item}'")
+            if self.kind is SolverKind.CONDENSED and key == "ksp_rtol":
+                try:
+                    rtol = float(value)
+                except ValueError:
+                    raise InputError(f"--petsc-option {item}: not a number") from None
+                continue
+            petsc[key] = value
+        return replace(self, petsc=petsc, rtol=rtol)
+
+
+_MUMPS: dict[str, object] = {
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+    # PORD ordering: MUMPS' sequential METIS analysis cost half of a 1M-DOF solve
+    # (benchmarks/README.md).
+    "mat_mumps_icntl_7": 4,
+}
+
+SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
+    {
+        "mumps": SolverSpec(SolverKind.DIRECT, _MUMPS, name="mumps"),
+        # Schur fieldsplit, A00 = K + gamma B^T B factorized by MUMPS, S by Jacobi-GMRES.
+        "fieldsplit": SolverSpec(
+            SolverKind.FIELDSPLIT,
+            {
+                "ksp_type": "fgmres",
+                "ksp_rtol": 1e-12,
+                "ksp_atol": 1e-14,
+                "ksp_max_it": 200,
+                "pc_type": "fieldsplit",
+                "pc_fieldsplit_type": "schur",
+                "pc_fieldsplit_schur_fact_type": "full",
+                "pc_fieldsplit_schur_precondition": "selfp",
+                "fieldsplit_u_ksp_type": "preonly",
+                "fieldsplit_u_pc_type": "lu",
+                "fieldsplit_u_pc_factor_mat_solver_type": "mumps",
+                "fieldsplit_u_mat_mumps_icntl_7": 4,
+                "fieldsplit_lambda_ksp_type": "gmres",
+                "fieldsplit_lambda_ksp_rtol": 1e-12,
+                "fieldsplit_lambda_ksp_max_it": 500,
+                "fieldsplit_lambda_pc_type": "jacobi",
+            },
+            name="fieldsplit",
+        ),
+        # A00 by one GAMG V-cycle with the bodies' rigid modes as near-nullspace, S by the
+        # augmented-Lagrangian diagonal -I/gamma (linalg/saddle.py: schur_al_diagonal).
+        "fieldsplit-gamg": SolverSpec(
+            SolverKind.FIELDSPLIT,
+            {
+                "ksp_type": "fgmres",
+                "ksp_rtol": 1e-10,
+                "ksp_max_it": 1000,
+                "ksp_gmres_restart": 200,
+                "pc_type": "fieldsplit",
+                "pc_fieldsplit_type": "schur",
+                "pc_fieldsplit_schur_fact_type": "upper",
+                "pc_fieldsplit_schur_precondition": "user",
+                "fieldsplit_u_ksp_type": "preonly",
+                "fieldsplit_u_pc_type": "gamg",
+                "fieldsplit_u_pc_gamg_threshold": 0.01,
+                "fieldsplit_u_pc_gamg_reuse_interpolation": True,
+                # SOR: stretched cells of graded meshes defeat Chebyshev/Jacobi (docs/scale.md).
+                "fieldsplit_u_mg_levels_pc_type": "sor",
+                "fieldsplit_lambda_ksp_type": "preonly",
+                "fieldsplit_lambda_pc_type": "jacobi",
+            },
+            name="fieldsplit-gamg",
+        ),
+        # Multipliers eliminated (D diagonal: NTS or dual mortar), CG on the SPD displacement
+        # system, GAMG (Chebyshev/Jacobi, one level of aggressive coarsening) with the bodies'
+        # rigid modes; the loop's solves only need signs (loose_rtol, docs/condensed.md).
+        "condensed": SolverSpec(
+            SolverKind.CONDENSED,
+            {
+                "ksp_type": "cg",
+                "ksp_norm_type": "unpreconditioned",
+                "ksp_max_it": 5000,
+                "pc_type": "gamg",
+                "pc_gamg_threshold": 0.01,
+                "pc_gamg_aggressive_coarsening": 1,
+            },
+            rtol=1e-9,
+            loose_rtol=1e-4,
+            name="condensed",
+        ),
+    }
+)
+
+
+def solver_spec(solver: SolverSpec | str) -> SolverSpec:
+    """A named preset (InputError listing them if unknown), or the spec itself."""
+    if isinstance(solver, SolverSpec):
+        return solver
+    if solver not in SOLVERS:
+        raise InputError(f"unknown solver '{solver}' (choose {', '.join(SOLVERS)})")
+    return SOLVERS[solver]

@@ -1,0 +1,157 @@
+"""Figures of a run: the contact line charts (matplotlib) and the deformed fields (pyvista).
+
+The deformed-field picture is like the paper's Fig. 3; the charts read the JSON summary.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..methods.solution import Solution
+from .stress import sigma_field
+
+
+def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | None:
+    """Save u_y and sigma_yy on the mesh deformed `scale` times; serial runs only."""
+    if sol.scene.mesh.comm.size > 1:
+        return None
+    import pyvista
+    from dolfinx import plot
+
+    pyvista.OFF_SCREEN = True
+    V = sol.fields.V
+    # vtk_mesh is a singledispatch function: mypy sees only its Mesh signature.
+    topology, cell_types, x = plot.vtk_mesh(V)  # type: ignore[arg-type]
+    grid = pyvista.UnstructuredGrid(topology, cell_types, x)
+    u = sol.u.x.array.reshape(-1, 2)
+    grid.point_data["u_y"] = u[:, 1]
+    grid.point_data["u"] = np.column_stack([u, np.zeros(len(u))])
+    s = sigma_field(sol).x.array.reshape(-1, 4)
+    # DG0 dofs follow the cell order of vtk_mesh(V) (both enumerate local cells).
+    grid.cell_data["sigma_yy"] = s[: grid.n_cells, 3]
+    warped = grid.warp_by_vector("u", factor=scale)
+    # pyvista annotates window_size as list[int]; it takes any sequence (as BasePlotter says).
+    plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)  # type: ignore[arg-type]
+    for col, (name, label) in enumerate((("u_y", "u_y (cm)"), ("sigma_yy", "sigma_yy (MPa)"))):
+        plotter.subplot(0, col)
+        plotter.add_mesh(
+            warped,
+            scalars=name,
+            cmap="turbo",
+            show_edges=False,
+            scalar_bar_args={
+                "title": label,
+                "vertical": True,
+                "position_x": 0.86,
+                "position_y": 0.15,
+            },
+        )
+        plotter.add_text(f"{label}, deformation x{scale:g}", font_size=10)
+        plotter.view_xy()  # type: ignore[call-arg]  # pyvista's functools.wraps confuses mypy
+    path.parent.mkdir(parents=True, exist_ok=True)
+    plotter.screenshot(str(path))
+    plotter.close()
+    return path
+
+
+def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
+    """Chart sigma_yy of both bodies and the contact pressure along the contact line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    itf = data["interface"]
+    x = np.asarray(itf["x"])
+    fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
+    for key, style, label in (
+        ("sigma_yy_1", "-", "sigma_yy body 1"),
+        ("sigma_yy_2", "--", "sigma_yy body 2"),
+    ):
+        vals = np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
+        ax.plot(x, vals, style, label=label)
+    ax.plot(x, -np.asarray(itf["pressure"]), ":", label="-pressure (multipliers)")
+    if "hertz" in data:
+        # Zoom on the contact zone and show the exact plane-strain Hertz profile.
+        a, p0 = data["hertz"]["a_exact"], data["hertz"]["p0_exact"]
+        xs = np.linspace(0.0, 2.0 * a, 400)
+        ax.plot(
+            xs,
+            -p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0.0, None)),
+            "k-",
+            lw=0.8,
+            alpha=0.6,
+            label="-pressure, exact 2D Hertz",
+        )
+        ax.set_xlim(0.0, 2.0 * a)
+    ax.set_xlabel("x (cm)")
+    ax.set_ylabel("MPa")
+    ax.set_title(title or f"{data['scene']} / {data['method']}: contact line")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
+    """Chart pair k along s: pressure, -sigma_nn and sigma_nt of both bodies (and Hertz)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    c = data["contacts"][k]
+    itf = c["interface"]
+
+    def arr(key: str) -> np.ndarray:
+        return np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
+
+    s = arr("s")
+    fig, (ax, bx) = plt.subplots(
+        2, 1, figsize=(7, 5.5), sharex=True, layout="constrained", height_ratios=(3, 1.3)
+    )
+    ax.plot(s, arr("pressure"), "k.-", ms=3, lw=1, label="pressure (multipliers)")
+    ax.plot(s, -arr("sigma_nn_active"), "-", label=f"-sigma_nn {c['active_body']} (active)")
+    ax.plot(s, -arr("sigma_nn_passive"), "--", label=f"-sigma_nn {c['passive_body']} (passive)")
+    bx.plot(s, arr("sigma_nt_active"), "-", label="active")
+    bx.plot(s, arr("sigma_nt_passive"), "--", label="passive")
+    hertz = [
+        h
+        for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else [])
+        if h.get("pair") == k
+    ]
+    if hertz:
+        # The exact profile against the distance from the centre, placed at the computed peak.
+        h = hertz[0]
+        a, p0 = h["a_exact"], h["p0_exact"]
+        sc = float(s[int(np.nanargmax(arr("pressure")))])
+        xs = np.linspace(-a, a, 400)
+        ax.plot(
+            sc + xs,
+            p0 * np.sqrt(np.clip(1 - (xs / a) ** 2, 0, None)),
+            "r-",
+            lw=0.8,
+            alpha=0.7,
+            label="exact Hertz (placed at the peak)",
+        )
+        ax.set_xlim(sc - 2.0 * a, sc + 2.0 * a)
+    active = np.asarray(itf["active"], dtype=bool)
+    if active.any():
+        ax.axvspan(s[active].min(), s[active].max(), color="0.9", zorder=0, label="active set")
+    ax.set_ylabel("normal traction (compression > 0)")
+    bx.set_ylabel("sigma_nt")
+    bx.set_xlabel("s, arc length along the active surface")
+    ax.set_title(f"{data['scene']} / {data['method']}: pair {k}, {c['active']} on {c['passive']}")
+    for a_ in (ax, bx):
+        a_.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    bx.legend(fontsize=8)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

@@ -1,0 +1,139 @@
+"""Quantities users read off a solution, pair by pair: stresses along the normal, forces.
+
+Stresses are each body's own FE stress, averaged at the surface nodes over the adjacent
+cells, resolved on the active surface's outward normal n and the tangent t (the direction of
+increasing arc length s along the active surface).
+The JSON assembly is in results/summary.py.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..contact.geometry import project
+from ..methods.solution import Solution
+from .stress import nodal_stress, surface_stress
+
+# The numeric columns of every pair's `interface` (plus the boolean `active`), in order.
+INTERFACE_FIELDS = (
+    "x",
+    "y",
+    "s",
+    "pressure",
+    "gap",
+    "sigma_nn_active",
+    "sigma_nn_passive",
+    "sigma_nt_active",
+    "sigma_nt_passive",
+)
+
+
+def resolve(sig: np.ndarray, n: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """n.sigma.n and t.sigma.n, row by row."""
+    tr = np.einsum("kij,kj->ki", sig, n)
+    return np.einsum("ki,ki->k", n, tr), np.einsum("ki,ki->k", t, tr)
+
+
+def none_if_nan(v: np.ndarray) -> list[float | None]:
+    return [None if not np.isfinite(x) else float(x) for x in v]
+
+
+def pair_interface(sol: Solution, k: int) -> dict[str, Any]:
+    """Pressure, gap and both bodies' sigma_nn, sigma_nt at pair k's multipliers, by s."""
+    if k not in sol.cache.interface:
+        sol.cache.interface[k] = _pair_interface(sol, k)
+    return sol.cache.interface[k]
+
+
+def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
+    """pair_interface, computed (collective)."""
+    pv = sol.pairs[k]
+    rows = pv.rows
+    surf_p = pv.passive.surface
+    n, t, x, s = pv.n, pv.t, pv.x, pv.s
+    gn_a, _, sig_a = nodal_stress(sol, pv.pair.active)
+    sa = sig_a[np.searchsorted(gn_a, pv.gblock)]
+    gn_p, _, sig_p = nodal_stress(sol, pv.pair.passive)
+    at_node = sig_p[np.searchsorted(gn_p, pv.passive.gblock)]
+    seg, xi, found = project(x, surf_p)
+    ends = surf_p.segments[seg]
+    sp = (1 - xi)[:, None, None] * at_node[ends[:, 0]] + xi[:, None, None] * at_node[ends[:, 1]]
+    sp[~found] = np.nan  # beyond the passive surface's end there is no value
+    nn_a, nt_a = resolve(sa, n, t)
+    nn_p, nt_p = resolve(sp, n, t)
+    order = np.argsort(s, kind="stable")
+    values = (x[:, 0], x[:, 1], s, sol.pressure[rows], sol.gap[rows], nn_a, nn_p, nt_a, nt_p)
+    cols = dict(zip(INTERFACE_FIELDS, values, strict=True))
+    out: dict[str, Any] = {key: none_if_nan(np.asarray(v)[order]) for key, v in cols.items()}
+    out["active"] = [bool(a) for a in sol.active[rows][order]]
+    return out
+
+
+def pair_forces(sol: Solution, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Total contact force (fx, fy) on pair k's active body and on its passive body."""
+    pv = sol.pairs[k]
+    # B^T lambda: the multipliers' nodal forces (compression positive pushes the bodies apart).
+    nodal = pv.B.T @ sol.pressure[pv.rows]
+    fa = np.array([nodal[pv.active.surface.dofs[:, c]].sum() for c in (0, 1)])
+    fp = np.array([nodal[pv.passive.surface.dofs[:, c]].sum() for c in (0, 1)])
+    return fa, fp
+
+
+def contacts_summary(sol: Solution) -> list[dict[str, Any]]:
+    """The `contacts` list of the JSON: one entry per pair, in the scene's order."""
+    out = []
+    for k, pv in enumerate(sol.pairs):
+        fa, fp = pair_forces(sol, k)
+        out.append(
+            {
+                "active": pv.pair.active,
+                "passive": pv.pair.passive,
+                "active_body": pv.active_body.name,
+                "passive_body": pv.passive_body.name,
+                "force": fa.tolist(),
+                "force_passive": fp.tolist(),
+                "balance": float(np.linalg.norm(fa + fp) / max(np.linalg.norm(fa), 1e-300)),
+                "multipliers": len(pv.rows),
+                "active_nodes": int(sol.active[pv.rows].sum()),
+                "interface": pair_interface(sol, k),
+            }
+        )
+    return out
+
+
+def cartesian_interface(sol: Solution) -> dict[str, list[float | None]]:
+    """Pair 0 along x: pressure and sigma_yy of every body at the multipliers (paper's view).
+
+    Only meaningful for a horizontal contact line (the paper's scenes).
+    """
+    itf = pair_interface(sol, 0)
+    x = np.asarray(itf["x"], dtype=float)
+    order = np.argsort(x, kind="stable")
+    pv = sol.pairs[0]
+    out: dict[str, list[float | None]] = {
+        "x": x[order].tolist(),
+        "pressure": [itf["pressure"][i] for i in order],
+    }
+    xm = pv.x[np.argsort(pv.s, kind="stable")]
+    for k, body in enumerate(sol.scene.bodies, start=1):
+        if body not in (pv.active_body, pv.passive_body):
+            continue
+        group = pv.pair.active if body == pv.active_body else pv.pair.passive
+        xs, s = surface_stress(sol, group)
+        inside = (xm[:, 0] >= xs[0] - 1e-12) & (xm[:, 0] <= xs[-1] + 1e-12)
+        vals = np.where(inside, np.interp(xm[:, 0], xs, s), np.nan)
+        out[f"sigma_yy_{k}"] = none_if_nan(vals[order])
+    return out
+
+
+def u_at_points(sol: Solution) -> np.ndarray:
+    """Gather (x, y, ux, uy) of all owned nodes, sorted by coordinates (for rank comparisons)."""
+    V = sol.fields.V
+    nloc = V.dofmap.index_map.size_local
+    xyz = V.tabulate_dof_coordinates()[:nloc, :2]
+    vals = sol.u.x.array[: 2 * nloc].reshape(-1, 2)
+    data = np.concatenate(V.mesh.comm.allgather(np.column_stack([xyz, vals])))
+    key = np.round(data[:, :2], 9)  # gmsh coordinates carry ~1e-17 noise around zero
+    return data[np.lexsort((data[:, 3], data[:, 2], key[:, 1], key[:, 0]))]

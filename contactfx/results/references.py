@@ -1,0 +1,151 @@
+"""Analytic references: plane-strain Hertz line contact, and the patch test's uniform stress.
+
+Hertz, for one pair: half-width, peak and the L2 error of the pressure. The distance r from
+the contact centre is measured along the active surface's tangent at the centre (the
+tangent-plane coordinate of Hertz's theory). For a half model (`symmetric`) the centre is the
+end of the active surface nearest the pressure peak; otherwise the pressure's centroid along
+the arc length.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from mpi4py import MPI
+
+from ..scenes import HertzReference, Scene
+from ..methods.solution import Solution
+from .interface import none_if_nan, pair_interface, resolve
+from .stress import body_vertex_stress
+
+
+def exact_pressure(x: np.ndarray, a: float, p0: float) -> np.ndarray:
+    """Plane-strain Hertz pressure p0 sqrt(1 - x^2/a^2) inside |x| < a, zero outside."""
+    return p0 * np.sqrt(np.clip(1.0 - (x / a) ** 2, 0.0, None))
+
+
+def fit_half_width(x: np.ndarray, p: np.ndarray) -> float | None:
+    """Least-squares fit of p^2 = p0^2 (1 - x^2/a^2); returns a."""
+    A = np.column_stack([np.ones_like(x), x**2])
+    (c0, c1), *_ = np.linalg.lstsq(A, p**2, rcond=None)
+    return float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else None
+
+
+def l2_error(
+    x: np.ndarray,
+    p: np.ndarray,
+    a: float,
+    p0: float,
+    samples: int = 40001,
+    both_sides: bool = False,
+) -> float:
+    """Relative L2 error over [0, 1.5 a] (or [-1.5 a, 1.5 a]) of the piecewise-linear pressure."""
+    xs = np.linspace(-1.5 * a if both_sides else 0.0, 1.5 * a, samples)
+    ph = np.interp(xs, x, p, left=0.0, right=0.0)
+    pe = exact_pressure(xs, a, p0)
+    return float(np.sqrt(np.trapezoid((ph - pe) ** 2, xs) / np.trapezoid(pe**2, xs)))
+
+
+def reference_values(scene: Scene, ref: HertzReference) -> dict[str, float]:
+    """E*, a and p0 of the pair's materials: 1/E* = sum (1 - nu^2)/E, a = sqrt(4 P R/(pi E*))."""
+    pair = scene.contacts[ref.pair]
+    mats = [scene.body_of_curve(g).material for g in (pair.active, pair.passive)]
+    e_star = 1.0 / sum((1 - m.nu**2) / m.E for m in mats)
+    a = math.sqrt(4 * ref.P * ref.R / (math.pi * e_star))
+    return {"E_star": e_star, "a": a, "p0": 2 * ref.P / (math.pi * a)}
+
+
+def centre_distance(
+    sol: Solution, ref: HertzReference
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(r, pressure, active) of the pair's multipliers, r signed along the centre's tangent."""
+    pv = sol.pairs[ref.pair]
+    rows = pv.rows
+    surf = pv.active.surface
+    node = pv.nodes
+    s_all, t_all = pv.arc
+    s, p = s_all[node], sol.pressure[rows]
+    order = np.argsort(s, kind="stable")
+    s, p, node, act = s[order], p[order], node[order], sol.active[rows][order]
+    if ref.symmetric:
+        peak = s[int(np.argmax(p))]
+        ends = np.array([np.nanmin(s_all), np.nanmax(s_all)])
+        centre_node = int(np.nanargmin(np.abs(s_all - ends[np.argmin(np.abs(ends - peak))])))
+        xc, tc = surf.x[centre_node], t_all[centre_node]
+    else:
+        w = np.clip(p, 0.0, None)
+        sc = float((w * s).sum() / max(w.sum(), 1e-300))
+        xc = np.array([np.interp(sc, s, surf.x[node, d]) for d in (0, 1)])
+        tc = np.array([np.interp(sc, s, t_all[node, d]) for d in (0, 1)])
+        tc /= np.linalg.norm(tc)
+    r = (surf.x[node] - xc) @ tc
+    if ref.symmetric and np.any(p > 0) and np.median(r[p > 0]) < 0:
+        r = -r  # the centre is the end of largest s: measure into the surface
+    return r, p, act
+
+
+def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> dict[str, object]:
+    """The `hertz` block of the JSON: fitted and bracketed half-width, p0 and the L2 error."""
+    if ref is None:
+        ref = next(r for r in sol.scene.references if isinstance(r, HertzReference))
+    exact = reference_values(sol.scene, ref)
+    r, p, act = centre_distance(sol, ref)
+    order = np.argsort(r, kind="stable")
+    r, p, act = r[order], p[order], act[order]
+    ra = np.abs(r[act])
+    last = float(ra.max()) if ra.size else 0.0
+    beyond = np.abs(r[(~act) & (np.abs(r) > last)])
+    return {
+        "pair": ref.pair,
+        "a": fit_half_width(r[act], p[act]),
+        "a_bracket": [last, float(beyond.min()) if beyond.size else None],
+        "a_exact": exact["a"],
+        "p0": float(p.max()),
+        "p0_exact": exact["p0"],
+        "E_star": exact["E_star"],
+        "l2_error": l2_error(r, p, exact["a"], exact["p0"], both_sides=not ref.symmetric),
+    }
+
+
+def _max_error(values: list[float | None], exact: np.ndarray, scale: float) -> float:
+    """Max |value - exact| / scale over the values that exist."""
+    v = np.array([np.nan if a is None else a for a in values], dtype=float)
+    return float(np.nanmax(np.abs(v - exact), initial=0.0) / scale)
+
+
+def uniform_stress_errors(sol: Solution, ref: np.ndarray) -> dict[str, Any]:
+    """Patch test against a uniform stress: max errors relative to the largest |ref_ij|."""
+    comm = sol.scene.comm
+    scale = float(np.abs(ref).max())
+    bodies = {
+        name: comm.allreduce(float(np.max(np.abs(v - ref), initial=0.0)), op=MPI.MAX) / scale
+        for name, v in body_vertex_stress(sol).items()
+    }
+    pairs = []
+    for k, pv in enumerate(sol.pairs):
+        itf = pair_interface(sol, k)
+        order = np.argsort(pv.s, kind="stable")
+        n, t = pv.n[order], pv.t[order]
+        nn, nt = resolve(np.broadcast_to(ref, (len(n), 2, 2)), n, t)
+
+        pairs.append(
+            {
+                "pressure": _max_error(itf["pressure"], -nn, scale),
+                **{
+                    key: _max_error(itf[key], exact, scale)
+                    for key, exact in (
+                        ("sigma_nn_active", nn),
+                        ("sigma_nn_passive", nn),
+                        ("sigma_nt_active", nt),
+                        ("sigma_nt_passive", nt),
+                    )
+                },
+            }
+        )
+    return {
+        "bodies": bodies,
+        "pairs": pairs,
+        "max": max([*bodies.values(), *(v for p in pairs for v in p.values())]),
+    }
