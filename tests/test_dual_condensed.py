@@ -72,8 +72,8 @@ def _condensed_solver(scene, reuse: bool = True):
     """The setup of the NTS Hertz problem and a condensed solver on it."""
     from contactfx.discretize.setup import prepare_contact
     from contactfx.discretize.supports import rigid_body_modes
-    from contactfx.linalg import make_solver
     from contactfx.methods.active_set import ActiveSetOptions
+    from contactfx.methods.solvers import make_solver
     from contactfx.options import SOLVERS, Method
     from contactfx.timers import Timers
 

@@ -1,6 +1,5 @@
 """PETSc linear algebra of the contact saddle points; it knows no Scene and no DOLFINx object."""
 
-from .factory import augmentation, make_solver
 from .policy import Decision, FactorizationPolicy, ReuseMode
 from .protocol import LinearSolver, SaddleResult
 
@@ -10,6 +9,4 @@ __all__ = [
     "LinearSolver",
     "ReuseMode",
     "SaddleResult",
-    "augmentation",
-    "make_solver",
 ]

@@ -19,12 +19,13 @@ from mpi4py import MPI
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..discretize.supports import rigid_body_modes
 from ..errors import InputError
-from ..linalg import LinearSolver, SaddleResult, make_solver
+from ..linalg import LinearSolver, SaddleResult
 from ..options import Basis, Method, SolverKind, SolverSpec, solver_spec
 from ..scenes import Scene
 from ..timers import Timers
 from .active_set import ActiveSetOptions, InitialSet, SetHistory, Step, run_active_set
 from .solution import Solution, finish
+from .solvers import make_solver
 
 log = logging.getLogger("contactfx")
 

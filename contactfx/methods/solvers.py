@@ -1,4 +1,7 @@
-"""One factory for every linear solver: it owns gamma, the near-nullspace and the reuse policy."""
+"""One factory for every linear solver: it owns gamma, the near-nullspace and the reuse policy.
+
+The methods turn a SolverSpec into a solver here; contactfx/linalg itself knows no spec.
+"""
 
 from __future__ import annotations
 
@@ -7,12 +10,12 @@ from collections.abc import Callable
 import numpy as np
 from petsc4py import PETSc
 
+from ..linalg.condensed import CondensedSolver
+from ..linalg.nullspace import near_nullspace
+from ..linalg.policy import FactorizationPolicy
+from ..linalg.protocol import LinearSolver
+from ..linalg.saddle import SaddleSolver
 from ..options import SolverKind, SolverSpec
-from .condensed import CondensedSolver
-from .nullspace import near_nullspace
-from .policy import FactorizationPolicy
-from .protocol import LinearSolver
-from .saddle import SaddleSolver
 
 
 def augmentation(spec: SolverSpec, e_max: float, h: float) -> float:
