@@ -109,7 +109,7 @@ def run_scene(
     spec = solver_spec(solver)
     sol = solve(scene, method, solver=spec, timers=timers, **options)
     times = {k: timers.seconds.get(k, 0.0) for k in TIME_KEYS}
-    for key in ("predictor", "reference_solve"):
+    for key in ("predictor", "reference_solve", "reference_lu", "reference_ldlt"):
         if key in timers.seconds:
             times[key] = timers.seconds[key]
     times["total"] = time.perf_counter() - t_start

@@ -89,12 +89,18 @@ class SolverKind(StrEnum):
 
     DIRECT = "direct"  # a factorization of the whole [[K, B^T], [B, C]] (MUMPS)
     FIELDSPLIT = "fieldsplit"  # PCFIELDSPLIT Schur on A00 = K + gamma B^T B
-    CONDENSED = "condensed"  # active multipliers eliminated (D diagonal), CG on u
+    CONDENSED = "condensed"  # active multipliers eliminated (D diagonal), CG + multigrid on u
+    CONDENSED_DIRECT = "condensed-direct"  # the same system factorized (Cholesky)
 
     @property
     def augmented(self) -> bool:
         """Whether A00 = K + gamma B^T B (a fieldsplit's A00 must be invertible alone)."""
         return self is SolverKind.FIELDSPLIT
+
+    @property
+    def condensed(self) -> bool:
+        """Whether the multipliers are eliminated (the displacement-only SPD system)."""
+        return self in (SolverKind.CONDENSED, SolverKind.CONDENSED_DIRECT)
 
 
 @dataclass(frozen=True)
@@ -122,13 +128,15 @@ class SolverSpec:
         bad = {
             SolverKind.DIRECT: pc not in ("lu", "cholesky"),
             SolverKind.FIELDSPLIT: pc != "fieldsplit",
-            SolverKind.CONDENSED: pc == "fieldsplit",
+            SolverKind.CONDENSED: pc in ("fieldsplit", "lu", "cholesky"),
+            SolverKind.CONDENSED_DIRECT: pc not in ("lu", "cholesky"),
         }[self.kind]
         if bad:
             fix = {
                 SolverKind.DIRECT: "a direct solver factorizes (pc_type lu or cholesky)",
                 SolverKind.FIELDSPLIT: "a fieldsplit solver needs pc_type fieldsplit",
-                SolverKind.CONDENSED: "the condensed system has no multiplier block to split",
+                SolverKind.CONDENSED: "it preconditions by multigrid (condensed-direct factorizes)",
+                SolverKind.CONDENSED_DIRECT: "it factorizes (pc_type cholesky or lu)",
             }[self.kind]
             raise InputError(
                 f"solver '{self.name}' ({self.kind.value}): PETSc option pc_type={pc} "
@@ -157,7 +165,7 @@ class SolverSpec:
             key = key.strip().lstrip("-")
             if not sep or not key:
                 raise InputError(f"--petsc-option expects KEY=VALUE, got '{item}'")
-            if self.kind is SolverKind.CONDENSED and key == "ksp_rtol":
+            if self.kind.condensed and key == "ksp_rtol":
                 try:
                     rtol = float(value)
                 except ValueError:
@@ -167,7 +175,7 @@ class SolverSpec:
         return replace(self, petsc=petsc, rtol=rtol)
 
 
-_MUMPS: dict[str, object] = {
+_MUMPS_LU: dict[str, object] = {
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
@@ -175,10 +183,14 @@ _MUMPS: dict[str, object] = {
     # (benchmarks/README.md).
     "mat_mumps_icntl_7": 4,
 }
+# The saddle point is symmetric (indefinite): MUMPS' LDL^T (SYM=2, PETSc's Cholesky on a
+# matrix not flagged SPD) takes about 0.75-0.8 of LU's time (docs/scale.md, "Symmetric").
+_MUMPS_LDLT: dict[str, object] = {**_MUMPS_LU, "pc_type": "cholesky"}
 
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
     {
-        "mumps": SolverSpec(SolverKind.DIRECT, _MUMPS, name="mumps"),
+        "mumps": SolverSpec(SolverKind.DIRECT, _MUMPS_LDLT, name="mumps"),
+        "mumps-lu": SolverSpec(SolverKind.DIRECT, _MUMPS_LU, name="mumps-lu"),
         # Schur fieldsplit, A00 = K + gamma B^T B factorized by MUMPS, S by Jacobi-GMRES.
         "fieldsplit": SolverSpec(
             SolverKind.FIELDSPLIT,
@@ -242,6 +254,23 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
             rtol=1e-9,
             loose_rtol=1e-4,
             name="condensed",
+        ),
+        # The same condensed system factorized: MUMPS Cholesky (SPD, SYM=1). Later sets run CG
+        # preconditioned by the kept factorization (a low-rank change: a few iterations)
+        # until the pivots have moved too far (linalg/condensed.py).
+        "condensed-direct": SolverSpec(
+            SolverKind.CONDENSED_DIRECT,
+            {
+                "ksp_type": "cg",
+                "ksp_norm_type": "unpreconditioned",
+                "ksp_max_it": 500,
+                "pc_type": "cholesky",
+                "pc_factor_mat_solver_type": "mumps",
+                "mat_mumps_icntl_7": 4,
+            },
+            rtol=1e-9,
+            loose_rtol=1e-4,
+            name="condensed-direct",
         ),
     }
 )

@@ -97,21 +97,17 @@ def test_condensed_matrix_equals_ptap(small_hertz) -> None:
     """K + E^T K + K E + E^T K E with the pivots decoupled is PETSc's PtAP T^T K T + P."""
     from petsc4py import PETSc
 
-    from contactfx.linalg.elimination import (
-        LocalRows,
-        condensed_matrix,
-        elimination_matrix,
-        pivot_rows,
-        pivots,
-    )
+    from contactfx.linalg.elimination import LocalRows, condensed_matrix, elimination_matrix
+    from contactfx.linalg.pivots import pivots
 
     setup, solver = _condensed_solver(small_hertz)
     x = setup.layout.x[setup.layout.mine, 0]
     K = setup.elasticity.K
     rows_b = LocalRows.of(setup.B, setup.node_dofs())
-    rows, piv, coef = pivots(rows_b, x < small_hertz.params["hertz_exact"]["a"], setup.comm)
     r0, r1 = K.getOwnershipRange()
-    prows = pivot_rows(rows_b, rows, piv, coef, r0)
+    n = K.getSize()[0]
+    pv = pivots(rows_b, x < small_hertz.params["hertz_exact"]["a"], setup.comm, r0, n)
+    piv, prows = pv.dofs, pv.e_rows
     T = elimination_matrix(prows, r0, r1, K.getSize()[0], K.getComm(), identity=True)
     E = elimination_matrix(prows, r0, r1, K.getSize()[0], K.getComm(), identity=False)
     ip = piv.astype(PETSc.IntType)
@@ -181,13 +177,6 @@ def test_condensed_refuses_a_non_diagonal_d(small_hertz, method: str, basis: str
     """Standard mortar and STS couple neighbouring active nodes: a clear error."""
     with pytest.raises(InputError, match="needs a diagonal D"):
         solve(small_hertz, method, basis=basis, solver="condensed")
-
-
-def test_condensed_refuses_a_curved_passive_surface_with_dual() -> None:
-    """Dual mortar on a curved passive surface leaves off-diagonal normal terms: refused."""
-    scene = load_scene_file(SCENES / "two_cylinders.toml", MPI.COMM_SELF)
-    with pytest.raises(InputError, match="needs a diagonal D"):
-        solve(scene, "mortar", basis="dual", solver="condensed")
 
 
 def test_basis_and_solver_errors() -> None:

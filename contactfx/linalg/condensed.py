@@ -18,16 +18,11 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import SolverError
-from .elimination import (
-    CondensedOperator,
-    LocalRows,
-    condensed_matrix,
-    elimination_matrix,
-    pivot_rows,
-    pivots,
-)
+from .elimination import CondensedOperator, LocalRows, condensed_matrix, elimination_matrix
 from .nullspace import orthonormalize
 from .petsc_options import PrefixedOptions, petsc_error_message, reason_name
+from .pivots import pivots
+from .policy import Decision, FactorizationPolicy
 from .protocol import SaddleResult
 
 # Pivot changes since the multigrid was built (summed over ranks) below which it is reused.
@@ -41,7 +36,8 @@ class CondensedSolver:
 
     `node_dofs` (m, 2): global dofs of each owned row's active node. `rtol`: the final
     tolerance (`polish`); `loose_rtol`: the relative reduction of the loop's solves.
-    `reuse` False: a throwaway solver (a new multigrid for every set).
+    `reuse` False: a throwaway solver (a new preconditioner for every set). `policy`: the
+    preconditioner is a factorization, kept while that is cheaper than a new one.
     """
 
     def __init__(
@@ -56,6 +52,7 @@ class CondensedSolver:
         rtol: float,
         loose_rtol: float | None = None,
         reuse: bool = True,
+        policy: FactorizationPolicy | None = None,
     ) -> None:
         self._K, self._f = K, f
         self._comm = K.getComm()
@@ -75,6 +72,8 @@ class CondensedSolver:
         self.stats = {"factorizations": 0.0, "reused": 0.0, "setup_time": 0.0}
         self._built_for: np.ndarray | None = None  # the pivots the multigrid was built with
         self.reuse = reuse
+        # With a factorization as preconditioner: refactor by measured costs (policy.py).
+        self.policy = policy
 
     exact = False  # the loop's solves stop at loose_rtol: a stationary set is polished
     can_probe = False  # no factorization: no exact responses
@@ -103,18 +102,19 @@ class CondensedSolver:
 
     def _solve(self, g: np.ndarray, active: np.ndarray, rtol: float) -> SaddleResult:
         t0 = time.perf_counter()
-        rows, piv, coef = pivots(self._rows, np.asarray(active, dtype=bool), self._mpi)
+        nglob = self._K.getSize()[0]
+        mask = np.asarray(active, dtype=bool)
+        pv = pivots(self._rows, mask, self._mpi, self._r0, nglob)
+        rows, piv, prows = pv.rows, pv.dofs, pv.e_rows
         # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
         ip: Any = piv.astype(PETSc.IntType)
-        prows = pivot_rows(self._rows, rows, piv, coef, self._r0)
-        nglob = self._K.getSize()[0]
         T = elimination_matrix(prows, self._r0, self._r1, nglob, self._comm, identity=True)
         d, t, r, b = (self._f.duplicate() for _ in range(4))
         d.set(0.0)
         d.setValues(ip, cast(Any, self._diag.getValues(ip)))
         d.assemble()
         t.set(0.0)
-        t.setValues(ip, cast(Any, -np.asarray(g)[rows] / coef))
+        t.setValues(ip, cast(Any, pv.shift(g)))
         t.assemble()
         self._K.mult(t, r)
         r.aypx(-1.0, self._f)  # f - K t
@@ -146,13 +146,16 @@ class CondensedSolver:
         self._K.mult(self._u, r)
         r.aypx(-1.0, self._f)  # f - K u: the contact force on the pivots
         mu = np.zeros(len(active))
-        mu[rows] = r.getValues(ip) / coef
+        mu[rows] = pv.multipliers(r.getValues(ip))
         u = self._u.array.copy()
         t2 = time.perf_counter()
         for obj in (T, d, t, r, b, v):
             obj.destroy()
         if reuse:
             A.destroy()
+        elif self.policy is not None:
+            self.policy.factorized(t1 - t0, numeric_only=True)
+            self.policy.applied(t2 - t1, max(its, 1))
         self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
         return SaddleResult(u, mu, its, reason, not reuse, -1, 0, t1 - t0, t2 - t1)
@@ -168,6 +171,8 @@ class CondensedSolver:
         if not self.reuse or prev is None:
             return False
         changed = self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
+        if self.policy is not None:
+            return self.policy.decide(changed, False, release=False) is Decision.LAGGED
         n_piv = self._mpi.allreduce(len(piv))
         return changed <= max(REBUILD_FRACTION * n_piv, REBUILD_CHANGES)
 

@@ -1,15 +1,14 @@
-"""The elimination of the active multipliers with a diagonal D: pivots, T, and T^T K T.
+"""The elimination of the active multipliers: T, E = T - I, and T^T K T.
 
-With a diagonal D (NTS, or mortar with the dual basis) each active row j of B touches one
-active node's own dofs only, so one of them, the pivot p(j) (the component with the largest
-coefficient c_j), is given by the constraint: u_p = -(g_j + sum_{k != p} B_jk u_k) / c_j.
-Writing u = T v + t (T the identity except on pivot rows, t = -g_j / c_j there) turns the
-saddle point into the symmetric positive definite displacement system
+Each active row j of B gives one displacement of its own node, the pivot p(j)
+(linalg/pivots.py): with a diagonal pivot block u_p = -(g_j + sum_{k != p} B_jk u_k) / c_j.
+Writing u = T v + t (T the identity except on pivot rows) turns the saddle point into the
+symmetric positive definite displacement system
 
     (T^T K T + P) v = T^T (f - K t),    P = diag(K_pp) on the pivots (v_p is free: set 0),
 
-and the multipliers follow from the pivot rows of equilibrium, mu_j = (f - K u)_p / c_j.
-Every function here takes what it needs explicitly (B's local CSR rows, the node dofs).
+and the multipliers follow from the pivot rows of equilibrium. Every function here takes
+what it needs explicitly (B's local CSR rows, E's pivot rows).
 """
 
 from __future__ import annotations
@@ -18,14 +17,7 @@ from dataclasses import dataclass
 from typing import Any, cast
 
 import numpy as np
-from mpi4py import MPI
 from petsc4py import PETSc
-
-from ..errors import InputError
-
-# Entries of B on another active node's dofs larger than this (relative to the row's pivot)
-# mean D is not diagonal: the elimination would couple the pivots.
-DIAGONAL_TOL = 1e-10
 
 PivotRows = dict[int, tuple[np.ndarray, np.ndarray]]
 
@@ -49,56 +41,6 @@ class LocalRows:
         """(columns, values) of local row j."""
         lo, hi = self.indptr[j], self.indptr[j + 1]
         return self.cols[lo:hi], self.vals[lo:hi]
-
-
-def pivots(
-    B: LocalRows, active: np.ndarray, comm: MPI.Comm
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(owned active rows, their pivot dofs, the pivot coefficients).
-
-    InputError if D is not diagonal or a row has no free dof of its own node.
-    """
-    rows = np.flatnonzero(active)
-    piv = np.zeros(len(rows), dtype=np.int64)
-    coef = np.zeros(len(rows))
-    for i, j in enumerate(rows):
-        cols, vals = B.row(j)
-        own = np.isin(cols, B.node_dofs[j])
-        if not own.any() or np.abs(vals[own]).max() == 0.0:
-            raise InputError(
-                "the condensed solver cannot eliminate a contact row whose "
-                "active node is fully prescribed: use --solver mumps"
-            )
-        k = np.flatnonzero(own)[int(np.argmax(np.abs(vals[own])))]
-        piv[i], coef[i] = cols[k], vals[k]
-    # Every active node's dofs, from all ranks: a row touching another one means that D is
-    # not diagonal.
-    others = np.concatenate(comm.allgather(B.node_dofs[rows].ravel()))
-    for i, j in enumerate(rows):
-        cols, vals = B.row(j)
-        foreign = np.isin(cols, others) & ~np.isin(cols, B.node_dofs[j])
-        if foreign.any() and np.abs(vals[foreign]).max() > DIAGONAL_TOL * abs(coef[i]):
-            raise InputError(
-                "the condensed solver needs a diagonal D (one active node per "
-                "constraint row): use --method nts, or mortar with --basis "
-                "dual (on a flat passive surface), or --solver mumps"
-            )
-    return rows, piv, coef
-
-
-def pivot_rows(
-    B: LocalRows, rows: np.ndarray, piv: np.ndarray, coef: np.ndarray, r0: int
-) -> PivotRows:
-    """Row p(j) of E = T - I per pivot (by local row): -B_j / c_j, -1 on the pivot, sorted."""
-    out: PivotRows = {}
-    for i, j in enumerate(rows):
-        cols, vals = B.row(j)
-        keep = (cols != piv[i]) & (vals != 0.0)
-        c = np.append(cols[keep], piv[i])
-        v = np.append(-vals[keep] / coef[i], -1.0)
-        order = np.argsort(c)
-        out[int(piv[i] - r0)] = (c[order], v[order])
-    return out
 
 
 def elimination_matrix(
@@ -151,6 +93,8 @@ def condensed_matrix(K: PETSc.Mat, E: PETSc.Mat, piv: np.ndarray, k_diag: PETSc.
     diag.assemble()
     A.setDiagonal(diag)
     A.setBlockSize(2)
+    # Symmetric positive definite: what a Cholesky factorization (MUMPS SYM=1) needs to know.
+    A.setOption(cast(PETSc.Mat.Option, PETSc.Mat.Option.SPD), True)
     for obj in (Et, EtK, C, EtKE, diag):
         obj.destroy()
     return A

@@ -11,6 +11,7 @@ import functools
 import logging
 
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 log = logging.getLogger("contactfx")
@@ -38,34 +39,49 @@ def petsc_library() -> ctypes.CDLL | None:
 def inverse_entries(F: PETSc.Mat, rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray | None:
     """Entries (rows x cols, as (len(cols), len(rows))) of A^-1 from its MUMPS factor F.
 
-    Serial only: on several ranks the call succeeds but leaves MUMPS' centralized
-    right-hand-side pointer set, and the next solve fails (INFOG(1) = -22). None on failure.
+    `rows`, `cols`: global row numbers of the whole system (n x n), the same on every rank.
+    MUMPS takes the pattern centralized on its host: on several ranks it is rank 0's
+    diagonal block of an MPI matrix with every row there (PETSc reads that block), and the
+    entries are broadcast. ICNTL(20), (21) and (30) are restored afterwards, for the next
+    ordinary solve. None on failure (a log line says why), the same on every rank.
     """
     lib = petsc_library()
     if lib is None:
         return None
+    comm = F.getComm()
+    mpi = comm.tompi4py()
+    host = mpi.rank == 0
     # Row c of the transposed pattern asks for the entries (rows, c) of A^-1.
-    count = np.zeros(n, dtype=np.int64)
-    count[cols] = len(rows)
+    count = np.zeros(n if host else 0, dtype=np.int64)
+    if host:
+        count[cols] = len(rows)
     indptr = np.concatenate([[0], np.cumsum(count)]).astype(PETSc.IntType)
-    indices = np.tile(rows, len(cols)).astype(PETSc.IntType)
+    indices = (np.tile(rows, len(cols)) if host else np.zeros(0)).astype(PETSc.IntType)
     values = np.zeros(len(indices), dtype=PETSc.ScalarType)
+    local = n if host else 0
     spT = PETSc.Mat().createAIJ(
-        (n, n),
+        ((local, n), (local, n)),
         csr=(indptr, indices, values),  # type: ignore[arg-type]
-        comm=PETSc.COMM_SELF,
+        comm=comm if mpi.size > 1 else PETSc.COMM_SELF,
     )
     spT.assemble()
     sp = PETSc.Mat().createTranspose(spT)
-    saved = {i: ctypes.c_int() for i in (20, 30)}
+    saved = {i: ctypes.c_int() for i in (20, 21, 30)}
     for i, v in saved.items():
         lib.MatMumpsGetIcntl(F.handle, i, ctypes.byref(v))
     err = lib.MatMumpsGetInverse(F.handle, sp.handle)
     for i, v in saved.items():  # back to ordinary solves
         lib.MatMumpsSetIcntl(F.handle, i, v.value)
-    entries = spT.getValuesCSR()[2].reshape(len(cols), len(rows)).copy()
+    entries = None
+    if host:
+        block = spT.getDiagonalBlock() if mpi.size > 1 else spT
+        entries = block.getValuesCSR()[2].reshape(len(cols), len(rows)).copy()
+    entries = mpi.bcast(entries, root=0)
     sp.destroy()
     spT.destroy()
-    if err != 0 or not np.all(np.isfinite(entries)):
+    err = mpi.allreduce(int(err), op=MPI.MAX)
+    if err != 0 or entries is None or not np.all(np.isfinite(entries)):
+        if host:
+            log.info("MUMPS selected inverse failed (error %d): dense probe solves", err)
         return None
     return entries

@@ -23,34 +23,51 @@ from .mumps import inverse_entries
 PROBE_ENTRIES = 64_000_000
 
 
-def unit_columns(probes: np.ndarray, active: np.ndarray) -> np.ndarray | None:
-    """The row of each column if every column of `probes` is e_j on an active row j, else None."""
+def unit_columns(
+    probes: np.ndarray, active: np.ndarray, positions: np.ndarray, comm: MPI.Comm
+) -> np.ndarray | None:
+    """The system row of each column if every column of `probes` is e_j on an active row j.
+
+    `positions`: each local multiplier row's (global) row in the whole system. None if a
+    column is not such a unit vector (the answer is the same on every rank).
+    """
     nz = probes != 0.0
-    if not (np.all(nz.sum(axis=0) == 1) and np.all(probes[nz] == 1.0)):
+    ok = bool(np.all(probes[nz] == 1.0)) and bool(np.all(active[np.nonzero(nz)[0]]))
+    count = comm.allreduce(nz.sum(axis=0))
+    if not comm.allreduce(ok, op=MPI.LAND) or not np.all(count == 1):
         return None
-    rows = np.argmax(nz, axis=0)
-    return rows if np.all(active[rows]) else None
+    here = nz.any(axis=0)
+    pos = np.full(probes.shape[1], -1, dtype=np.int64)
+    pos[here] = positions[np.argmax(nz[:, here], axis=0)]
+    comm.Allreduce(MPI.IN_PLACE, pos, op=MPI.MAX)
+    return pos
 
 
 def selected_responses(
-    factor: PETSc.Mat, positions: np.ndarray, n: int, probes: np.ndarray, active: np.ndarray
+    factor: PETSc.Mat,
+    positions: np.ndarray,
+    n: int,
+    probes: np.ndarray,
+    active: np.ndarray,
+    comm: MPI.Comm,
 ) -> np.ndarray | None:
     """Responses (local rows x k) as selected entries of A^-1 from the MUMPS factor, or None.
 
-    `positions`: each local multiplier row's row in the whole system A (n x n, serial).
+    `positions`: each local multiplier row's global row in the whole system A (n x n). The
+    requested entries are the (active rows) x (probe rows) block, gathered on every rank.
     None if a column is not a unit vector on an active row, or MUMPS refuses.
     """
-    col_rows = unit_columns(probes, active)
-    if col_rows is None:
+    col_pos = unit_columns(probes, active, positions, comm)
+    if col_pos is None:
         return None
-    req = np.flatnonzero(active)
-    cols, where = np.unique(positions[col_rows], return_inverse=True)
-    order = np.argsort(positions[req])
-    entries = inverse_entries(factor, positions[req][order], cols, n)
+    req = np.sort(np.concatenate(comm.allgather(positions[active])))
+    cols, where = np.unique(col_pos, return_inverse=True)
+    entries = inverse_entries(factor, req, cols, n)
     if entries is None:
         return None
+    mine = np.flatnonzero(active)
     out = np.zeros((len(active), probes.shape[1]))
-    out[req[order], :] = entries[where].T
+    out[mine, :] = entries[where][:, np.searchsorted(req, positions[mine])].T
     return out
 
 

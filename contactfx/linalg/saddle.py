@@ -101,13 +101,12 @@ class SaddleSolver:
 
     @property
     def cheap_responses(self) -> bool:
-        """Whether responses are MUMPS' selected inverse entries (serial MUMPS, plain K).
+        """Whether responses are MUMPS' selected inverse entries (MUMPS, plain K).
 
-        petsc4py does not wrap MatMumpsGetInverse; it is called through ctypes. On several
-        ranks it leaves MUMPS' centralized right-hand-side pointer set, and the next solve
-        fails (INFOG(1) = -22): there the probes stay dense multi-right-hand-side solves.
+        petsc4py does not wrap MatMumpsGetInverse; it is called through ctypes
+        (linalg/mumps.py), on one rank or several.
         """
-        if not (self.direct and self.gamma == 0.0 and self._mpi.size == 1):
+        if not (self.direct and self.gamma == 0.0):
             return False
         self._configure()
         solver_type = self._ksp.getPC().getFactorSolverType()
@@ -288,7 +287,9 @@ class SaddleSolver:
         out = None
         if self.cheap_responses:
             F = self._ksp.getPC().getFactorMatrix()
-            out = selected_responses(F, m.rows_l, m.A.getSize()[0], probes, active)
+            start = m.A.getOwnershipRange()[0]
+            n = m.A.getSize()[0]
+            out = selected_responses(F, m.rows_l + start, n, probes, active, self._mpi)
             if out is None and self._mpi.rank == 0:
                 log.info("saddle solver: no selected inverse entries: dense probe solves")
         if out is None:

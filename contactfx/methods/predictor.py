@@ -46,9 +46,9 @@ def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
     above COARSE_PREDICTOR_DOFS otherwise.
     """
     if predictor is Predictor.AUTO:
-        if spec.kind is SolverKind.DIRECT and scene.comm.size == 1:
+        if spec.kind is SolverKind.DIRECT:
             return False
-        if spec.kind is SolverKind.CONDENSED:
+        if spec.kind.condensed:
             return True
         return scene_dofs(scene) >= COARSE_PREDICTOR_DOFS
     return predictor is Predictor.COARSE
@@ -56,7 +56,7 @@ def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
 
 def coarse_factor(spec: SolverSpec) -> float:
     """How much coarser the predictor's mesh is (every size times this)."""
-    return CONDENSED_COARSE_FACTOR if spec.kind is SolverKind.CONDENSED else COARSE_FACTOR
+    return CONDENSED_COARSE_FACTOR if spec.kind.condensed else COARSE_FACTOR
 
 
 def coarse_margin(spec: SolverSpec) -> float:
@@ -65,7 +65,7 @@ def coarse_margin(spec: SolverSpec) -> float:
     A direct solver probes the uncertain band, so a generous superset costs it nothing; the
     condensed loop pays a solve per ring it must release (463k DOFs: 6 -> 4 steps).
     """
-    return 0.5 if spec.kind is SolverKind.CONDENSED else 1.5
+    return 0.5 if spec.kind.condensed else 1.5
 
 
 def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0) -> InitialSet:

@@ -41,17 +41,21 @@ def make_solver(
     displacements); `node_dofs` (m, 2): the dofs of each multiplier row's active node (the
     condensed solver's pivots); `reuse` False: a throwaway solver for one set.
     """
-    if spec.kind is SolverKind.CONDENSED:
+    if spec.kind.condensed:
+        factorized = spec.kind is SolverKind.CONDENSED_DIRECT
         return CondensedSolver(
             K,
             B,
             f,
             spec.petsc,
             node_dofs,
-            modes(),
+            [] if factorized else modes(),
             rtol=spec.rtol,
             loose_rtol=spec.loose_rtol,
             reuse=reuse,
+            # A kept Cholesky factorization pays per CG iteration (one back-substitution):
+            # the cost rule of the saddle-point solver decides when to refactor.
+            policy=FactorizationPolicy(reuse) if factorized else None,
         )
     nullspace = None
     if spec.augmented:

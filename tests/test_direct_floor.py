@@ -1,0 +1,111 @@
+"""The direct-solve floor: a symmetric default, the condensed path on curved surfaces, and the
+selected inverse on several ranks."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from contactfx import load_scene_file, solve
+from contactfx.options import SOLVERS, SolverKind
+
+TWO_CYLINDERS = ROOT / "tests" / "scenes" / "two_cylinders.toml"
+
+
+@pytest.fixture(scope="module")
+def cylinders():
+    """Two cylinders (R 40 and 60): a curved passive surface, so dual mortar's D is not diagonal."""
+    return load_scene_file(TWO_CYLINDERS)
+
+
+def test_default_factorizes_symmetrically() -> None:
+    """The default `mumps` is MUMPS' LDL^T of the saddle point; LU stays as `mumps-lu`."""
+    assert SOLVERS["mumps"].kind is SolverKind.DIRECT
+    assert SOLVERS["mumps"].petsc["pc_type"] == "cholesky"
+    assert SOLVERS["mumps-lu"].petsc["pc_type"] == "lu"
+
+
+@pytest.mark.parametrize("solver", ["condensed", "condensed-direct"])
+@pytest.mark.parametrize(("method", "basis"), [("mortar", "dual"), ("nts", "standard")])
+def test_condensed_on_a_curved_passive_surface(cylinders, method, basis, solver) -> None:
+    """Dual mortar on two cylinders couples neighbouring pivots: condensed = MUMPS to 1e-6."""
+    ref = solve(cylinders, method, basis=basis, solver="mumps-lu")
+    sol = solve(cylinders, method, basis=basis, solver=solver)
+    assert np.array_equal(sol.active, ref.active)
+    assert np.abs(sol.pressure - ref.pressure).max() <= 1e-6 * np.abs(ref.pressure).max()
+    du = np.abs(sol.u.x.array - ref.u.x.array).max()
+    assert du <= 1e-6 * np.abs(ref.u.x.array).max()
+
+
+def test_curved_dual_mortar_pivot_block_is_coupled(cylinders) -> None:
+    """The case the coupled elimination exists for: off-diagonal pivot entries above round-off."""
+    from contactfx.contact import Kernel
+    from contactfx.discretize.setup import prepare_contact
+    from contactfx.linalg.elimination import LocalRows
+    from contactfx.linalg.pivots import pivots
+    from contactfx.options import Basis
+    from contactfx.timers import Timers
+
+    setup = prepare_contact(cylinders, Kernel.MORTAR, 1e-6, Timers(), Basis.DUAL)
+    rows = LocalRows.of(setup.B, setup.node_dofs())
+    n = setup.elasticity.K.getSize()[0]
+    r0 = setup.elasticity.K.getOwnershipRange()[0]
+    every = np.ones(len(setup.g), dtype=bool)
+    assert pivots(rows, every, setup.comm, r0, n).coupled is not None
+    setup.destroy()
+
+
+def test_reference_timing_reports_both_factorizations(tmp_path: Path) -> None:
+    """--reference-timing times a fresh LU and a fresh LDL^T of the final saddle point."""
+    import json
+
+    from contactfx import cli
+
+    out = tmp_path / "r.json"
+    assert (
+        cli.main(
+            ["solve", "hertz", "--refine", "0.1", "--reference-timing", "--json", str(out), "-q"]
+        )
+        == 0
+    )
+    times = json.loads(out.read_text())["times"]
+    for key in ("reference_solve", "reference_lu", "reference_ldlt"):
+        assert times[key] > 0.0
+
+
+SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import numpy as np
+    from mpi4py import MPI
+    import contactfx
+    from contactfx.scenes import HertzParams, hertz
+
+    scene = hertz(HertzParams(refine=0.05), comm=MPI.COMM_WORLD)
+    sol = contactfx.solve(scene, "mortar", solver=sys.argv[1])
+    probes = sol.history[0]["probes"]
+    # Rows in the layout are ordered by owner rank: sort them by position to compare.
+    x = np.round(sol.layout.x, 9)
+    order = np.lexsort((x[:, 1], x[:, 0]))
+    np.save(sys.argv[2], np.concatenate([[probes], sol.pressure[order]]))
+    """
+)
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("solver", ["mumps", "mumps-lu"])
+def test_two_ranks_probe_by_selected_inverse(tmp_path: Path, mpi_script, solver) -> None:
+    """On 2 ranks the probe step uses MUMPS' selected inverse too: every row probed in the
+    first step (as serially), the same pressures to 1e-8."""
+    script = tmp_path / "probe.py"
+    script.write_text(SCRIPT)
+    mpi_script(script, solver, str(tmp_path / "two.npy"), ranks=2)
+    mpi_script(script, solver, str(tmp_path / "one.npy"), ranks=1)
+    two, one = np.load(tmp_path / "two.npy"), np.load(tmp_path / "one.npy")
+    assert two[0] == one[0] > 0  # the same candidates probed in step 1
+    p1, p2 = one[1:], two[1:]
+    assert np.abs(p2 - p1).max() <= 1e-8 * np.abs(p1).max()
