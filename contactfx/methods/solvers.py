@@ -5,7 +5,7 @@ The methods turn a SolverSpec into a solver here; contactfx/linalg itself knows 
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 from petsc4py import PETSc
@@ -16,6 +16,18 @@ from ..linalg.policy import FactorizationPolicy
 from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
 from ..options import SolverKind, SolverSpec
+
+# MUMPS' analysis on several ranks: parallel (ICNTL(28) = 2) with PT-Scotch (ICNTL(29) = 1),
+# the package of the stack's MUMPS that orders in parallel. On one rank MUMPS would fall back
+# to a sequential SCOTCH ordering instead of the preset's, so it is set only on several.
+PARALLEL_ANALYSIS: dict[str, object] = {"mat_mumps_icntl_28": 2, "mat_mumps_icntl_29": 1}
+
+
+def with_parallel_analysis(petsc: Mapping[str, object], ranks: int) -> Mapping[str, object]:
+    """The options with MUMPS' parallel analysis on several ranks (unless they set it)."""
+    if ranks == 1 or any(k in petsc for k in PARALLEL_ANALYSIS):
+        return petsc
+    return {**petsc, **PARALLEL_ANALYSIS}
 
 
 def augmentation(spec: SolverSpec, e_max: float, h: float) -> float:
@@ -68,7 +80,7 @@ def make_solver(
         K,
         B,
         f,
-        spec.petsc,
+        with_parallel_analysis(spec.petsc, K.getComm().tompi4py().size) if direct else spec.petsc,
         direct=direct,
         gamma=augmentation(spec, e_max, h),
         nullspace=nullspace,

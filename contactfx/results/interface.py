@@ -37,6 +37,7 @@ def resolve(sig: np.ndarray, n: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, 
 
 
 def none_if_nan(v: np.ndarray) -> list[float | None]:
+    """The values as floats, None where not finite (JSON has no NaN)."""
     return [None if not np.isfinite(x) else float(x) for x in v]
 
 

@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 from mpi4py import MPI
 
-from ..scenes import HertzReference, Scene
 from ..methods.solution import Solution
-from .interface import none_if_nan, pair_interface, resolve
+from ..scenes import HertzReference, Scene
+from .interface import pair_interface, resolve
 from .stress import body_vertex_stress
 
 
