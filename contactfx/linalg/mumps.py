@@ -36,14 +36,30 @@ def petsc_library() -> ctypes.CDLL | None:
     return lib
 
 
-def inverse_entries(F: PETSc.Mat, rows: np.ndarray, cols: np.ndarray, n: int) -> np.ndarray | None:
+def _pattern(rows: np.ndarray, cols: np.ndarray, symmetric: bool) -> list[np.ndarray]:
+    """The rows requested in each column: all of `rows`, or only half of the pairs in `cols`.
+
+    With `symmetric` the other half follows from A^-1 = A^-T.
+    """
+    if not symmetric:
+        return [rows] * len(cols)
+    in_cols = np.isin(rows, cols)
+    return [rows[~in_cols | (rows >= c)] for c in cols]
+
+
+def inverse_entries(
+    F: PETSc.Mat, rows: np.ndarray, cols: np.ndarray, n: int, symmetric: bool = False
+) -> np.ndarray | None:
     """Entries (rows x cols, as (len(cols), len(rows))) of A^-1 from its MUMPS factor F.
 
-    `rows`, `cols`: global row numbers of the whole system (n x n), the same on every rank.
-    MUMPS takes the pattern centralized on its host: on several ranks it is rank 0's
-    diagonal block of an MPI matrix with every row there (PETSc reads that block), and the
-    entries are broadcast. ICNTL(20), (21) and (30) are restored afterwards, for the next
-    ordinary solve. None on failure (a log line says why), the same on every rank.
+    `rows`, `cols`: sorted global row numbers of the whole system (n x n), the same on every
+    rank. `symmetric`: A is symmetric, so of the pairs within `cols` only one half is asked
+    for (MUMPS' work per column shrinks with the rows requested: about a third less when
+    every row is a column). MUMPS takes the pattern centralized on its host: on several
+    ranks it is rank 0's diagonal block of an MPI matrix with every row there (PETSc reads
+    that block), and the entries are broadcast. ICNTL(20), (21) and (30) are restored
+    afterwards, for the next ordinary solve. None on failure (a log line says why), the
+    same on every rank.
     """
     lib = petsc_library()
     if lib is None:
@@ -51,12 +67,13 @@ def inverse_entries(F: PETSc.Mat, rows: np.ndarray, cols: np.ndarray, n: int) ->
     comm = F.getComm()
     mpi = comm.tompi4py()
     host = mpi.rank == 0
-    # Row c of the transposed pattern asks for the entries (rows, c) of A^-1.
+    asked = _pattern(rows, cols, symmetric) if host else []
+    # Row c of the transposed pattern asks for the entries (asked rows, c) of A^-1.
     count = np.zeros(n if host else 0, dtype=np.int64)
     if host:
-        count[cols] = len(rows)
+        count[cols] = [len(a) for a in asked]
     indptr = np.concatenate([[0], np.cumsum(count)]).astype(PETSc.IntType)
-    indices = (np.tile(rows, len(cols)) if host else np.zeros(0)).astype(PETSc.IntType)
+    indices = (np.concatenate(asked) if asked else np.zeros(0)).astype(PETSc.IntType)
     values = np.zeros(len(indices), dtype=PETSc.ScalarType)
     local = n if host else 0
     spT = PETSc.Mat().createAIJ(
@@ -75,7 +92,7 @@ def inverse_entries(F: PETSc.Mat, rows: np.ndarray, cols: np.ndarray, n: int) ->
     entries = None
     if host:
         block = spT.getDiagonalBlock() if mpi.size > 1 else spT
-        entries = block.getValuesCSR()[2].reshape(len(cols), len(rows)).copy()
+        entries = _unpack(block.getValuesCSR()[2], asked, rows, cols)
     entries = mpi.bcast(entries, root=0)
     sp.destroy()
     spT.destroy()
@@ -85,3 +102,23 @@ def inverse_entries(F: PETSc.Mat, rows: np.ndarray, cols: np.ndarray, n: int) ->
             log.info("MUMPS selected inverse failed (error %d): dense probe solves", err)
         return None
     return entries
+
+
+def _unpack(
+    values: np.ndarray, asked: list[np.ndarray], rows: np.ndarray, cols: np.ndarray
+) -> np.ndarray:
+    """(len(cols), len(rows)) entries from the CSR values of the asked pattern.
+
+    The half of the pairs within `cols` that was not asked for is filled by symmetry.
+    """
+    out = np.full((len(cols), len(rows)), np.nan)
+    lo = 0
+    for k, a in enumerate(asked):
+        out[k, np.searchsorted(rows, a)] = values[lo : lo + len(a)]
+        lo += len(a)
+    missing = np.isnan(out)
+    if missing.any():
+        ks, ii = np.nonzero(missing)
+        # Entry (rows[i], cols[k]) = entry (cols[k], rows[i]) = column rows[i], row cols[k].
+        out[ks, ii] = out[np.searchsorted(cols, rows[ii]), np.searchsorted(rows, cols[ks])]
+    return out

@@ -50,19 +50,21 @@ def selected_responses(
     probes: np.ndarray,
     active: np.ndarray,
     comm: MPI.Comm,
+    symmetric: bool = False,
 ) -> np.ndarray | None:
     """Responses (local rows x k) as selected entries of A^-1 from the MUMPS factor, or None.
 
     `positions`: each local multiplier row's global row in the whole system A (n x n). The
     requested entries are the (active rows) x (probe rows) block, gathered on every rank.
-    None if a column is not a unit vector on an active row, or MUMPS refuses.
+    None if a column is not a unit vector on an active row, or MUMPS refuses. `symmetric`:
+    A is symmetric (half of the pairs within the columns are asked for).
     """
     col_pos = unit_columns(probes, active, positions, comm)
     if col_pos is None:
         return None
     req = np.sort(np.concatenate(comm.allgather(positions[active])))
     cols, where = np.unique(col_pos, return_inverse=True)
-    entries = inverse_entries(factor, req, cols, n)
+    entries = inverse_entries(factor, req, cols, n, symmetric)
     if entries is None:
         return None
     mine = np.flatnonzero(active)

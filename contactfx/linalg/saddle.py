@@ -289,7 +289,8 @@ class SaddleSolver:
             F = self._ksp.getPC().getFactorMatrix()
             start = m.A.getOwnershipRange()[0]
             n = m.A.getSize()[0]
-            out = selected_responses(F, m.rows_l + start, n, probes, active, self._mpi)
+            # The saddle point is symmetric whichever way it is factorized (LU or LDL^T).
+            out = selected_responses(F, m.rows_l + start, n, probes, active, self._mpi, True)
             if out is None and self._mpi.rank == 0:
                 log.info("saddle solver: no selected inverse entries: dense probe solves")
         if out is None:
