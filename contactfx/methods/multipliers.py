@@ -16,12 +16,13 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from ..contact.rigid_kernels import diagonal_on_nodes
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..discretize.supports import rigid_body_modes
 from ..errors import InputError
 from ..linalg import LinearSolver, SaddleResult, make_solver
 from ..options import Basis, Method, SolverKind, SolverSpec, solver_spec
-from ..scenes import Scene
+from ..scenes import Obstacle, Scene
 from ..timers import Timers
 from .active_set import ActiveSetOptions, InitialSet, SetHistory, Step, run_active_set
 from .solution import Solution, finish
@@ -200,7 +201,9 @@ def _solver(setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool)
     )
 
 
-def check_solver(method: Method, basis: Basis, spec: SolverSpec) -> None:
+def check_solver(
+    method: Method, basis: Basis, spec: SolverSpec, obstacles: tuple[Obstacle, ...] = ()
+) -> None:
     """InputError if the solver cannot handle the method's multipliers."""
     diagonal = method is Method.NTS or (method is Method.MORTAR and basis is Basis.DUAL)
     if spec.kind is SolverKind.CONDENSED and not diagonal:
@@ -208,6 +211,14 @@ def check_solver(method: Method, basis: Basis, spec: SolverSpec) -> None:
             "the condensed solver needs a diagonal D: use --method nts or "
             "--method mortar --basis dual"
         )
+    if spec.kind is SolverKind.CONDENSED:
+        curved = [ob for ob in obstacles if not diagonal_on_nodes(ob.geometry, method, basis)]
+        if curved:
+            raise InputError(
+                f"the condensed solver needs a diagonal D: dual mortar on the {curved[0].shape} "
+                f"obstacle '{curved[0].name}' couples neighbouring nodes (its normal turns): "
+                "use --method nts or --solver mumps"
+            )
 
 
 def reference_solve(
@@ -249,7 +260,7 @@ def solve_contact(
     if basis is not Basis.STANDARD and method is not Method.MORTAR:
         raise InputError(f"the {basis.value} multiplier basis applies to the mortar method only")
     spec = solver_spec(solver)
-    check_solver(method, basis, spec)
+    check_solver(method, basis, spec, scene.obstacles)
     timers = timers or Timers()
     setup = prepare_contact(scene, method.kernel, aso.penetration_tol, timers, basis)
     try:
