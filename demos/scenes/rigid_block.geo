@@ -13,7 +13,7 @@ DefineConstant[
   H = {20, Name "Parameters/H block height"},
   r_fine = {1.5, Name "Parameters/r_fine end of the fine zone (x)"},
   x_edge = {1.0, Name "Parameters/x_edge a node of the top inside the fine zone (a punch edge)"},
-  hc = {0.03, Name "Parameters/hc size on the top for x <= r_fine"},
+  hc = {0.015, Name "Parameters/hc size on the top for x <= r_fine"},
   slope = {0.1, Name "Parameters/slope size growth per unit distance"},
   hf = {2.0, Name "Parameters/hf far size"}
 ];
