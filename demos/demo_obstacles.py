@@ -204,7 +204,7 @@ for name, (h, c) in hertz.items():
     assert abs(h["p0"] / h["p0_exact"] - 1) < 0.01, (name, h)
     assert h["l2_error"] < 0.01, (name, h)
     assert c["balance"] < 1e-10, (name, c["balance"])
-for name, (P, interior, l1, c) in flat.items():
+for name, (_, interior, l1, c) in flat.items():
     assert interior < 0.015 and l1 < 0.15, (name, interior, l1)
     assert abs(c["force"][0]) < 1e-10 * abs(c["force"][1]), (name, c["force"])
 f_api, f_file = again["contacts"][0]["force"], hertz["mortar"][1]["force"]

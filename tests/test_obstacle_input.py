@@ -11,14 +11,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, run_cli
 
-from contactfx import (
-    InputError,
-    Obstacle,
-    load_scene_file,
-    run_scene,
-    scene_from_gmsh,
-    solve,
-)
+from contactfx import InputError, Obstacle, load_scene_file, scene_from_gmsh, solve
 from contactfx.results.interface import u_at_points
 from contactfx.scenes import Dirichlet, parse_scene_file
 

@@ -229,7 +229,7 @@ def test_two_obstacles_on_one_body_balance(indenter: Scene) -> None:
 
 def test_coarse_predictor_carries_the_obstacles(indenter: Scene) -> None:
     """The coarse predictor remeshes the .geo with the obstacle: same converged answer."""
-    sol_a, data_a = run_scene(indenter, "mortar", predictor="none")
+    sol_a, _ = run_scene(indenter, "mortar", predictor="none")
     sol_b, data_b = run_scene(indenter, "mortar", predictor="coarse")
     assert "predictor" in data_b["times"]
     ua, ub = u_at_points(sol_a), u_at_points(sol_b)
