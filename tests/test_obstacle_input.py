@@ -84,12 +84,17 @@ def test_scene_file_and_python_api_agree(tmp_path: Path) -> None:
         ('shape = "polyline"\npoints = [[0, 0], [0, 0]]\nsurface = "top"\n', "coincide"),
         (CIRCLE.replace('"top"', '"block"'), "'block' is a surface group, a curve group is"),
         (CIRCLE.replace("[0.0, 20.0]", "[0.0, 19.99]"), "obstacle 'ind' penetrates body"),
+        (
+            'shape = "plane"\npoint = [0.0, 1.0]\nnormal = [0.0, 1.0]\nsurface = "top"\n',
+            "does not face obstacle 'obstacle0'",
+        ),
     ],
-    ids=["shape", "radius", "polyline", "not-a-curve", "penetration"],
+    ids=["shape", "radius", "polyline", "not-a-curve", "penetration", "facing"],
 )
 def test_bad_obstacles_cli_one_line(tmp_path: Path, obstacle: str, needle: str) -> None:
     """Unknown shape, radius <= 0, degenerate polyline, a surface group that is not a curve,
-    an initial penetration: exit 2, one line, no traceback, no JSON."""
+    an initial penetration, a plane whose normal points away from the body: exit 2, one
+    line, no traceback, no JSON."""
     out = tmp_path / "r.json"
     proc = run_cli("solve", str(scene_file(tmp_path, obstacle)), "--json", str(out))
     assert proc.returncode == 2
