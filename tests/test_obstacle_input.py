@@ -134,15 +134,20 @@ def test_out_writes_the_obstacle(tmp_path: Path) -> None:
 
 def test_solvers_and_methods_that_refuse_obstacles() -> None:
     """Schwarz refuses obstacles; the condensed solver takes NTS against a circle (its rows
-    touch their own node only) but not dual mortar (the circle's normal turns)."""
+    touch their own node only) but not dual mortar (the circle's normal turns), and dual
+    mortar against a straight polyline (the punch's face)."""
     scene = load_scene_file(INDENTER)
     with pytest.raises(InputError, match="schwarz does not take rigid obstacles"):
         solve(scene, "schwarz")
     with pytest.raises(InputError, match="dual mortar on the circle obstacle 'indenter'"):
         solve(scene, "mortar", basis="dual", solver="condensed")
-    direct, condensed = solve(scene, "nts"), solve(scene, "nts", solver="condensed")
-    ua, ub = u_at_points(direct), u_at_points(condensed)
-    assert np.abs(ub[:, 2:] - ua[:, 2:]).max() < 1e-6 * np.abs(ua[:, 2:]).max()
+    punch = load_scene_file(DEMO_SCENES / "rigid_punch.toml")
+    for s, options in ((scene, {}), (punch, {"basis": "dual"})):
+        method = "mortar" if options else "nts"
+        direct = solve(s, method, **options)
+        condensed = solve(s, method, solver="condensed", **options)
+        ua, ub = u_at_points(direct), u_at_points(condensed)
+        assert np.abs(ub[:, 2:] - ua[:, 2:]).max() < 1e-6 * np.abs(ua[:, 2:]).max()
 
 
 MPI_SCRIPT = textwrap.dedent("""

@@ -235,12 +235,18 @@ def rigid_operator(
 def diagonal_on_nodes(shape: RigidShape, kernel: str, basis: str) -> bool:
     """Whether every row touches its own node's dofs only (what the condensed solver needs).
 
-    NTS always; dual mortar on a plane (constant normal: biorthogonality makes the
-    neighbours' entries vanish); not on a circle or polyline, whose normal turns.
+    NTS always; dual mortar where the normal is constant (a plane, a straight polyline:
+    biorthogonality makes the neighbours' entries vanish); not on a circle, nor near the
+    corners of a polyline, where the normal turns.
     """
-    return str(kernel) == "nts" or (
-        str(kernel) == "mortar" and basis == "dual" and isinstance(shape, Plane)
-    )
+    if str(kernel) == "nts":
+        return True
+    if str(kernel) != "mortar" or basis != "dual":
+        return False
+    if isinstance(shape, Polyline):
+        normals = shape.surface().normals
+        return bool(np.all(np.abs(normals - normals[0]) <= 1e-12))
+    return isinstance(shape, Plane)
 
 
 def facing_angle(
