@@ -23,6 +23,7 @@ from .methods import SchwarzOptions, Solution
 from .options import SOLVERS, Basis, Method, Predictor, SolverKind, SolverSpec
 from .scenes import (
     HertzReference,
+    Obstacle,
     Scene,
     UniformStress,
     load_scene_file,
@@ -42,6 +43,7 @@ __all__ = [
     "InputError",
     "MeshError",
     "Method",
+    "Obstacle",
     "Predictor",
     "Scene",
     "SchwarzOptions",

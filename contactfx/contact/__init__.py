@@ -1,4 +1,8 @@
-"""Contact discretization kernels (pure numpy/scipy): NTS, STS and segment-based mortar."""
+"""Contact discretization kernels (pure numpy/scipy): NTS, STS and segment-based mortar.
+
+Against a body (`contact_operator`) or a rigid obstacle (`rigid_operator`: rigid.py,
+rigid_kernels.py).
+"""
 
 from __future__ import annotations
 
@@ -8,14 +12,22 @@ from enum import StrEnum
 from . import mortar, nts, sts
 from .geometry import Surface
 from .operator import ContactOperator, overlap_tolerance
+from .rigid import Circle, Plane, Polyline, RigidShape
+from .rigid_kernels import RigidOperator, rigid_operator
 
 __all__ = [
     "OPERATORS",
+    "Circle",
     "ContactOperator",
     "Kernel",
+    "Plane",
+    "Polyline",
+    "RigidOperator",
+    "RigidShape",
     "Surface",
     "contact_operator",
     "overlap_tolerance",
+    "rigid_operator",
 ]
 
 

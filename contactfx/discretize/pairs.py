@@ -14,7 +14,7 @@ import scipy.sparse as sp
 from dolfinx import fem
 
 from ..contact import ContactOperator, Kernel, Surface, contact_operator
-from ..scenes import Body, ContactPair, Scene
+from ..scenes import Body, ContactPair, Obstacle, Scene
 from .surfaces import GatheredSurface, gather_surface
 
 # A pair with both of its bodies and gathered surfaces: (pair, active body, passive body,
@@ -24,21 +24,37 @@ GatheredPair = tuple[ContactPair, Body, Body, GatheredSurface, GatheredSurface]
 
 @dataclass(frozen=True)
 class PairData:
-    """One contact pair with its bodies, gathered surfaces and contact operator."""
+    """One contact pair with its bodies, gathered surfaces and contact operator.
+
+    A pair against a rigid obstacle (`obstacle` set) has no passive body or surface: its
+    `pair.passive` is the obstacle's name, and `motion` ((n_active, 2)) maps the obstacle's
+    rigid displacement to the weighted gap (the force on the obstacle is motion^T lambda).
+    """
 
     index: int
     pair: ContactPair
     active_body: Body
-    passive_body: Body
+    passive_body: Body | None
     active: GatheredSurface
-    passive: GatheredSurface
+    passive: GatheredSurface | None
     operator: ContactOperator
     first_row: int  # first row of this pair in the stacked operator
+    obstacle: Obstacle | None = None
+    motion: sp.csr_matrix | None = None
 
     @property
     def label(self) -> str:
         """How messages name the pair."""
+        if self.obstacle is not None:
+            return f" of pair {self.index} ({self.pair.active} on obstacle {self.pair.passive})"
         return f" of pair {self.index} ({self.pair.active} on {self.pair.passive})"
+
+    @property
+    def overlap_text(self) -> str:
+        """What an initial penetration of this pair is called in the error."""
+        if self.passive_body is None:
+            return f"obstacle '{self.pair.passive}' penetrates body '{self.active_body.name}'"
+        return f"bodies '{self.active_body.name}' and '{self.passive_body.name}' overlap"
 
 
 def gather_pairs(scene: Scene, V: fem.FunctionSpace) -> list[GatheredPair]:

@@ -23,6 +23,14 @@ from .coupling import (
     petsc_constraint,
 )
 from .elasticity import Elasticity, assemble_elasticity
+from .obstacles import (
+    GatheredObstacle,
+    build_obstacle_pairs,
+    check_obstacle_geometry,
+    gather_obstacles,
+    moved,
+    node_free_rows,
+)
 from .pairs import GatheredPair, PairData, build_pairs, gather_pairs, stack
 from .supports import check_held
 from .surfaces import check_facing
@@ -61,7 +69,7 @@ class ContactSetup:
         loose = {b.name for b in self.needs_contact}
         pair_of = self.layout.pair[self.layout.mine]
         for p in self.pairs:
-            if not ({p.active_body.name, p.passive_body.name} & loose):
+            if not ({b.name for b in (p.active_body, p.passive_body) if b is not None} & loose):
                 continue
             rows = pair_of == p.index
             if comm.allreduce(int(active[rows].sum())) == 0:
@@ -96,6 +104,19 @@ def assemble_and_gather(scene: Scene, timers: Timers) -> tuple[Elasticity, int, 
     with timers("search"):
         gathered = gather_pairs(scene, V)
     return el, ndofs, gathered
+
+
+def all_pairs(
+    gathered: list[GatheredPair],
+    obstacles: list[GatheredObstacle],
+    kernel: Kernel,
+    ndofs: int,
+    **kernel_options: object,
+) -> list[PairData]:
+    """The body pairs, then the obstacle pairs, with their operators of `kernel`."""
+    pairs = build_pairs(gathered, kernel, ndofs, **kernel_options)
+    row = sum(p.active.surface.n_nodes for p in pairs)
+    return pairs + build_obstacle_pairs(obstacles, kernel, ndofs, len(pairs), row, **kernel_options)
 
 
 def prescribed_gap_shift(
@@ -138,9 +159,14 @@ def prepare_contact(
     el, ndofs, gathered = assemble_and_gather(scene, timers)
     V = el.V
     dual = basis is Basis.DUAL
+    with timers("search"):
+        obstacles = gather_obstacles(scene, V)
     with timers("contact"):
-        pairs = build_pairs(gathered, kernel, ndofs, **({"basis": basis} if dual else {}))
+        pairs = all_pairs(gathered, obstacles, kernel, ndofs, **({"basis": basis} if dual else {}))
         for p in pairs:
+            if p.passive is None:
+                check_obstacle_geometry(p)
+                continue
             if not p.operator.overlapping.any():
                 raise GeometryError(
                     f"contact pair {p.index}: the active surface "
@@ -153,21 +179,25 @@ def prepare_contact(
             scene,
             el,
             op,
-            np.vstack([active_union.surface.dofs] + [p.passive.surface.dofs for p in pairs]),
+            np.vstack(
+                [active_union.surface.dofs]
+                + [p.passive.surface.dofs for p in pairs if p.passive is not None]
+            ),
         )
         if np.any(shift):
             op = ContactOperator(op.B, op.gap + shift, op.weights)
         dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
-        layout, order = multiplier_layout(
-            comm, active_union, op, pair_of_row, constrained_rows(op, dirichlet)
+        usable = constrained_rows(op, dirichlet) & node_free_rows(
+            op, active_union.surface.dofs, pairs, dirichlet
         )
+        layout, order = multiplier_layout(comm, active_union, op, pair_of_row, usable)
         B = petsc_constraint(V, op, order, layout, dirichlet)
     w_all = layout.weights
     g_all = op.gap[order] / w_all
     if dual:
         # A dual (sign-changing) weighting averages the gap with negative weights: check
         # for overlap with the standard, positive weights (geometry, not the multipliers).
-        std = stack(build_pairs(gathered, kernel, ndofs))[1]
+        std = stack(all_pairs(gathered, obstacles, kernel, ndofs))[1]
         g_all = (std.gap[order] + shift[order]) / std.weights[order]
     h = float(np.median(w_all))
     for p in pairs:
@@ -175,11 +205,12 @@ def prepare_contact(
         j = rows[int(np.argmin(g_all[rows]))]
         if g_all[j] < -penetration_tol * h:
             raise GeometryError(
-                f"bodies '{p.active_body.name}' and '{p.passive_body.name}' "
-                f"overlap: initial penetration {-g_all[j]:.3e} at ("
+                f"{p.overlap_text}: initial penetration {-g_all[j]:.3e} at ("
                 f"{layout.x[j, 0]:.4g}, {layout.x[j, 1]:.4g}) exceeds the "
                 f"tolerance {penetration_tol * h:.1e}"
             )
+    # Checked at their reference positions, the obstacles now take their prescribed motion.
+    op = moved(op, pairs)
     needs_contact = check_held(
         scene, V, el.bc_dofs, [(p.active_body, p.passive_body, p.active) for p in pairs]
     )

@@ -3,7 +3,8 @@
 Each body has three rigid modes (two translations, a rotation about its centroid). A
 Dirichlet dof of the body and a contact-surface normal of a pair (taken as bilateral, the
 most the contact can hold) each give one linear condition on the modes; the modes in the
-null space of all these conditions make K + contact singular, whatever the load.
+null space of all these conditions make K + contact singular, whatever the load. A rigid
+obstacle is a body that does not move: its pairs' rows hold the active body alone.
 """
 
 from __future__ import annotations
@@ -19,8 +20,9 @@ from ..linalg.nullspace import orthonormalize
 from ..scenes import Body, Scene
 from .surfaces import GatheredSurface
 
-# A contact pair as the check needs it: (active body, passive body, active surface).
-Contact = tuple[Body, Body, GatheredSurface]
+# A contact pair as the check needs it: (active body, passive body or None for a rigid
+# obstacle, active surface).
+Contact = tuple[Body, Body | None, GatheredSurface]
 
 
 def body_blocks(V: fem.FunctionSpace, cells: np.ndarray) -> np.ndarray:
@@ -128,14 +130,16 @@ def _contact_rows(
     for active_body, passive_body, active in pairs:
         surf = active.surface
         n = nodal_normals(surf)
-        a, q = index[active_body.name], index[passive_body.name]
+        a = index[active_body.name]
         r = np.zeros((surf.n_nodes, 3 * len(scene.bodies)))
         r[:, 3 * a : 3 * a + 3] = np.einsum(
             "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[a], sizes[a])
         )
-        r[:, 3 * q : 3 * q + 3] -= np.einsum(
-            "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[q], sizes[q])
-        )
+        if passive_body is not None:
+            q = index[passive_body.name]
+            r[:, 3 * q : 3 * q + 3] -= np.einsum(
+                "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[q], sizes[q])
+            )
         rows.append(r)
     return np.vstack(rows)
 

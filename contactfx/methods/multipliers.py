@@ -203,7 +203,11 @@ def _solver(setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool)
 
 
 def check_solver(method: Method, basis: Basis, spec: SolverSpec) -> None:
-    """InputError if the solver cannot handle the method's multipliers."""
+    """InputError if the solver cannot handle the method's multipliers.
+
+    A diagonal D per method; curved surfaces and obstacles (whose rows also touch the
+    neighbours' pivots) are handled by the coupled elimination of linalg/pivots.py.
+    """
     diagonal = method is Method.NTS or (method is Method.MORTAR and basis is Basis.DUAL)
     if spec.kind.condensed and not diagonal:
         raise InputError(

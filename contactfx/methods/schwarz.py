@@ -139,6 +139,10 @@ def solve_schwarz(
     Body N (held by its supports) takes Neumann data, body D (held only by the contact)
     Dirichlet data; the contact line must be straight, horizontal and closed everywhere.
     """
+    if scene.obstacles:
+        raise InputError(
+            "schwarz does not take rigid obstacles ([[obstacle]]): use nts, sts, mortar or penalty"
+        )
     if len(scene.bodies) != 2 or len(scene.contacts) != 1:
         raise InputError(
             f"schwarz supports two bodies with one contact pair (this scene has "

@@ -17,7 +17,7 @@ from ..discretize.pairs import PairData
 from ..discretize.setup import ContactSetup
 from ..discretize.surfaces import GatheredSurface
 from ..options import Basis, Method
-from ..scenes import Body, ContactPair, Scene
+from ..scenes import Body, ContactPair, Obstacle, Scene
 from ..timers import Timers
 
 # One record per active-set (or Schwarz) iteration; None where a value is undefined.
@@ -39,18 +39,22 @@ class PairView:
     """One contact pair of a solution: its surfaces, multiplier rows and their geometry.
 
     Row i of `B` is the pair's multiplier row `rows[i]` (layout order): the weighted gap's
-    linearization, whose transpose spreads the multipliers into nodal forces.
+    linearization, whose transpose spreads the multipliers into nodal forces. Against a
+    rigid obstacle (`obstacle` set) there is no passive body or surface; row i of `motion`
+    is the same row's derivative by the obstacle's displacement (its force: motion^T lambda).
     """
 
     index: int
     pair: ContactPair
     active_body: Body
-    passive_body: Body
+    passive_body: Body | None
     active: GatheredSurface
-    passive: GatheredSurface
+    passive: GatheredSurface | None
     rows: np.ndarray  # layout rows of the pair's multipliers
     gblock: np.ndarray  # global node (dof block) of each of those rows
     B: sp.csr_matrix
+    obstacle: Obstacle | None = None
+    motion: sp.csr_matrix | None = None
 
     @property
     def label(self) -> str:
@@ -171,6 +175,8 @@ def pair_views(
             rows,
             layout.gblock[rows],
             B[order[rows]].tocsr(),
+            p.obstacle,
+            None if p.motion is None else p.motion[order[rows] - p.first_row].tocsr(),
         )
         out.append(view)
     return out

@@ -11,11 +11,21 @@ from typing import Any
 import numpy as np
 
 from ..methods.solution import Solution
+from .obstacles import outline
 from .stress import sigma_field
 
 
-def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | None:
-    """Save u_y and sigma_yy on the mesh deformed `scale` times; serial runs only."""
+def deformed_fields(
+    sol: Solution,
+    path: Path,
+    scale: float = 100.0,
+    window: tuple[float, float, float, float] | None = None,
+) -> Path | None:
+    """Save u_y and sigma_yy on the mesh deformed `scale` times; serial runs only.
+
+    Rigid obstacles are drawn as black outlines, displaced `scale` times their motion.
+    `window` (xmin, xmax, ymin, ymax) zooms on a part of the plane (default: everything).
+    """
     if sol.scene.mesh.comm.size > 1:
         return None
     import pyvista
@@ -33,6 +43,10 @@ def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | N
     # DG0 dofs follow the cell order of vtk_mesh(V) (both enumerate local cells).
     grid.cell_data["sigma_yy"] = s[: grid.n_cells, 3]
     warped = grid.warp_by_vector("u", factor=scale)
+    # Rigid obstacles: their outlines moved by `scale` times their motion, like the mesh.
+    outlines = [
+        outline(ob, x[:, :2]) + scale * np.asarray(ob.displacement) for ob in sol.scene.obstacles
+    ]
     # pyvista annotates window_size as list[int]; it takes any sequence (as BasePlotter says).
     plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)  # type: ignore[arg-type]
     for col, (name, label) in enumerate((("u_y", "u_y (cm)"), ("sigma_yy", "sigma_yy (MPa)"))):
@@ -49,12 +63,46 @@ def deformed_fields(sol: Solution, path: Path, scale: float = 100.0) -> Path | N
                 "position_y": 0.15,
             },
         )
+        for xy in outlines:
+            pts = np.column_stack([xy, np.zeros(len(xy))])
+            plotter.add_mesh(pyvista.lines_from_points(pts), color="black", line_width=2)
         plotter.add_text(f"{label}, deformation x{scale:g}", font_size=10)
         plotter.view_xy()  # type: ignore[call-arg]  # pyvista's functools.wraps confuses mypy
+        if window is not None:
+            _zoom(plotter, window)
     path.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(path))
     plotter.close()
     return path
+
+
+def _zoom(plotter: Any, window: tuple[float, float, float, float]) -> None:
+    """Look at `window` (xmin, xmax, ymin, ymax) from above, in parallel projection."""
+    x0, x1, y0, y1 = window
+    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    cam = plotter.camera
+    cam.parallel_projection = True
+    cam.focal_point = (cx, cy, 0.0)
+    cam.position = (cx, cy, 10.0 * max(x1 - x0, y1 - y0))
+    cam.up = (0.0, 1.0, 0.0)
+    # Half the view's height; each subplot is 800 x 600 pixels.
+    cam.parallel_scale = 0.5 * max(y1 - y0, 0.75 * (x1 - x0))
+
+
+def contact_window(data: dict[str, Any]) -> tuple[float, float, float, float] | None:
+    """A window on the active nodes of the obstacle pairs (three times their extent)."""
+    pts = []
+    for c in data["contacts"]:
+        itf = c["interface"]
+        if "obstacle" in c:
+            pts += [(x, y) for x, y, a in zip(itf["x"], itf["y"], itf["active"], strict=True) if a]
+    if not pts:
+        return None
+    xy = np.asarray(pts)
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    half = 1.5 * max(float(np.max(hi - lo)), 1e-12 * float(np.abs(xy).max() + 1.0))
+    cx, cy = 0.5 * (lo + hi)
+    return (cx - half, cx + half, cy - half, cy + half)
 
 
 def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
@@ -117,9 +165,10 @@ def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
     )
     ax.plot(s, arr("pressure"), "k.-", ms=3, lw=1, label="pressure (multipliers)")
     ax.plot(s, -arr("sigma_nn_active"), "-", label=f"-sigma_nn {c['active_body']} (active)")
-    ax.plot(s, -arr("sigma_nn_passive"), "--", label=f"-sigma_nn {c['passive_body']} (passive)")
     bx.plot(s, arr("sigma_nt_active"), "-", label="active")
-    bx.plot(s, arr("sigma_nt_passive"), "--", label="passive")
+    if "obstacle" not in c:  # a rigid obstacle has no stress to show
+        ax.plot(s, -arr("sigma_nn_passive"), "--", label=f"-sigma_nn {c['passive_body']} (passive)")
+        bx.plot(s, arr("sigma_nt_passive"), "--", label="passive")
     hertz = [
         h
         for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else [])
@@ -146,7 +195,8 @@ def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
     ax.set_ylabel("normal traction (compression > 0)")
     bx.set_ylabel("sigma_nt")
     bx.set_xlabel("s, arc length along the active surface")
-    ax.set_title(f"{data['scene']} / {data['method']}: pair {k}, {c['active']} on {c['passive']}")
+    on = f"obstacle '{c['passive']}'" if "obstacle" in c else c["passive"]
+    ax.set_title(f"{data['scene']} / {data['method']}: pair {k}, {c['active']} on {on}")
     for a_ in (ax, bx):
         a_.grid(alpha=0.3)
     ax.legend(fontsize=8)

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..methods.solution import Solution
 from .interface import INTERFACE_FIELDS
+from .obstacles import from_summary, outline
 from .stress import sigma_field
 
 
@@ -42,7 +43,11 @@ def write_fields(sol: Solution, outdir: Path) -> list[Path]:
 
 
 def write_contact_surfaces(data: dict[str, Any], outdir: Path) -> list[Path]:
-    """One VTK polyline per pair (open in ParaView): pressure, gap and the active flag."""
+    """One VTK polyline per pair (open in ParaView): pressure, gap and the active flag.
+
+    Each rigid obstacle also gets its outline, `obstacle_NAME.vtp`, at its reference
+    position with its rigid motion as point data `displacement` (warp it like the body).
+    """
     import pyvista
 
     written = []
@@ -56,4 +61,19 @@ def write_contact_surfaces(data: dict[str, Any], outdir: Path) -> list[Path]:
         path = outdir / f"contact{k}_{c['active']}.vtp"
         line.save(str(path))
         written.append(path)
+        if "obstacle" in c:
+            written.append(_write_outline(c, pts[:, :2], outdir))
     return written
+
+
+def _write_outline(entry: dict[str, Any], near: np.ndarray, outdir: Path) -> Path:
+    """The outline of the obstacle of a `contacts` entry as a VTK polyline."""
+    import pyvista
+
+    ob = from_summary(entry)
+    xy = outline(ob, near)
+    line = pyvista.lines_from_points(np.column_stack([xy, np.zeros(len(xy))]))
+    line.point_data["displacement"] = np.tile([*ob.displacement, 0.0], (len(xy), 1))
+    path = outdir / f"obstacle_{ob.name}.vtp"
+    line.save(str(path))
+    return path

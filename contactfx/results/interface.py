@@ -14,6 +14,8 @@ import numpy as np
 
 from ..contact.geometry import project
 from ..methods.solution import Solution
+from ..scenes import Obstacle
+from ..scenes.model import OBSTACLE_SHAPES
 from .stress import nodal_stress, surface_stress
 
 # The numeric columns of every pair's `interface` (plus the boolean `active`), in order.
@@ -52,16 +54,18 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     """pair_interface, computed (collective)."""
     pv = sol.pairs[k]
     rows = pv.rows
-    surf_p = pv.passive.surface
     n, t, x, s = pv.n, pv.t, pv.x, pv.s
     gn_a, _, sig_a = nodal_stress(sol, pv.pair.active)
     sa = sig_a[np.searchsorted(gn_a, pv.gblock)]
-    gn_p, _, sig_p = nodal_stress(sol, pv.pair.passive)
-    at_node = sig_p[np.searchsorted(gn_p, pv.passive.gblock)]
-    seg, xi, found = project(x, surf_p)
-    ends = surf_p.segments[seg]
-    sp = (1 - xi)[:, None, None] * at_node[ends[:, 0]] + xi[:, None, None] * at_node[ends[:, 1]]
-    sp[~found] = np.nan  # beyond the passive surface's end there is no value
+    sp = np.full_like(sa, np.nan)  # a rigid obstacle has no stress of its own
+    if pv.passive is not None:
+        surf_p = pv.passive.surface
+        gn_p, _, sig_p = nodal_stress(sol, pv.pair.passive)
+        at_node = sig_p[np.searchsorted(gn_p, pv.passive.gblock)]
+        seg, xi, found = project(x, surf_p)
+        ends = surf_p.segments[seg]
+        sp = (1 - xi)[:, None, None] * at_node[ends[:, 0]] + xi[:, None, None] * at_node[ends[:, 1]]
+        sp[~found] = np.nan  # beyond the passive surface's end there is no value
     nn_a, nt_a = resolve(sa, n, t)
     nn_p, nt_p = resolve(sp, n, t)
     order = np.argsort(s, kind="stable")
@@ -78,6 +82,9 @@ def pair_forces(sol: Solution, k: int) -> tuple[np.ndarray, np.ndarray]:
     # B^T lambda: the multipliers' nodal forces (compression positive pushes the bodies apart).
     nodal = pv.B.T @ sol.pressure[pv.rows]
     fa = np.array([nodal[pv.active.surface.dofs[:, c]].sum() for c in (0, 1)])
+    if pv.motion is not None:  # a rigid obstacle: its force is its columns' share
+        return fa, pv.motion.T @ sol.pressure[pv.rows]
+    assert pv.passive is not None  # a body pair has a passive surface
     fp = np.array([nodal[pv.passive.surface.dofs[:, c]].sum() for c in (0, 1)])
     return fa, fp
 
@@ -92,16 +99,32 @@ def contacts_summary(sol: Solution) -> list[dict[str, Any]]:
                 "active": pv.pair.active,
                 "passive": pv.pair.passive,
                 "active_body": pv.active_body.name,
-                "passive_body": pv.passive_body.name,
+                # An obstacle pair names the obstacle on both passive keys.
+                "passive_body": pv.pair.passive
+                if pv.passive_body is None
+                else pv.passive_body.name,
                 "force": fa.tolist(),
                 "force_passive": fp.tolist(),
                 "balance": float(np.linalg.norm(fa + fp) / max(np.linalg.norm(fa), 1e-300)),
                 "multipliers": len(pv.rows),
                 "active_nodes": int(sol.active[pv.rows].sum()),
                 "interface": pair_interface(sol, k),
+                **({} if pv.obstacle is None else {"obstacle": obstacle_summary(pv.obstacle)}),
             }
         )
     return out
+
+
+def obstacle_summary(ob: Obstacle) -> dict[str, Any]:
+    """An obstacle as the JSON gives it: its shape, parameters and prescribed displacement."""
+    params = {key: getattr(ob, key) for key in OBSTACLE_SHAPES[ob.shape]}
+    if ob.points is not None:
+        params["points"] = [list(p) for p in ob.points]
+    return {
+        "shape": ob.shape,
+        **{k: list(v) if isinstance(v, tuple) else v for k, v in params.items()},
+        "displacement": list(ob.displacement),
+    }
 
 
 def cartesian_interface(sol: Solution) -> dict[str, list[float | None]]:

@@ -49,8 +49,11 @@ def body_of_curve(scene: Scene, name: str) -> Body:
 
 
 def _check_bodies(scene: Scene) -> None:
-    if len(scene.bodies) < 2:
-        raise InputError(f"a contact scene needs at least two bodies (got {len(scene.bodies)})")
+    if len(scene.bodies) < (1 if scene.obstacles else 2):
+        raise InputError(
+            f"a contact scene needs at least two bodies, or one and an [[obstacle]] "
+            f"(got {len(scene.bodies)} bodies)"
+        )
     known = set()
     for body in scene.bodies:
         tag = scene.body_tag(body)
@@ -68,8 +71,8 @@ def _check_bodies(scene: Scene) -> None:
 
 def _check_pairs(scene: Scene) -> dict[str, str]:
     """Check every pair joins two bodies; return each contact curve's body name."""
-    if not scene.contacts:
-        raise InputError("the scene has no contact pair (add a [[contact]] entry)")
+    if not scene.contacts and not scene.obstacles:
+        raise InputError("the scene has no contact pair (add a [[contact]] or [[obstacle]] entry)")
     found: dict[str, str] = {}
     for k, pair in enumerate(scene.contacts):
         for curve in (pair.active, pair.passive):
@@ -80,6 +83,26 @@ def _check_pairs(scene: Scene) -> dict[str, str]:
                 f"contact pair {k}: '{pair.active}' and '{pair.passive}' lie on "
                 f"the same body '{found[pair.active]}' (self-contact is not supported)"
             )
+    return found
+
+
+def _check_obstacles(scene: Scene, known: dict[str, str]) -> dict[str, str]:
+    """Check every obstacle's surface is a curve of one body; return those curves' bodies."""
+    found: dict[str, str] = {}
+    names: set[str] = set()
+    for k, obstacle in enumerate(scene.obstacles):
+        where = f"obstacle {k} ('{obstacle.name}')"
+        if obstacle.name in names:
+            raise InputError(f"{where}: two obstacles are called '{obstacle.name}'")
+        if obstacle.name in scene.groups.by_name:
+            raise InputError(
+                f"{where}: '{obstacle.name}' is also a physical group of the mesh: "
+                "give the obstacle another name"
+            )
+        names.add(obstacle.name)
+        scene.curve_tag(obstacle.surface, f"{where}: surface")
+        if obstacle.surface not in known and obstacle.surface not in found:
+            found[obstacle.surface] = body_of_curve(scene, obstacle.surface).name
     return found
 
 
@@ -102,10 +125,10 @@ def _check_conditions(scene: Scene) -> None:
             raise InputError(f"load on '{load.group}': values must be finite")
     for ref in scene.references:
         pair = getattr(ref, "pair", 0)
-        if not 0 <= pair < len(scene.contacts):
+        if not 0 <= pair < len(scene.contacts) + len(scene.obstacles):
             raise InputError(
-                f"reference: pair {pair} does not exist "
-                f"(the scene has {len(scene.contacts)} contact pairs)"
+                f"reference: pair {pair} does not exist (the scene has "
+                f"{len(scene.contacts)} contact pairs and {len(scene.obstacles)} obstacles)"
             )
 
 
@@ -118,5 +141,6 @@ def check_scene(scene: Scene) -> Scene:
         body.material.check(f"body '{body.name}'")
     _check_bodies(scene)
     curve_bodies = _check_pairs(scene)
+    curve_bodies.update(_check_obstacles(scene, curve_bodies))
     _check_conditions(scene)
     return replace(scene, curve_bodies=curve_bodies)

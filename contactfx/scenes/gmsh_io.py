@@ -24,7 +24,17 @@ from scipy.sparse.csgraph import connected_components
 from ..errors import ContactFxError, InputError, MeshError, error_type
 from ..meshes import QUAD4
 from .checks import check_scene
-from .model import Body, ContactPair, Dirichlet, Groups, Load, Material, Reference, Scene
+from .model import (
+    Body,
+    ContactPair,
+    Dirichlet,
+    Groups,
+    Load,
+    Material,
+    Obstacle,
+    Reference,
+    Scene,
+)
 
 # The other 2D element types of gmsh, named for the error message.
 _GMSH_2D_NAMES = {
@@ -208,6 +218,7 @@ class SceneParts:
     loads: tuple[Load, ...] = ()
     references: tuple[Reference, ...] = ()
     name: str = "scene"
+    obstacles: tuple[Obstacle, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -264,6 +275,7 @@ def scene_from_gmsh(
             **(params or {}),
         },
         recipe=recipe,
+        obstacles=parts.obstacles,
     )
     return check_scene(scene)
 
@@ -272,12 +284,13 @@ def from_gmsh(
     model_or_path: Any,
     *,
     bodies: Mapping[str, Material | Mapping[str, float]],
-    contacts: list[tuple[str, str]] | list[ContactPair],
+    contacts: list[tuple[str, str]] | list[ContactPair] | None = None,
     dirichlet: list[Dirichlet] | None = None,
     loads: list[Load] | None = None,
     references: list[Reference] | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
     name: str | None = None,
+    obstacles: list[Obstacle] | None = None,
 ) -> Scene:
     """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path.
 
@@ -291,6 +304,7 @@ def from_gmsh(
         references: Analytic references (HertzReference, UniformStress) to report.
         comm: The communicator the mesh is distributed over.
         name: The scene's label (default: the file's stem, or "gmsh-model").
+        obstacles: Rigid obstacles (Obstacle), each against one curve group of a body.
 
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
@@ -304,10 +318,11 @@ def from_gmsh(
     )
     parts = SceneParts(
         mats,
-        tuple(p if isinstance(p, ContactPair) else ContactPair(*p) for p in contacts),
+        tuple(p if isinstance(p, ContactPair) else ContactPair(*p) for p in contacts or ()),
         tuple(dirichlet or ()),
         tuple(loads or ()),
         tuple(references or ()),
         label,
+        tuple(obstacles or ()),
     )
     return scene_from_gmsh(model_or_path, parts, comm)

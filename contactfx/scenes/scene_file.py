@@ -16,11 +16,13 @@ from mpi4py import MPI
 from ..errors import InputError
 from .gmsh_io import SceneParts, scene_from_gmsh
 from .model import (
+    OBSTACLE_SHAPES,
     ContactPair,
     Dirichlet,
     HertzReference,
     Load,
     Material,
+    Obstacle,
     Pressure,
     Reference,
     Scene,
@@ -28,7 +30,17 @@ from .model import (
     UniformStress,
 )
 
-TOP_KEYS = {"mesh", "name", "bodies", "contact", "dirichlet", "pressure", "traction", "reference"}
+TOP_KEYS = {
+    "mesh",
+    "name",
+    "bodies",
+    "contact",
+    "obstacle",
+    "dirichlet",
+    "pressure",
+    "traction",
+    "reference",
+}
 SECTION_KEYS = {
     "bodies": {"E", "nu"},
     "contact": {"active", "passive"},
@@ -37,6 +49,7 @@ SECTION_KEYS = {
     "traction": {"group", "t"},
     "reference.hertz": {"type", "pair", "R", "P", "symmetric"},
     "reference.uniform_stress": {"type", "sigma"},
+    "obstacle": {"name", "shape", "surface", "displacement"},
 }
 
 
@@ -77,6 +90,38 @@ def _entries(doc: dict[str, Any], key: str) -> list[Any]:
     return value
 
 
+def _vector(where: str, value: Any) -> tuple[float, float]:
+    if not (isinstance(value, list) and len(value) == 2):
+        raise InputError(f"{where}: expected a vector [x, y], got {value!r}")
+    return (_number(where, value[0]), _number(where, value[1]))
+
+
+def _obstacle(k: int, entry: Any) -> Obstacle:
+    shape = entry.get("shape") if isinstance(entry, dict) else None
+    if shape not in OBSTACLE_SHAPES:
+        choices = ", ".join(f"'{s}'" for s in OBSTACLE_SHAPES)
+        raise InputError(f"obstacle {k}: shape must be one of {choices} (got {shape!r})")
+    where = f"obstacle {k} ({shape})"
+    takes = set(OBSTACLE_SHAPES[shape])
+    e = _keys(where, entry, SECTION_KEYS["obstacle"] | takes, {"shape", "surface"} | takes)
+    name = e.get("name", f"obstacle{k}")
+    if not isinstance(name, str) or not name:
+        raise InputError(f"{where}: name must be a non-empty string, got {name!r}")
+    values: dict[str, Any] = {}
+    for key in sorted(takes):
+        if key == "radius":
+            values[key] = _number(f"{where}.radius", e[key])
+        elif key == "points":
+            if not isinstance(e[key], list):
+                raise InputError(f"{where}.points: expected a list of points [[x, y], ...]")
+            values[key] = tuple(_vector(f"{where}.points", p) for p in e[key])
+        else:
+            values[key] = _vector(f"{where}.{key}", e[key])
+    if "displacement" in e:
+        values["displacement"] = _vector(f"{where}.displacement", e["displacement"])
+    return Obstacle(name, shape, _string(f"{where}.surface", e["surface"]), **values)
+
+
 def _reference(k: int, entry: Any) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
     if kind not in ("hertz", "uniform_stress"):
@@ -86,7 +131,9 @@ def _reference(k: int, entry: Any) -> Reference:
         e = _keys(where, entry, SECTION_KEYS["reference.hertz"], {"type", "R", "P"})
         pair = e.get("pair", 0)
         if isinstance(pair, bool) or not isinstance(pair, int):
-            raise InputError(f"{where}: pair must be an integer index into [[contact]]")
+            raise InputError(
+                f"{where}: pair must be an integer index into [[contact]], then [[obstacle]]"
+            )
         # An omitted `symmetric` takes the dataclass's default: one default for both APIs.
         flags = {"symmetric": e["symmetric"]} if "symmetric" in e else {}
         if not all(isinstance(v, bool) for v in flags.values()):
@@ -110,7 +157,14 @@ def _reference(k: int, entry: Any) -> Reference:
 def parse_scene_file(
     path: Path,
 ) -> tuple[
-    Path, str, dict[str, Material], list[ContactPair], list[Dirichlet], list[Load], list[Reference]
+    Path,
+    str,
+    dict[str, Material],
+    list[ContactPair],
+    list[Dirichlet],
+    list[Load],
+    list[Reference],
+    list[Obstacle],
 ]:
     """Read and check a scene file; return the mesh path and the scene's parts."""
     try:
@@ -121,7 +175,9 @@ def parse_scene_file(
         raise InputError(f"cannot read scene file {path}: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"scene file {path} is not valid TOML: {exc}") from None
-    _keys(str(path.name), doc, TOP_KEYS, {"mesh", "bodies", "contact"})
+    _keys(str(path.name), doc, TOP_KEYS, {"mesh", "bodies"})
+    if "contact" not in doc and "obstacle" not in doc:
+        raise InputError(f"{path.name}: missing key 'contact' (or 'obstacle')")
     mesh = path.parent / _string("mesh", doc["mesh"])
     name = str(doc.get("name", path.stem))
     if not isinstance(doc["bodies"], dict) or not doc["bodies"]:
@@ -166,7 +222,8 @@ def parse_scene_file(
             )
         )
     refs = [_reference(k, e) for k, e in enumerate(_entries(doc, "reference"))]
-    return mesh, name, bodies, pairs, bcs, loads, refs
+    obstacles = [_obstacle(k, e) for k, e in enumerate(_entries(doc, "obstacle"))]
+    return mesh, name, bodies, pairs, bcs, loads, refs, obstacles
 
 
 def load_scene_file(
@@ -174,6 +231,8 @@ def load_scene_file(
 ) -> Scene:
     """The Scene of a TOML scene file (mesh path relative to the file)."""
     path = Path(path)
-    mesh, name, bodies, pairs, bcs, loads, refs = parse_scene_file(path)
-    parts = SceneParts(bodies, tuple(pairs), tuple(bcs), tuple(loads), tuple(refs), name)
+    mesh, name, bodies, pairs, bcs, loads, refs, obstacles = parse_scene_file(path)
+    parts = SceneParts(
+        bodies, tuple(pairs), tuple(bcs), tuple(loads), tuple(refs), name, tuple(obstacles)
+    )
     return scene_from_gmsh(mesh, parts, comm, size_factor, {"scene_file": str(path)})

@@ -163,6 +163,8 @@ def profiles(sol: Solution, summary: dict[str, Any]) -> Profiles:
     disp = []
     for pd in sol.pairs:
         for side in (pd.active, pd.passive):
+            if side is None:  # a rigid obstacle: no displacement field of its own
+                continue
             s = arc_length(side.surface)[0]
             order = np.argsort(s, kind="stable")
             disp.append((s[order], surface_displacement(sol, side)[order]))
