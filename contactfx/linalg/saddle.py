@@ -50,6 +50,16 @@ _REUSE_KSP: Mapping[str, object] = {
 }
 
 
+def _ksp_options(options: Mapping[str, object], reuse: bool, rank: int) -> dict[str, object]:
+    """The options, with the reuse GMRES's in place of the KSP's own (a log line says so)."""
+    if not reuse:
+        return dict(options)
+    replaced = sorted(k for k in options if k in _REUSE_KSP)
+    if replaced and rank == 0:
+        log.info("saddle solver: the factorization's GMRES sets %s", ", ".join(replaced))
+    return {**options, **_REUSE_KSP}
+
+
 class SaddleSolver:
     """A persistent saddle-point solver for one (K, B, f): call `solve(g, active)` repeatedly.
 
@@ -80,11 +90,7 @@ class SaddleSolver:
         self.stats = {"reused": 0, "setup_time": 0.0}
         self._mpi = K.getComm().tompi4py()
         self._m = SaddleBlocks(K, B, f, gamma, nullspace, schur_user)
-        keys = {**options, **(_REUSE_KSP if self.policy.reuse else {})}
-        replaced = sorted(k for k in options if k in _REUSE_KSP and self.policy.reuse)
-        if replaced and self._mpi.rank == 0:
-            log.info("saddle solver: the factorization's GMRES sets %s", ", ".join(replaced))
-        self._options = PrefixedOptions(keys)
+        self._options = PrefixedOptions(_ksp_options(options, self.policy.reuse, self._mpi.rank))
         self._ksp = PETSc.KSP().create(K.getComm())
         self._ksp.setOptionsPrefix(self._options.prefix)
         self._fieldsplit = fieldsplit
