@@ -38,7 +38,8 @@ def unit_columns(
         return None
     here = nz.any(axis=0)
     pos = np.full(probes.shape[1], -1, dtype=np.int64)
-    pos[here] = positions[np.argmax(nz[:, here], axis=0)]
+    if here.any():  # a rank may own no multiplier row, or none of the probed ones
+        pos[here] = positions[np.argmax(nz[:, here], axis=0)]
     comm.Allreduce(MPI.IN_PLACE, pos, op=MPI.MAX)
     return pos
 
