@@ -21,7 +21,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from ..errors import InputError
+from ..errors import EliminationError
 
 # Entries of B on another active node's dofs larger than this (relative to the row's pivot)
 # mean D is not diagonal: the elimination would couple the pivots.
@@ -56,21 +56,28 @@ def pivots(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(owned active rows, their pivot dofs, the pivot coefficients).
 
-    InputError if D is not diagonal or a row has no free dof of its own node.
+    EliminationError on every rank if a row has no free dof of its own node or D is not
+    diagonal (it carries that row's node dofs; the linear algebra knows no pairs).
     """
     rows = np.flatnonzero(active)
     piv = np.zeros(len(rows), dtype=np.int64)
     coef = np.zeros(len(rows))
+    bad: tuple[int, int] | None = None
     for i, j in enumerate(rows):
         cols, vals = B.row(j)
         own = np.isin(cols, B.node_dofs[j])
         if not own.any() or np.abs(vals[own]).max() == 0.0:
-            raise InputError(
-                "the condensed solver cannot eliminate a contact row whose "
-                "active node is fully prescribed: use --solver mumps"
-            )
+            bad = bad or (int(B.node_dofs[j, 0]), int(B.node_dofs[j, 1]))
+            continue
         k = np.flatnonzero(own)[int(np.argmax(np.abs(vals[own])))]
         piv[i], coef[i] = cols[k], vals[k]
+    _raise_first(
+        comm,
+        bad,
+        "prescribed",
+        "the condensed solver cannot eliminate a contact row whose active node is fully "
+        "prescribed: use --solver mumps",
+    )
     # Every active node's dofs, from all ranks: a row touching another one means that D is
     # not diagonal.
     others = np.concatenate(comm.allgather(B.node_dofs[rows].ravel()))
@@ -78,12 +85,22 @@ def pivots(
         cols, vals = B.row(j)
         foreign = np.isin(cols, others) & ~np.isin(cols, B.node_dofs[j])
         if foreign.any() and np.abs(vals[foreign]).max() > DIAGONAL_TOL * abs(coef[i]):
-            raise InputError(
-                "the condensed solver needs a diagonal D (one active node per "
-                "constraint row): use --method nts, or mortar with --basis "
-                "dual (on a flat passive surface), or --solver mumps"
-            )
+            bad = bad or (int(B.node_dofs[j, 0]), int(B.node_dofs[j, 1]))
+    _raise_first(
+        comm,
+        bad,
+        "not_diagonal",
+        "the condensed solver needs a diagonal D (one active node per constraint row): use "
+        "--method nts, or mortar with --basis dual (on a flat passive surface), or --solver mumps",
+    )
     return rows, piv, coef
+
+
+def _raise_first(comm: MPI.Comm, bad: tuple[int, int] | None, reason: str, text: str) -> None:
+    """Raise EliminationError on every rank if any rank found a bad row (the smallest dofs)."""
+    found = [b for b in comm.allgather(bad) if b is not None]
+    if found:
+        raise EliminationError(text, min(found), reason)
 
 
 def pivot_rows(
