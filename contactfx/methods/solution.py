@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
 
-from ..contact.geometry import arc_length, nodal_normals
+from ..contact.geometry import arc_length, nodal_normals, project
 from ..discretize.coupling import Multipliers
 from ..discretize.pairs import PairData
 from ..discretize.setup import ContactSetup
@@ -86,6 +86,23 @@ class PairView:
     def x(self) -> np.ndarray:
         """Coordinates of each multiplier row's node."""
         return self.active.surface.x[self.nodes]
+
+    @cached_property
+    def frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(nu, tau, found): the contact frame at each multiplier row's node.
+
+        nu is the passive surface's normal at the node's projection, turned to point out of
+        the active body: the direction the multiplier acts along (every kernel measures the
+        gap along the passive normal). tau is perpendicular to it, along increasing s.
+        Where the node projects beyond the passive surface's end (found False), the active
+        surface's own normal and tangent.
+        """
+        seg, _, found = project(self.x, self.passive.surface)
+        nu = np.where(found[:, None], -self.passive.surface.normals[seg], self.n)
+        t = self.t
+        tau = t - np.einsum("ki,ki->k", t, nu)[:, None] * nu
+        tau /= np.linalg.norm(tau, axis=1)[:, None]
+        return nu, tau, found
 
 
 @dataclass

@@ -111,5 +111,3 @@ def body_stress_deviation(
         v = vals[:, component[0], component[1]]
         out[name] = comm.allreduce(float(np.max(np.abs(v / target - 1.0), initial=0.0)), op=MPI.MAX)
     return out
-
-
