@@ -88,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
             ]
             if "interface" in data:
                 written.append(plot_interface(data, args.out / "interface.png"))
-            log.info("wrote fields (XDMF), %s to %s", ", ".join(p.name for p in written), args.out)
+            log.info("wrote fields.pvtu, %s to %s", ", ".join(p.name for p in written), args.out)
         for line in terminal_summary(data):
             print(line)
     return 0
