@@ -149,8 +149,9 @@ class ContactSetup:
         return (
             f"bod{'ies' if len(names) > 1 else 'y'} {', '.join(names)} "
             f"{'are' if len(names) > 1 else 'is'} held by no support and no contact "
-            f"{when}{pairs}: their position is undetermined (K is singular); check that each "
-            "[[contact]] pair names two surfaces that touch, or add a [[dirichlet]] support"
+            f"{when}{pairs}: {'their' if len(names) > 1 else 'its'} position is undetermined "
+            "(K is singular); check that each [[contact]] pair names two surfaces that touch, "
+            "or add a [[dirichlet]] support"
         )
 
     def destroy(self) -> None:
