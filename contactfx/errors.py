@@ -25,6 +25,20 @@ class SolverError(ContactFxError):
     """A linear solve diverged (PETSc's reason is in the message)."""
 
 
+class EliminationError(InputError):
+    """A solver cannot eliminate a contact row (raised on every rank alike).
+
+    Attributes:
+        node_dofs: The global (x, y) dofs of the active node of the first such row; the
+            caller, which knows the pairs, names the pair from them.
+        reason: "prescribed" (the node has no free dof to eliminate).
+    """
+
+    def __init__(self, message: str, node_dofs: tuple[int, int], reason: str) -> None:
+        super().__init__(message)
+        self.node_dofs, self.reason = node_dofs, reason
+
+
 class ActiveSetError(ContactFxError):
     """The active-set iteration cycled or hit its iteration limit."""
 

@@ -42,7 +42,7 @@ def test_blocks_nts_writes_schema(tmp_path) -> None:
     n = data["multipliers"]
     assert all(len(data["interface"][k]) == n for k in ("x", "pressure", "sigma_yy_1"))
     assert data["contact_force"] == pytest.approx(150.0, rel=1e-10)
-    assert (tmp_path / "fields" / "displacement.xdmf").exists()
+    assert (tmp_path / "fields" / "fields.pvtu").exists()
     assert (tmp_path / "fields" / "interface.png").stat().st_size > 10_000
 
 

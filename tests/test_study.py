@@ -28,7 +28,7 @@ from conftest import ROOT, run_cli
 
 from contactfx.scenes import HertzParams, hertz
 from contactfx.study import Level, run_study
-from contactfx.study.measures import fit_rate, fit_rate_to_reference
+from contactfx.study.measures import fit_rate
 
 SCENES = ROOT / "tests" / "scenes"
 RATE_BAND = (0.6, 1.3)
@@ -84,18 +84,6 @@ def test_fit_rate_recovers_a_noisy_power_law() -> None:
     # Round-off (mortar on a patch test) and missing errors are no data points.
     assert fit_rate(h[:3], [4e-2, 2e-2, 1e-12]) == pytest.approx(1.0)
     assert fit_rate(h[:2], [4e-2, None]) is None
-
-
-def test_rate_against_a_finer_reference() -> None:
-    """Differences from the finest level, C (h^r - h_ref^r): the rate within 0.05 of r,
-    where the plain slope overstates it; differences that do not vanish give 0."""
-    rng = np.random.default_rng(3)
-    h = 0.1 / 2.0 ** np.arange(5)
-    for rate in (1.0, 1.5, 2.0):
-        diff = 2.0 * (h[:-1] ** rate - h[-1] ** rate) * np.exp(rng.normal(0.0, 0.02, 4))
-        assert abs(fit_rate_to_reference(h[:-1], diff, h[-1]) - rate) < 0.05
-        assert fit_rate(h[:-1], diff) > rate + 0.1
-    assert fit_rate_to_reference(h[:-1], [0.03, 0.029, 0.028, 0.0275], h[-1]) == 0.0
 
 
 def test_hertz_study_rates_in_the_band(hertz_serial: tuple[dict, str, Path]) -> None:

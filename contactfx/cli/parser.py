@@ -166,8 +166,8 @@ def _solve_parser(sub: Any) -> None:
     o.add_argument(
         "--out",
         type=Path,
-        help="directory for XDMF fields, contact surfaces (VTK) "
-        "and one interface figure per contact pair",
+        help="directory for the fields (fields.pvtu: u, sigma, E; pyvista and ParaView), "
+        "the contact surfaces (VTK) and one interface figure per contact pair",
     )
     o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
 

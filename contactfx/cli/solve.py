@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
                     sol, args.out / "fields.png", scale=1.0, window=contact_window(data)
                 )
                 written += [picture] if picture is not None else []
-            log.info("wrote fields (XDMF), %s to %s", ", ".join(p.name for p in written), args.out)
+            log.info("wrote fields.pvtu, %s to %s", ", ".join(p.name for p in written), args.out)
         for line in terminal_summary(data):
             print(line)
     return 0

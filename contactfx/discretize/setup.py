@@ -11,6 +11,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..contact import ContactOperator, Kernel
+from ..contact.geometry import nodal_normals
 from ..errors import GeometryError, SingularSystemError
 from ..options import Basis
 from ..scenes import Body, Scene
@@ -32,8 +33,11 @@ from .obstacles import (
     node_free_rows,
 )
 from .pairs import GatheredPair, PairData, build_pairs, gather_pairs, stack
-from .supports import check_held
+from .supports import Holding, check_held, holding
 from .surfaces import check_facing
+
+# An active row whose traction is below this fraction of the largest holds nothing.
+HOLDING_RTOL = 1e-9
 
 
 @dataclass
@@ -52,6 +56,9 @@ class ContactSetup:
     w: np.ndarray  # weights of the rows owned here
     h: float  # median contact weight (about the contact element size)
     needs_contact: list[Body]  # bodies whose supports alone leave a rigid mode free
+    holding: Holding  # the bodies' rigid frames and what their supports fix
+    row_normal: np.ndarray  # (n, 2) active-surface normal at every multiplier row (global)
+    row_bodies: np.ndarray  # (n, 2) body indices (active, passive side) of every row
 
     def normalized_gap(self, u: fem.Function) -> np.ndarray:
         """Nodal gap (weighted gap / weight) of the owned rows at displacement u."""
@@ -84,6 +91,76 @@ class ContactSetup:
                 f"body '{self.needs_contact[0].name}' is not held by its supports alone and no "
                 "node is in contact (empty active set): the load pulls the bodies apart"
             )
+
+    def loaded(self, active: np.ndarray, lam: np.ndarray) -> np.ndarray:
+        """Rows of `active` (owned) whose traction carries load (above round-off of the largest).
+
+        Only active rows count: penalty's traction -eps g is large and negative elsewhere.
+        """
+        on = np.asarray(active, dtype=bool)
+        big = float(np.max(np.abs(lam[on]), initial=0.0))
+        lam_max = self.comm.allreduce(big, op=MPI.MAX)
+        return on & (lam > HOLDING_RTOL * lam_max)
+
+    def check_held_by(self, holds: np.ndarray, when: str, detail: np.ndarray | None = None) -> None:
+        """Raise SingularSystemError if the rows `holds` (owned) leave a body free.
+
+        A body whose supports leave a rigid mode free must be held by contact rows (taken
+        as bilateral). `detail` (owned rows): if the check fails, the bodies named are
+        those that `holds & detail` leaves free (e.g. counting only rows that carried load
+        in the last solve: a body pressed by nothing is lost too). `when` says which set.
+        """
+        if not self.needs_contact:
+            return
+        free, glob = self._free_modes(holds)
+        loose = self.holding.loose(free)
+        if not loose:
+            return
+        if detail is not None:
+            free, glob = self._free_modes(holds & detail)
+            loose = self.holding.loose(free)
+        raise SingularSystemError(self._floating_message(loose, free, glob, when))
+
+    def _free_modes(self, holds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(free rigid modes, the global mask) of supports plus the owned rows `holds`."""
+        glob = np.zeros(self.layout.size, dtype=bool)
+        for idx, vals in self.comm.allgather((self.layout.mine, np.asarray(holds, dtype=bool))):
+            glob[idx] = vals
+        rows = np.flatnonzero(glob)
+        hold = self.holding
+        contact = hold.contact_rows(
+            self.layout.x[rows],
+            self.row_normal[rows],
+            self.row_bodies[rows, 0],
+            self.row_bodies[rows, 1],
+        )
+        return hold.free_modes(contact), glob
+
+    def _floating_message(
+        self, loose: list[int], free: np.ndarray, holds: np.ndarray, when: str
+    ) -> str:
+        """One line: the loose bodies, their free motion and the pairs that lost contact."""
+        hold = self.holding
+        names = [f"'{hold.bodies[k].name}' ({hold.describe(free, k)})" for k in loose]
+        lost = [
+            f"{p.index} ({p.pair.active} on {p.pair.passive})"
+            for p in self.pairs
+            if {hold.index(p.active_body), hold.index(p.passive_body)} & set(loose)
+            and not holds[self.layout.pair == p.index].any()
+        ]
+        pairs = (
+            f": pair{'s' * (len(lost) > 1)} {', '.join(lost)} "
+            f"{'carry' if len(lost) > 1 else 'carries'} no load"
+            if lost
+            else ""
+        )
+        return (
+            f"bod{'ies' if len(names) > 1 else 'y'} {', '.join(names)} "
+            f"{'are' if len(names) > 1 else 'is'} held by no support and no contact "
+            f"{when}{pairs}: {'their' if len(names) > 1 else 'its'} position is undetermined "
+            "(K is singular); check that each [[contact]] pair names two surfaces that touch, "
+            "or add a [[dirichlet]] support"
+        )
 
     def destroy(self) -> None:
         """Free B (K and f belong to the elasticity, which the solution keeps for its fields)."""
@@ -211,9 +288,11 @@ def prepare_contact(
             )
     # Checked at their reference positions, the obstacles now take their prescribed motion.
     op = moved(op, pairs)
+    hold = holding(scene, V, el.bc_dofs)
     needs_contact = check_held(
-        scene, V, el.bc_dofs, [(p.active_body, p.passive_body, p.active) for p in pairs]
+        scene, V, el.bc_dofs, [(p.active_body, p.passive_body, p.active) for p in pairs], hold
     )
+    row_normal, row_bodies = row_frames(pairs, layout, hold)
     mine = layout.mine
     return ContactSetup(
         comm,
@@ -228,4 +307,21 @@ def prepare_contact(
         w_all[mine],
         h,
         needs_contact,
+        hold,
+        row_normal,
+        row_bodies,
     )
+
+
+def row_frames(
+    pairs: list[PairData], layout: Multipliers, hold: Holding
+) -> tuple[np.ndarray, np.ndarray]:
+    """(normal (n, 2), body indices (n, 2)) of every multiplier row, in the layout order."""
+    normal = np.zeros((layout.size, 2))
+    bodies = np.zeros((layout.size, 2), dtype=np.int64)
+    for p in pairs:
+        rows = np.flatnonzero(layout.pair == p.index)
+        nodes = np.searchsorted(p.active.gblock, layout.gblock[rows])
+        normal[rows] = nodal_normals(p.active.surface)[nodes]
+        bodies[rows] = (hold.index(p.active_body), hold.index(p.passive_body))
+    return normal, bodies

@@ -9,6 +9,8 @@ obstacle is a body that does not move: its pairs' rows hold the active body alon
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
@@ -121,29 +123,6 @@ def _dirichlet_rows(
     return np.vstack(scene.comm.allgather(local))
 
 
-def _contact_rows(
-    scene: Scene, pairs: list[Contact], centres: np.ndarray, sizes: np.ndarray
-) -> np.ndarray:
-    """Rows n . (m_active - m_passive) at the active nodes of every pair (gathered data)."""
-    index = {b.name: k for k, b in enumerate(scene.bodies)}
-    rows = []
-    for active_body, passive_body, active in pairs:
-        surf = active.surface
-        n = nodal_normals(surf)
-        a = index[active_body.name]
-        r = np.zeros((surf.n_nodes, 3 * len(scene.bodies)))
-        r[:, 3 * a : 3 * a + 3] = np.einsum(
-            "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[a], sizes[a])
-        )
-        if passive_body is not None:
-            q = index[passive_body.name]
-            r[:, 3 * q : 3 * q + 3] -= np.einsum(
-                "nd,ndm->nm", n, rigid_modes_at(surf.x, centres[q], sizes[q])
-            )
-        rows.append(r)
-    return np.vstack(rows)
-
-
 def _free_modes(rows: np.ndarray, ncols: int) -> np.ndarray:
     """Orthonormal basis (k, ncols) of the modes that every row leaves free."""
     if rows.shape[0] == 0:
@@ -166,25 +145,101 @@ def _describe(mode: np.ndarray) -> str:
     return f"translation along ({d[0]:.3g}, {d[1]:.3g})"
 
 
-def check_held(
-    scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray, pairs: list[Contact]
-) -> list[Body]:
-    """Raise SingularSystemError if a body can move freely; return those needing contact."""
+@dataclass(frozen=True)
+class Holding:
+    """The bodies' rigid frames and the conditions their supports put on the rigid modes.
+
+    Column 3 k + m of a row is mode m of body k; `dirichlet` holds one row per Dirichlet
+    dof (gathered from every rank). Contact rows come from `contact_rows`.
+    """
+
+    bodies: tuple[Body, ...]
+    centres: np.ndarray  # (nb, 2)
+    sizes: np.ndarray  # (nb,)
+    dirichlet: np.ndarray  # (k, 3 nb)
+
+    def index(self, body: Body | None) -> int:
+        """Column block of `body`; -1 for a rigid obstacle (None: fixed, no modes of its own)."""
+        if body is None:
+            return -1
+        return next(k for k, b in enumerate(self.bodies) if b.name == body.name)
+
+    def contact_rows(
+        self, x: np.ndarray, n: np.ndarray, active: np.ndarray, passive: np.ndarray
+    ) -> np.ndarray:
+        """Rows n . (m_active - m_passive) at points x with normals n (bilateral contact).
+
+        `active`, `passive`: the body index of each point's two sides (-1: a rigid obstacle,
+        which holds like a fixed body).
+        """
+        nb = len(self.bodies)
+        rows = np.zeros((len(x), 3 * nb))
+        for k in range(nb):
+            for side, sign in ((active, 1.0), (passive, -1.0)):
+                sel = np.flatnonzero(side == k)
+                if sel.size:
+                    m = rigid_modes_at(x[sel], self.centres[k], self.sizes[k])
+                    cols = slice(3 * k, 3 * k + 3)
+                    rows[sel, cols] += sign * np.einsum("nd,ndm->nm", n[sel], m)
+        return rows
+
+    def free_modes(self, contact: np.ndarray | None = None) -> np.ndarray:
+        """Orthonormal basis of the modes the supports (and `contact` rows) leave free."""
+        rows = self.dirichlet if contact is None else np.vstack([self.dirichlet, contact])
+        return _free_modes(rows, 3 * len(self.bodies))
+
+    def loose(self, free: np.ndarray) -> list[int]:
+        """Indices of the bodies that take part in a free mode."""
+        return [
+            k
+            for k in range(len(self.bodies))
+            if free.size and np.abs(free[:, 3 * k : 3 * k + 3]).max() > 1e-6
+        ]
+
+    def needs_contact(self) -> list[Body]:
+        """The bodies whose supports alone leave a rigid mode free."""
+        return [self.bodies[k] for k in self.loose(self.free_modes())]
+
+    def describe(self, free: np.ndarray, k: int) -> str:
+        """The free motion of body k (its largest part in the free modes)."""
+        part = free[:, 3 * k : 3 * k + 3]
+        return _describe(free[int(np.argmax(np.linalg.norm(part, axis=1))), 3 * k : 3 * k + 3])
+
+
+def holding(scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray) -> Holding:
+    """The rigid frames of the scene's bodies and the rows of their Dirichlet conditions."""
     owned, centres, sizes = _body_frames(scene, V)
-    nb = len(scene.bodies)
     rows_d = _dirichlet_rows(scene, V, bc_dofs, owned, centres, sizes)
-    free_d = _free_modes(rows_d, 3 * nb)
-    free = _free_modes(np.vstack([rows_d, _contact_rows(scene, pairs, centres, sizes)]), 3 * nb)
+    return Holding(tuple(scene.bodies), centres, sizes, rows_d)
+
+
+def check_held(
+    scene: Scene,
+    V: fem.FunctionSpace,
+    bc_dofs: np.ndarray,
+    pairs: list[Contact],
+    hold: Holding | None = None,
+) -> list[Body]:
+    """Raise SingularSystemError if a body can move freely; return those needing contact.
+
+    Contacts count as bilateral here (the most they can hold); whether the converged
+    active set still holds every body is checked after the loop (setup.check_held_by).
+    """
+    hold = hold or holding(scene, V, bc_dofs)
+    rows = []
+    for active_body, passive_body, active in pairs:
+        surf = active.surface
+        a = np.full(surf.n_nodes, hold.index(active_body))
+        q = np.full(surf.n_nodes, hold.index(passive_body))
+        rows.append(hold.contact_rows(surf.x, nodal_normals(surf), a, q))
+    free = hold.free_modes(np.vstack(rows))
     if free.shape[0]:
         mode = free[0]
+        nb = len(scene.bodies)
         k = int(np.argmax([np.linalg.norm(mode[3 * i : 3 * i + 3]) for i in range(nb)]))
         raise SingularSystemError(
             f"body '{scene.bodies[k].name}' can still move freely after its supports and "
             f"contacts ({_describe(mode[3 * k : 3 * k + 3])}): add a [[dirichlet]] support or a "
             "contact pair that holds it"
         )
-    return [
-        b
-        for k, b in enumerate(scene.bodies)
-        if free_d.size and np.abs(free_d[:, 3 * k : 3 * k + 3]).max() > 1e-6
-    ]
+    return hold.needs_contact()

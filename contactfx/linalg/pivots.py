@@ -22,7 +22,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from mpi4py import MPI
 
-from ..errors import InputError
+from ..errors import EliminationError
 from .elimination import LocalRows, PivotRows
 
 # Off-diagonal entries of B_AP up to this (relative to the row's pivot) are round-off of a
@@ -32,20 +32,31 @@ DIAGONAL_TOL = 1e-10
 DROP = 1e-16
 
 
-def _own_pivots(B: LocalRows, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each row's pivot dof (its own node's component of largest |coefficient|) and value."""
+def _own_pivots(B: LocalRows, rows: np.ndarray, comm: MPI.Comm) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's pivot dof (its own node's component of largest |coefficient|) and value.
+
+    EliminationError on every rank if a row's node has no free dof (it carries that node's
+    dofs: the linear algebra knows no pairs, the caller names the pair).
+    """
     piv = np.zeros(len(rows), dtype=np.int64)
     coef = np.zeros(len(rows))
+    bad: tuple[int, int] | None = None
     for i, j in enumerate(rows):
         cols, vals = B.row(j)
         own = np.isin(cols, B.node_dofs[j])
         if not own.any() or np.abs(vals[own]).max() == 0.0:
-            raise InputError(
-                "the condensed solver cannot eliminate a contact row whose "
-                "active node is fully prescribed: use --solver mumps"
-            )
+            bad = bad or (int(B.node_dofs[j, 0]), int(B.node_dofs[j, 1]))
+            continue
         k = np.flatnonzero(own)[int(np.argmax(np.abs(vals[own])))]
         piv[i], coef[i] = cols[k], vals[k]
+    found = [b for b in comm.allgather(bad) if b is not None]
+    if found:
+        raise EliminationError(
+            "the condensed solver cannot eliminate a contact row whose active node is fully "
+            "prescribed: use --solver mumps",
+            min(found),
+            "prescribed",
+        )
     return piv, coef
 
 
@@ -105,7 +116,7 @@ def pivots(B: LocalRows, active: np.ndarray, comm: MPI.Comm, r0: int, n: int) ->
     `r0`: this rank's first displacement dof; `n`: the number of displacement dofs.
     """
     rows = np.flatnonzero(active)
-    piv, coef = _own_pivots(B, rows)
+    piv, coef = _own_pivots(B, rows, comm)
     all_piv = np.concatenate(comm.allgather(piv))
     counts = comm.allgather(len(rows))
     mine = slice(sum(counts[: comm.rank]), sum(counts[: comm.rank + 1]))

@@ -50,13 +50,24 @@ _REUSE_KSP: Mapping[str, object] = {
 }
 
 
-def _ksp_options(options: Mapping[str, object], reuse: bool, rank: int) -> dict[str, object]:
-    """The options, with the reuse GMRES's in place of the KSP's own (a log line says so)."""
+def _reuse_options(options: Mapping[str, object], reuse: bool, say: bool) -> dict[str, object]:
+    """The options with the reused factorization's GMRES keys; say which ones it overrides.
+
+    A direct preset's own ksp_type=preonly is replaced by design (not worth a line); any
+    other option the reuse overrides was the user's.
+    """
     if not reuse:
         return dict(options)
-    replaced = sorted(k for k in options if k in _REUSE_KSP)
-    if replaced and rank == 0:
-        log.info("saddle solver: the factorization's GMRES sets %s", ", ".join(replaced))
+    replaced = sorted(
+        f"{k}={v}"
+        for k, v in options.items()
+        if k in _REUSE_KSP and (k, v) != ("ksp_type", "preonly")
+    )
+    if replaced and say:
+        log.info(
+            "saddle solver: %s ignored (the reused factorization runs its own GMRES)",
+            ", ".join(replaced),
+        )
     return {**options, **_REUSE_KSP}
 
 
@@ -90,7 +101,8 @@ class SaddleSolver:
         self.stats = {"reused": 0, "setup_time": 0.0}
         self._mpi = K.getComm().tompi4py()
         self._m = SaddleBlocks(K, B, f, gamma, nullspace, schur_user)
-        self._options = PrefixedOptions(_ksp_options(options, self.policy.reuse, self._mpi.rank))
+        keys = _reuse_options(options, self.policy.reuse, self._mpi.rank == 0)
+        self._options = PrefixedOptions(keys)
         self._ksp = PETSc.KSP().create(K.getComm())
         self._ksp.setOptionsPrefix(self._options.prefix)
         self._fieldsplit = fieldsplit

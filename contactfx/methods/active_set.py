@@ -152,6 +152,14 @@ class Step:
     text: str = ""  # extra words for the log line
 
 
+@dataclass(frozen=True)
+class Proposal:
+    """A next set other than the update's, and why (for the log line)."""
+
+    active: np.ndarray  # owned rows
+    why: str
+
+
 class Iteration(Protocol):
     """What a method gives the loop: a solve on a set and, optionally, a better next set."""
 
@@ -166,9 +174,17 @@ class Iteration(Protocol):
         """Solve with `active` (owned rows) in contact."""
         ...
 
-    def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The set to solve next instead of `step.new_active` (None: take the update)."""
         ...
+
+
+def held_by_last(
+    setup: ContactSetup, prev: tuple[np.ndarray, np.ndarray] | None, when: str
+) -> None:
+    """Before a loop gives up: a floating body (singular solves) is the error to report."""
+    if prev is not None:
+        setup.check_held_by(setup.loaded(*prev), f"in the last solve ({when})")
 
 
 def run_active_set(
@@ -184,10 +200,19 @@ def run_active_set(
     history: History = []
     entered = left = 0
     resid = np.nan
+    prev: tuple[np.ndarray, np.ndarray] | None = None  # the last set solved, its tractions
     for it in range(1, aso.max_iterations + 1):
         n_active = comm.allreduce(int(active.sum()))
         setup.check_not_floating(n_active)
-        state.visit(active, it, n_active, iteration.probing)
+        # A set that leaves a body free makes the solve singular: name the bodies (and, by
+        # the last solve's tractions, those held only by rows that carried nothing).
+        carried = None if prev is None else ~prev[0] | setup.loaded(*prev)
+        setup.check_held_by(active, f"in the active set of iteration {it}", carried)
+        try:
+            state.visit(active, it, n_active, iteration.probing)
+        except ActiveSetError:
+            held_by_last(setup, prev, "when the active set started to cycle")
+            raise
         t0 = time.perf_counter()
         with timers("solve"):
             step = iteration.solve(active, it)
@@ -195,20 +220,32 @@ def run_active_set(
         resid = step.residual
         entered = comm.allreduce(int(np.sum(step.new_active & ~active)))
         left = comm.allreduce(int(np.sum(active & ~step.new_active)))
-        history.append(
-            {
-                "iteration": it,
-                "active": n_active,
-                "entered": entered,
-                "left": left,
-                "residual": resid,
-                **step.record,
-                "solve_time": t_solve,
-            }
-        )
+        record: dict[str, float | None] = {
+            "iteration": it,
+            "active": n_active,
+            "entered": entered,
+            "left": left,
+            "residual": resid,
+            **step.record,
+            "solve_time": t_solve,
+        }
+        history.append(record)
+        stationary = entered == 0 and left == 0
+        proposal = None if stationary else iteration.next_set(active, step, entered)
+        after = ""
+        if proposal is not None:
+            # The next set is not the update's: say how it differs from this one, so that
+            # the next line's count adds up.
+            added = comm.allreduce(int(np.sum(proposal.active & ~active)))
+            released = comm.allreduce(int(np.sum(active & ~proposal.active)))
+            record["next_added"], record["next_released"] = added, released
+            after = (
+                f"; next set: {proposal.why}, +{added} -{released} -> "
+                f"{n_active + added - released} active"
+            )
         if comm.rank == 0:
             log.info(
-                "%s %2d: %5d active, +%d -%d, %s%.3f s",
+                "%s %2d: %5d active, +%d -%d, %s%.3f s%s",
                 iteration.label,
                 it,
                 n_active,
@@ -216,17 +253,20 @@ def run_active_set(
                 left,
                 step.text,
                 t_solve,
+                after,
             )
-        if entered == 0 and left == 0:
+        if stationary:
             if resid > aso.tolerance:
                 raise ActiveSetError(
                     f"active set is stationary at iteration {it} but the "
                     f"complementarity residual {resid:.2e} exceeds "
                     f"{aso.tolerance:.1e}: the linear solves are too inexact"
                 )
+            setup.check_held_by(setup.loaded(active, step.lam), "at the converged solution")
             return step, active, history
-        proposed = iteration.next_set(active, step, entered)
-        active = step.new_active if proposed is None else proposed
+        prev = (active, step.lam)
+        active = step.new_active if proposal is None else proposal.active
+    held_by_last(setup, prev, f"after {aso.max_iterations} iterations")
     raise ActiveSetError(
         f"active set did not converge in {aso.max_iterations} iterations "
         f"(last change: +{entered} -{left}, residual {resid:.2e})"

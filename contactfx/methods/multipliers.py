@@ -19,12 +19,19 @@ from mpi4py import MPI
 
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..discretize.supports import rigid_body_modes
-from ..errors import InputError
+from ..errors import EliminationError, InputError
 from ..linalg import LinearSolver, SaddleResult
 from ..options import Basis, Method, SolverKind, SolverSpec, solver_spec
 from ..scenes import Scene
 from ..timers import Timers
-from .active_set import ActiveSetOptions, InitialSet, SetHistory, Step, run_active_set
+from .active_set import (
+    ActiveSetOptions,
+    InitialSet,
+    Proposal,
+    SetHistory,
+    Step,
+    run_active_set,
+)
 from .solution import Solution, finish
 from .solvers import make_solver
 
@@ -107,7 +114,10 @@ class MultiplierIteration:
         """One saddle-point solve on `active`, with the probe responses if probing."""
         comm = self.setup.comm
         g = self.setup.g
-        res = self.solver.solve(g, active, fresh=self.probe is not None)
+        try:
+            res = self.solver.solve(g, active, fresh=self.probe is not None)
+        except EliminationError as err:
+            raise InputError(refusal(self.setup, err)) from None
         self._probes = None
         if self.probe is not None:
             self._probes = self.solver.responses(self.state.probe_rhs(self.probe), active)
@@ -147,7 +157,7 @@ class MultiplierIteration:
         # scales the test, so the update is lambda > 0 on active, penetration on inactive.
         return lam, gap, lam - self.c * gap > 0
 
-    def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The predicted set after a probing solve, or the union to probe; None otherwise."""
         comm = self.setup.comm
         if self.probe is not None:
@@ -160,7 +170,10 @@ class MultiplierIteration:
             if predicted is None:
                 self._say("the probes' complementarity problem has no solution: plain update")
                 return None
-            return None if np.array_equal(predicted, active) else predicted
+            # Collective: every rank must take the same branch (the loop logs the change).
+            if comm.allreduce(bool(np.array_equal(predicted, active)), op=MPI.LAND):
+                return None
+            return Proposal(predicted, "the probes' complementarity problem")
         if self.aso.predictor and self.direct and not (entered == 0 and self.given_start):
             # Probe the union of the current and the updated set: on the Hertz scene the plain
             # update adds every penetrating node and then drops one or two edge nodes per
@@ -175,7 +188,7 @@ class MultiplierIteration:
             n_cand = comm.allreduce(int(cand.sum()))
             if 0 < n_new and n_cand <= self.aso.max_probes:
                 self.probe = self.state.global_indices(cand)
-                return union
+                return Proposal(union, "both sets' union, probed")
             if n_cand > self.aso.max_probes:
                 self._say(f"{n_cand} candidates exceed max_probes: plain update")
         return None
@@ -184,6 +197,21 @@ class MultiplierIteration:
         """A log line for a fallback of the probe policy (rank 0)."""
         if self.setup.comm.rank == 0:
             log.info("%s: %s", self.label, text)
+
+
+def refusal(setup: ContactSetup, err: EliminationError) -> str:
+    """The condensed solver's refusal with the pair and the reason (the solver knows rows)."""
+    layout = setup.layout
+    rows = np.flatnonzero(layout.gblock == err.node_dofs[0] // 2)
+    if not rows.size:
+        return str(err)
+    p = setup.pairs[int(layout.pair[rows[0]])]
+    x = layout.x[rows[0]]
+    where = f"pair {p.index} ({p.pair.active} on {p.pair.passive}) at ({x[0]:.4g}, {x[1]:.4g})"
+    return (
+        f"the condensed solver cannot eliminate the contact row of {where}: its active "
+        f"node is fully prescribed ({err.reason}); use --solver mumps"
+    )
 
 
 def _solver(setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool) -> LinearSolver:

@@ -26,7 +26,7 @@ from ..linalg.petsc_options import petsc_error_message, petsc_options, reason_na
 from ..options import Method, SolverSpec, solver_spec
 from ..scenes import Scene
 from ..timers import Timers
-from .active_set import ActiveSetOptions, Step, run_active_set
+from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
 from .solution import PenaltyResult, Solution, finish
 
 DEFAULT_FACTOR = 1e3
@@ -149,7 +149,7 @@ class PenaltyIteration:
             text,
         )
 
-    def next_set(self, active: np.ndarray, step: Step, entered: int) -> np.ndarray | None:
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """Always the plain update."""
         return None
 

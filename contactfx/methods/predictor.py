@@ -13,6 +13,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
+from ..logs import stage
 from ..options import Basis, Method, Predictor, SolverKind, SolverSpec
 from ..scenes import Scene
 from ..timers import Timers
@@ -114,7 +115,7 @@ def predict(
         if scene.comm.rank == 0:
             log.info("coarse predictor: the scene cannot be remeshed, starting without it")
         return None
-    with timers("predictor"):
+    with timers("predictor"), stage("predictor"):
         coarse = scene.remeshed(coarse_factor(spec))
         sol = solve_contact(coarse, method, spec, aso, basis=basis, label="predictor")
         return coarse_initial_set(sol, margin=coarse_margin(spec))

@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
 
-from ..contact.geometry import arc_length, nodal_normals
+from ..contact.geometry import arc_length, nodal_normals, project
 from ..discretize.coupling import Multipliers
 from ..discretize.pairs import PairData
 from ..discretize.setup import ContactSetup
@@ -90,6 +90,30 @@ class PairView:
     def x(self) -> np.ndarray:
         """Coordinates of each multiplier row's node."""
         return self.active.surface.x[self.nodes]
+
+    @cached_property
+    def frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(nu, tau, found): the contact frame at each multiplier row's node.
+
+        nu is the passive surface's normal at the node's projection, turned to point out of
+        the active body: the direction the multiplier acts along (every kernel measures the
+        gap along the passive normal). tau is perpendicular to it, along increasing s.
+        Where the node projects beyond the passive surface's end (found False), the active
+        surface's own normal and tangent. Against a rigid obstacle: its exact outward normal
+        at the closest point, turned the same way.
+        """
+        if self.passive is None:
+            assert self.obstacle is not None  # a pair without a passive body has an obstacle
+            closest = self.obstacle.geometry.closest(self.x)
+            found, normal = closest.found, closest.normal
+        else:
+            seg, _, found = project(self.x, self.passive.surface)
+            normal = self.passive.surface.normals[seg]
+        nu = np.where(found[:, None], -normal, self.n)
+        t = self.t
+        tau = t - np.einsum("ki,ki->k", t, nu)[:, None] * nu
+        tau /= np.linalg.norm(tau, axis=1)[:, None]
+        return nu, tau, found
 
 
 @dataclass

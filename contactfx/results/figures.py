@@ -5,6 +5,7 @@ The deformed-field picture is like the paper's Fig. 3; the charts read the JSON 
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +33,10 @@ def deformed_fields(
     from dolfinx import plot
 
     pyvista.OFF_SCREEN = True
+    if not os.environ.get("DISPLAY"):
+        # Without an X server VTK tries X first and warns ("bad X server connection")
+        # before it falls back to EGL: ask for EGL directly (unless the user chose).
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     V = sol.fields.V
     # vtk_mesh is a singledispatch function: mypy sees only its Mesh signature.
     topology, cell_types, x = plot.vtk_mesh(V)  # type: ignore[arg-type]
@@ -105,6 +110,20 @@ def contact_window(data: dict[str, Any]) -> tuple[float, float, float, float] | 
     return (cx - half, cx + half, cy - half, cy + half)
 
 
+def contact_zoom(s: np.ndarray, active: np.ndarray) -> tuple[float, float] | None:
+    """Limits around the active zone of a contact line (None if nothing is active).
+
+    The zone plus half its length (at least three node spacings) on each side, within the
+    line.
+    """
+    if not active.any():
+        return None
+    lo, hi = float(s[active].min()), float(s[active].max())
+    spacing = float(np.median(np.diff(np.unique(s)))) if len(np.unique(s)) > 1 else 0.0
+    margin = max(0.5 * (hi - lo), 3.0 * spacing)
+    return max(float(np.nanmin(s)), lo - margin), min(float(np.nanmax(s)), hi + margin)
+
+
 def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
     """Chart sigma_yy of both bodies and the contact pressure along the contact line."""
     import matplotlib
@@ -135,6 +154,10 @@ def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
             label="-pressure, exact 2D Hertz",
         )
         ax.set_xlim(0.0, 2.0 * a)
+    else:
+        zoom = contact_zoom(x, np.asarray(itf["pressure"], dtype=float) > 0.0)
+        if zoom is not None:
+            ax.set_xlim(*zoom)
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("MPa")
     ax.set_title(title or f"{data['scene']} / {data['method']}: contact line")
@@ -190,6 +213,10 @@ def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
         )
         ax.set_xlim(sc - 2.0 * a, sc + 2.0 * a)
     active = np.asarray(itf["active"], dtype=bool)
+    zoom = None if hertz else contact_zoom(s, active)
+    if zoom is not None:
+        # No reference to place: zoom on the contact zone, as the Hertz charts do.
+        ax.set_xlim(*zoom)
     if active.any():
         ax.axvspan(s[active].min(), s[active].max(), color="0.9", zorder=0, label="active set")
     ax.set_ylabel("normal traction (compression > 0)")

@@ -1,4 +1,4 @@
-"""Write what a run produced: the JSON summary (atomically), XDMF fields, contact polylines."""
+"""Write what a run produced: the JSON summary (atomically), the fields, contact polylines."""
 
 from __future__ import annotations
 
@@ -25,21 +25,87 @@ def write_json(path: Path, data: dict[str, Any]) -> None:
     os.replace(tmp, path)
 
 
-def write_fields(sol: Solution, outdir: Path) -> list[Path]:
-    """Write u, the DG0 stress tensor and E as XDMF (open in ParaView)."""
-    from dolfinx.io import XDMFFile
+def field_grid(sol: Solution) -> Any:
+    """This rank's owned cells as a pyvista grid: u (points), sigma and E (cells).
 
-    outdir.mkdir(parents=True, exist_ok=True)
-    msh = sol.scene.mesh
-    s = sigma_field(sol)
-    written = []
-    for name, fn in (("displacement", sol.u), ("stress", s), ("E", sol.fields.E)):
-        path = outdir / f"{name}.xdmf"
-        with XDMFFile(msh.comm, path, "w") as xf:
-            xf.write_mesh(msh)
-            xf.write_function(fn)
-        written.append(path)
-    return written
+    u is padded to 3 components and sigma to the 3 x 3 tensor (9 components, z zero),
+    which is how ParaView reads vectors and tensors. The points are this rank's dofs (Q1:
+    the vertices), ghosts included where an owned cell needs them.
+    """
+    import pyvista
+    from dolfinx import plot
+
+    V = sol.fields.V
+    msh = V.mesh
+    ncells = msh.topology.index_map(msh.topology.dim).size_local
+    # vtk_mesh is a singledispatch function: mypy sees only its Mesh signature.
+    topology, cell_types, x = plot.vtk_mesh(V)  # type: ignore[arg-type]
+    width = 5  # VTK_QUAD: a count and four points per cell
+    grid = pyvista.UnstructuredGrid(topology[: width * ncells], cell_types[:ncells], x)
+    u = sol.u.x.array.reshape(-1, 2)
+    grid.point_data["u"] = np.column_stack([u, np.zeros(len(u))])
+    sig = sigma_field(sol)
+    # DG0 values by each cell's own dof (not assumed to equal the cell index).
+    s = sig.x.array.reshape(-1, 4)[sig.function_space.dofmap.list[:ncells, 0]]
+    tensor = np.zeros((ncells, 9))
+    tensor[:, [0, 1, 3, 4]] = s
+    grid.cell_data["sigma"] = tensor
+    E = sol.fields.E
+    grid.cell_data["E"] = E.x.array[E.function_space.dofmap.list[:ncells, 0]]
+    return grid
+
+
+def write_fields(sol: Solution, outdir: Path) -> list[Path]:
+    """Write u, the DG0 stress tensor and E as fields.pvtu: one binary .vtu piece per rank.
+
+    pyvista (pyvista.read) and ParaView open it. Measured at 400k DOFs (serial): 0.5 s,
+    25 MB; DOLFINx's XDMF took 0.35 s but pyvista's XDMF reader crashes on it, its VTKFile
+    (ASCII) 7.6 s, its VTKHDF names every array "u" and its VTX (.bp) pyvista cannot read.
+    """
+    comm = sol.scene.comm
+    if comm.rank == 0:
+        outdir.mkdir(parents=True, exist_ok=True)
+    comm.Barrier()
+    grid = field_grid(sol)
+    piece = outdir / f"fields_p{comm.rank}.vtu"
+    # lz4: 3x faster than zlib for 1.6x the size (0.3 s against 0.9 s at 400k DOFs).
+    grid.save(str(piece), binary=True, compression="lz4")
+    pieces = comm.gather(piece.name)
+    main = outdir / "fields.pvtu"
+    if comm.rank == 0:
+        assert pieces is not None
+        main.write_text(_pvtu(grid, pieces))
+    comm.Barrier()
+    return [main]
+
+
+def _pvtu(grid: Any, pieces: list[str]) -> str:
+    """The parallel file that names every piece and declares their arrays."""
+
+    def arrays(data: Any) -> str:
+        return "".join(
+            f'<PDataArray type="{_vtk_type(data[k])}" Name="{k}" '
+            f'NumberOfComponents="{1 if data[k].ndim == 1 else data[k].shape[1]}"/>'
+            for k in data
+        )
+
+    return (
+        '<?xml version="1.0"?>\n<VTKFile type="PUnstructuredGrid" version="1.0" '
+        'byte_order="LittleEndian" header_type="UInt64">\n<PUnstructuredGrid GhostLevel="0">\n'
+        f"<PPointData>{arrays(grid.point_data)}</PPointData>\n"
+        f"<PCellData>{arrays(grid.cell_data)}</PCellData>\n"
+        f'<PPoints><PDataArray type="{_vtk_type(grid.points)}" NumberOfComponents="3"/>'
+        "</PPoints>\n"
+        + "".join(f'<Piece Source="{p}"/>\n' for p in pieces)
+        + "</PUnstructuredGrid>\n</VTKFile>\n"
+    )
+
+
+def _vtk_type(a: np.ndarray) -> str:
+    """VTK's name of a numpy dtype (the pieces' arrays are float64 here)."""
+    return {"float64": "Float64", "float32": "Float32", "int64": "Int64", "int32": "Int32"}[
+        str(np.asarray(a).dtype)
+    ]
 
 
 def write_contact_surfaces(data: dict[str, Any], outdir: Path) -> list[Path]:

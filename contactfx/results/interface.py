@@ -1,8 +1,12 @@
 """Quantities users read off a solution, pair by pair: stresses along the normal, forces.
 
 Stresses are each body's own FE stress, averaged at the surface nodes over the adjacent
-cells, resolved on the active surface's outward normal n and the tangent t (the direction of
-increasing arc length s along the active surface).
+cells. Each body's traction sigma.m (m its outward normal, the passive one's turned to point
+out of the active body) is resolved on the contact frame of PairView.frame: nu, the normal
+the multipliers act along (the passive surface's), and tau perpendicular to it (the
+direction of increasing arc length s along the active surface). On a frictionless contact
+sigma_nt then tends to 0 and sigma_nn to -p at the discretization's order also on curved
+pairs, where the active surface's own normal differs from nu by the slope (docs/hertz.md).
 The JSON assembly is in results/summary.py.
 """
 
@@ -32,10 +36,12 @@ INTERFACE_FIELDS = (
 )
 
 
-def resolve(sig: np.ndarray, n: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """n.sigma.n and t.sigma.n, row by row."""
-    tr = np.einsum("kij,kj->ki", sig, n)
-    return np.einsum("ki,ki->k", n, tr), np.einsum("ki,ki->k", t, tr)
+def resolve(
+    sig: np.ndarray, m: np.ndarray, nu: np.ndarray, tau: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """nu.sigma.m and tau.sigma.m row by row: the traction on normal m in the frame (nu, tau)."""
+    tr = np.einsum("kij,kj->ki", sig, m)
+    return np.einsum("ki,ki->k", nu, tr), np.einsum("ki,ki->k", tau, tr)
 
 
 def none_if_nan(v: np.ndarray) -> list[float | None]:
@@ -54,7 +60,7 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     """pair_interface, computed (collective)."""
     pv = sol.pairs[k]
     rows = pv.rows
-    n, t, x, s = pv.n, pv.t, pv.x, pv.s
+    n, x, s = pv.n, pv.x, pv.s
     gn_a, _, sig_a = nodal_stress(sol, pv.pair.active)
     sa = sig_a[np.searchsorted(gn_a, pv.gblock)]
     sp = np.full_like(sa, np.nan)  # a rigid obstacle has no stress of its own
@@ -66,8 +72,9 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
         ends = surf_p.segments[seg]
         sp = (1 - xi)[:, None, None] * at_node[ends[:, 0]] + xi[:, None, None] * at_node[ends[:, 1]]
         sp[~found] = np.nan  # beyond the passive surface's end there is no value
-    nn_a, nt_a = resolve(sa, n, t)
-    nn_p, nt_p = resolve(sp, n, t)
+    nu, tau, _ = pv.frame
+    nn_a, nt_a = resolve(sa, n, nu, tau)
+    nn_p, nt_p = resolve(sp, nu, nu, tau)
     order = np.argsort(s, kind="stable")
     values = (x[:, 0], x[:, 1], s, sol.pressure[rows], sol.gap[rows], nn_a, nn_p, nt_a, nt_p)
     cols = dict(zip(INTERFACE_FIELDS, values, strict=True))

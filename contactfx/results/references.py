@@ -17,7 +17,7 @@ from mpi4py import MPI
 
 from ..methods.solution import Solution
 from ..scenes import HertzReference, Scene
-from .interface import pair_interface, resolve
+from .interface import pair_forces, pair_interface, resolve
 from .stress import body_vertex_stress
 
 
@@ -48,10 +48,11 @@ def l2_error(
     return float(np.sqrt(np.trapezoid((ph - pe) ** 2, xs) / np.trapezoid(pe**2, xs)))
 
 
-def reference_values(scene: Scene, ref: HertzReference) -> dict[str, float]:
-    """E*, a and p0 of the pair's materials: 1/E* = sum (1 - nu^2)/E, a = sqrt(4 P R/(pi E*)).
+def reference_values(scene: Scene, ref: HertzReference, P: float) -> dict[str, float]:
+    """E*, a and p0 of the pair's materials under the line load P.
 
-    A rigid obstacle (pair index len(contacts) + i) is infinitely stiff: it adds nothing.
+    1/E* = sum (1 - nu^2)/E, a = sqrt(4 P R/(pi E*)), p0 = 2 P / (pi a). A rigid obstacle
+    (pair index len(contacts) + i) is infinitely stiff: it adds nothing.
     """
     if ref.pair >= len(scene.contacts):
         groups = [scene.obstacles[ref.pair - len(scene.contacts)].surface]
@@ -59,14 +60,27 @@ def reference_values(scene: Scene, ref: HertzReference) -> dict[str, float]:
         groups = [scene.contacts[ref.pair].active, scene.contacts[ref.pair].passive]
     mats = [scene.body_of_curve(g).material for g in groups]
     e_star = 1.0 / sum((1 - m.nu**2) / m.E for m in mats)
-    a = math.sqrt(4 * ref.P * ref.R / (math.pi * e_star))
-    return {"E_star": e_star, "a": a, "p0": 2 * ref.P / (math.pi * a)}
+    a = math.sqrt(4 * P * ref.R / (math.pi * e_star))
+    return {"E_star": e_star, "a": a, "p0": 2 * P / (math.pi * a)}
+
+
+def computed_load(sol: Solution, ref: HertzReference, tangent: np.ndarray) -> float:
+    """The pair's line load: its contact force along the normal at the centre (x2 if halved).
+
+    `tangent` is the active surface's tangent at the contact centre.
+    """
+    force = pair_forces(sol, ref.pair)[0]
+    normal = np.array([-tangent[1], tangent[0]])
+    return float(abs(force @ normal) * (2.0 if ref.symmetric else 1.0))
 
 
 def centre_distance(
     sol: Solution, ref: HertzReference
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(r, pressure, active) of the pair's multipliers, r signed along the centre's tangent."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(r, pressure, active, tc) of the pair's multipliers, r signed along the centre's tangent.
+
+    tc is that tangent (unit).
+    """
     pv = sol.pairs[ref.pair]
     rows = pv.rows
     surf = pv.active.surface
@@ -89,15 +103,16 @@ def centre_distance(
     r = (surf.x[node] - xc) @ tc
     if ref.symmetric and np.any(p > 0) and np.median(r[p > 0]) < 0:
         r = -r  # the centre is the end of largest s: measure into the surface
-    return r, p, act
+    return r, p, act, tc
 
 
 def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> dict[str, object]:
     """The `hertz` block of the JSON: fitted and bracketed half-width, p0 and the L2 error."""
     if ref is None:
         ref = next(r for r in sol.scene.references if isinstance(r, HertzReference))
-    exact = reference_values(sol.scene, ref)
-    r, p, act = centre_distance(sol, ref)
+    r, p, act, tc = centre_distance(sol, ref)
+    load = ref.P if ref.P is not None else computed_load(sol, ref, tc)
+    exact = reference_values(sol.scene, ref, load)
     order = np.argsort(r, kind="stable")
     r, p, act = r[order], p[order], act[order]
     ra = np.abs(r[act])
@@ -111,6 +126,8 @@ def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> dict[str,
         "p0": float(p.max()),
         "p0_exact": exact["p0"],
         "E_star": exact["E_star"],
+        "P": load,
+        "P_source": "given" if ref.P is not None else "computed (the pair's contact force)",
         "l2_error": l2_error(r, p, exact["a"], exact["p0"], both_sides=not ref.symmetric),
     }
 
@@ -133,16 +150,21 @@ def uniform_stress_errors(sol: Solution, ref: np.ndarray) -> dict[str, Any]:
     for k, pv in enumerate(sol.pairs):
         itf = pair_interface(sol, k)
         order = np.argsort(pv.s, kind="stable")
-        n, t = pv.n[order], pv.t[order]
-        nn, nt = resolve(np.broadcast_to(ref, (len(n), 2, 2)), n, t)
-
+        nu, tau, _ = (v[order] for v in pv.frame)
+        sig = np.broadcast_to(ref, (len(nu), 2, 2))
+        # The exact values of the columns: each side's traction in the contact frame.
+        nn_a, nt_a = resolve(sig, pv.n[order], nu, tau)
+        nn_p, nt_p = resolve(sig, nu, nu, tau)
+        exact = {"nn_active": nn_a, "nn_passive": nn_p, "nt_active": nt_a, "nt_passive": nt_p}
         sides = ("active",) if pv.obstacle is not None else ("active", "passive")
         pairs.append(
             {
-                "pressure": _max_error(itf["pressure"], -nn, scale),
+                "pressure": _max_error(itf["pressure"], -nn_p, scale),
                 **{
-                    f"sigma_{kind}_{side}": _max_error(itf[f"sigma_{kind}_{side}"], exact, scale)
-                    for kind, exact in (("nn", nn), ("nt", nt))
+                    f"sigma_{kind}_{side}": _max_error(
+                        itf[f"sigma_{kind}_{side}"], exact[f"{kind}_{side}"], scale
+                    )
+                    for kind in ("nn", "nt")
                     for side in sides
                 },
             }

@@ -103,6 +103,33 @@ def check_quadrilaterals() -> None:
         )
 
 
+def check_separate_bodies() -> None:
+    """Raise MeshError if two physical surface groups (bodies) share mesh nodes.
+
+    Contact needs the interface nodes duplicated: a single conforming mesh (shared points or
+    curves, BooleanFragments, Coherence, or gmsh's automatic coherence after a geometry
+    transformation such as Rotate) glues the bodies together where they touch.
+    """
+    groups = gmsh.model.getPhysicalGroups(2)
+    nodes = [gmsh.model.mesh.getNodesForPhysicalGroup(d, t)[0].astype(np.int64) for d, t in groups]
+    top = max((int(n.max()) for n in nodes if n.size), default=0)
+    owner = np.full(top + 1, -1, dtype=np.int64)
+    for k, tags in enumerate(nodes):
+        shared = tags[owner[tags] >= 0]
+        if shared.size:
+            names = [gmsh.model.getPhysicalName(*g) or f"surface group {g[1]}" for g in groups]
+            x = gmsh.model.mesh.getNode(int(shared[0]))[0]
+            raise MeshError(
+                f"bodies '{names[owner[shared[0]]]}' and '{names[k]}' share {shared.size} mesh "
+                f"node{'s' * (shared.size > 1)} (e.g. at ({x[0]:.4g}, {x[1]:.4g})): a single "
+                "conforming mesh glues them together; contact needs each body built from its "
+                "own points and curves, so that the interface nodes are duplicated (no shared "
+                "points or curves, no BooleanFragments or Coherence; in a .geo with Rotate, "
+                "Translate or other transformations set Geometry.AutoCoherence = 0)"
+            )
+        owner[tags] = k
+
+
 def _run_on_root(
     comm: MPI.Comm, build: Callable[[], None], own_session: bool
 ) -> tuple[bool | None, str | None]:
@@ -122,6 +149,7 @@ def _run_on_root(
         try:
             build()
             check_quadrilaterals()
+            check_separate_bodies()
         except ContactFxError as exc:
             error = f"{type(exc).__name__}:{exc}"
         except ValueError as exc:  # a geometry builder's parameter check

@@ -163,14 +163,16 @@ Load = Pressure | Traction
 class HertzReference:
     """Plane-strain Hertz line contact on one pair: effective radius R, full line load P.
 
-    `symmetric`: the model is a half model cut through the contact centre (which is then the
-    end of the active surface nearest the symmetry line); otherwise (the default, in Python
-    and in scene files alike) the centre is the pressure's centroid.
+    `P` None (omitted): the load is the pair's computed contact force (twice it for a half
+    model), which is what a displacement-controlled scene knows. `symmetric`: the model is a
+    half model cut through the contact centre (which is then the end of the active surface
+    nearest the symmetry line); otherwise (the default, in Python and in scene files alike)
+    the centre is the pressure's centroid.
     """
 
     pair: int
     R: float
-    P: float
+    P: float | None = None
     symmetric: bool = False
 
 

@@ -128,7 +128,7 @@ def _reference(k: int, entry: Any) -> Reference:
         raise InputError(f"reference {k}: type must be 'hertz' or 'uniform_stress' (got {kind!r})")
     where = f"reference {k} ({kind})"
     if kind == "hertz":
-        e = _keys(where, entry, SECTION_KEYS["reference.hertz"], {"type", "R", "P"})
+        e = _keys(where, entry, SECTION_KEYS["reference.hertz"], {"type", "R"})
         pair = e.get("pair", 0)
         if isinstance(pair, bool) or not isinstance(pair, int):
             raise InputError(
@@ -138,8 +138,10 @@ def _reference(k: int, entry: Any) -> Reference:
         flags = {"symmetric": e["symmetric"]} if "symmetric" in e else {}
         if not all(isinstance(v, bool) for v in flags.values()):
             raise InputError(f"{where}: symmetric must be true or false")
-        R, P = _number(f"{where}.R", e["R"]), _number(f"{where}.P", e["P"])
-        if R <= 0 or P <= 0:
+        # Without P (a displacement-controlled scene) the pair's computed force is the load.
+        R = _number(f"{where}.R", e["R"])
+        P = _number(f"{where}.P", e["P"]) if "P" in e else None
+        if R <= 0 or (P is not None and P <= 0):
             raise InputError(f"{where}: R and P must be positive")
         return HertzReference(pair, R, P, **flags)
     e = _keys(where, entry, SECTION_KEYS["reference.uniform_stress"], {"type", "sigma"})

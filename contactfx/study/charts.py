@@ -10,9 +10,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullFormatter
 
-from .core import Study
+from .core import Study, series
 from .measures import ROUND_OFF
 from .report import main_errors
 
@@ -35,23 +35,23 @@ LABELS = {
 
 
 def _series(study: Study, method: str, name: str, x: str) -> tuple[np.ndarray, np.ndarray]:
-    """(x, error) of a method's finished runs with an error above round-off."""
-    ref = study.reference
-    # Self-convergence: on the reference's mesh a method differs from it by the methods only.
-    last = ref["level"] if ref["kind"] == "self" and ref.get("level") is not None else None
-    pts = [
-        (r.h if x == "h" else r.after_mesh, r.errors.get(name))
-        for r in study.runs
-        if r.method == method and r.ok and (last is None or r.level < last)
-    ]
-    pts = [(a, e) for a, e in pts if a and e is not None and e > 0]
-    return np.array([p[0] for p in pts]), np.array([p[1] for p in pts])
+    """(x, error) of what the rate is fitted to (core.series): exactly the charted points."""
+    kind = "self" if study.reference["kind"] == "self" else "exact"
+    return series(study.runs, method, name, x, kind)
 
 
-def _rate_text(rate: float | None, errors: np.ndarray) -> str:
+def _rate_text(rate: float | None, errors: np.ndarray, flag: str | None = None) -> str:
     if rate is not None:
-        return f"rate {rate:.2f}"
+        return f"rate {rate:.2f}" + (f" ({flag}!)" if flag else "")
     return "exact to round-off" if np.all(errors <= ROUND_OFF) else "no rate (< 2 levels)"
+
+
+def _label(study: Study, name: str) -> str:
+    """The y label: self-convergence charts the difference from the next finer level."""
+    if study.reference["kind"] == "self":
+        what = name.split("_pair")[0]
+        return f"{what}: relative L2 difference\nfrom the next finer level (along s)"
+    return LABELS.get(name, name)
 
 
 def _figure(study: Study, x: str) -> tuple[plt.Figure, list[plt.Axes], list[str]]:
@@ -78,7 +78,8 @@ def _draw(ax: plt.Axes, study: Study, name: str, x: str, label: str | None = Non
         if not len(xs):
             continue
         rate = rates[m].get(name)
-        text = _rate_text(rate, e) if x == "h" or rate is None else f"error ~ t^{rate:.2f}"
+        flag = study.flags.get(m, {}).get(name) if x == "h" else None
+        text = _rate_text(rate, e, flag) if x == "h" or rate is None else f"error ~ t^{rate:.2f}"
         ax.loglog(
             xs,
             e,
@@ -92,14 +93,29 @@ def _draw(ax: plt.Axes, study: Study, name: str, x: str, label: str | None = Non
         )
 
 
+def tick_values(lo: float, hi: float) -> list[float]:
+    """At least three readable values in [lo, hi] (lo > 0) for a log axis.
+
+    Decades: 1 x 10^k; a few decades: 1, 2, 5 x 10^k; about one: every integer times 10^k;
+    shorter (h over one or two refinements): evenly spaced round numbers.
+    """
+    for mantissas in ((1,), (1, 2, 5), tuple(range(1, 10))):
+        decades = range(int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi))) + 1)
+        values = [m * 10.0**k for k in decades for m in mantissas]
+        inside = sorted({float(f"{v:.12g}") for v in values if lo <= v <= hi})
+        if len(inside) >= 3:
+            return inside
+    linear = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]).tick_values(lo, hi)
+    return [float(f"{v:.12g}") for v in linear if lo <= v <= hi]
+
+
 def _ticks(ax: plt.Axes) -> None:
-    """Plain-number labels; at 1, 2, 5 x 10^k when the range is short (few decades)."""
+    """Plain-number labels, at least three on each axis however short its range."""
     for axis in (ax.xaxis, ax.yaxis):
         lo, hi = sorted(axis.get_view_interval())
-        short = lo > 0 and np.log10(hi / lo) <= 2.5
-        axis.set_major_locator(
-            LogLocator(base=10, subs=(1.0, 2.0, 5.0) if short else (1.0,), numticks=8)
-        )
+        if not lo > 0:
+            continue
+        axis.set_major_locator(FixedLocator(tick_values(lo, hi)))
         axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         axis.set_minor_formatter(NullFormatter())
 
@@ -123,11 +139,11 @@ def plot_convergence(study: Study, path: Path, extra: Sequence[tuple[str, Study]
         for label, other in extra:
             _draw(ax, other, name, "h", label)
         ax.set_xlabel("contact element size h (median in the contact zone)", fontsize=11)
-        ax.set_ylabel(LABELS.get(name, name), fontsize=11)
+        ax.set_ylabel(_label(study, name), fontsize=11)
         ax.grid(True, which="both", alpha=0.3)
         _ticks(ax)
         model = (
-            "fitted: difference ~ h^rate - h_ref^rate"
+            "fitted: |u_k - u_k+1| ~ h_k^rate (successive levels)"
             if study.reference["kind"] == "self"
             else "fitted: error ~ h^rate"
         )
@@ -143,7 +159,7 @@ def plot_time(study: Study, path: Path, extra: Sequence[tuple[str, Study]] = ())
         for label, other in extra:
             _draw(ax, other, name, "time", label)
         ax.set_xlabel("wall time after meshing (s): assembly, search, solves", fontsize=11)
-        ax.set_ylabel(LABELS.get(name, name), fontsize=11)
+        ax.set_ylabel(_label(study, name), fontsize=11)
         ax.grid(True, which="both", alpha=0.3)
         _ticks(ax)
         ax.legend(fontsize=10, title="lower left is better", title_fontsize=10)

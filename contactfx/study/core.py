@@ -13,18 +13,19 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 from mpi4py import MPI
 
 from ..api import run_scene
 from ..errors import ContactFxError
 from ..options import Method, SolverSpec
-from ..scenes import HertzReference, Scene, UniformStress
+from ..scenes import HertzReference, Reference, Scene, UniformStress
 from ..timers import Timers
 from .levels import Level
 from .measures import (
+    ROUND_OFF,
     contact_size,
     fit_rate,
-    fit_rate_to_reference,
     hertz_errors,
     patch_error,
     profiles,
@@ -53,6 +54,8 @@ class Study:
     wall: float
     ranks: int
     settings: dict[str, Any] = field(default_factory=dict)
+    # Per method and error: why its rate is not a convergence rate ("non-monotone").
+    flags: dict[str, dict[str, str]] = field(default_factory=dict)
 
 
 def reference_kind(scene: Scene) -> str:
@@ -99,6 +102,7 @@ def solve_one(
     times["total"] += mesh_time
     run.dofs, run.elements, run.iterations = data["dofs"], data["elements"], data["iterations"]
     run.times, run.summary, run.h = times, data, contact_size(data)
+    run.forces = [list(c["force"]) for c in data["contacts"]]
     if kind == "self":
         run.profiles = profiles(sol, data)
     else:
@@ -129,14 +133,28 @@ def self_reference(runs: list[Run], methods: list[str]) -> Run | None:
     return None
 
 
-def apply_reference(kind: str, runs: list[Run], methods: list[str]) -> dict[str, Any]:
-    """Fill in the self-convergence errors; return the report's `reference` block."""
+def hertz_window(references: tuple[Reference, ...]) -> str:
+    """The interval the Hertz L2 error is taken over, as the scene's references say."""
+    refs = [r for r in references if isinstance(r, HertzReference)]
+    windows = sorted(
+        {"[0, 1.5 a] (half model)" if r.symmetric else "[-1.5 a, 1.5 a] (full model)" for r in refs}
+    )
+    return " and ".join(windows) or "[0, 1.5 a]"
+
+
+def apply_reference(
+    kind: str, runs: list[Run], methods: list[str], references: tuple[Reference, ...] = ()
+) -> dict[str, Any]:
+    """Fill in the self-convergence errors; return the report's `reference` block.
+
+    `references`: the scene's, for what the description says (the Hertz window).
+    """
     if kind == "hertz":
         return {
             "kind": "exact",
             "type": "hertz",
             "description": "plane-strain Hertz line contact (Johnson 4.2): half-width a, "
-            "peak pressure p0, relative L2 error of the pressure over [0, 1.5 a]",
+            f"peak pressure p0, relative L2 error of the pressure over {hertz_window(references)}",
         }
     if kind == "patch":
         return {
@@ -150,49 +168,73 @@ def apply_reference(kind: str, runs: list[Run], methods: list[str]) -> dict[str,
         for r in runs:
             if r.ok and r is not ref and r.profiles is not None:
                 r.errors = compare_profiles(r.profiles, ref.profiles)  # type: ignore[arg-type]
+    for m in methods:
+        done = {r.level: r for r in runs if r.method == m and r.ok and r.profiles is not None}
+        for k, r in done.items():
+            if k + 1 in done:
+                r.successive = compare_profiles(r.profiles, done[k + 1].profiles)  # type: ignore[arg-type]
     return {
         "kind": "self",
         "type": "finest level",
         "method": ref.method if ref else None,
         "level": ref.level if ref else None,
         "h": ref.h if ref else None,
-        "rates": "err ~ C (h^r - h_ref^r) fitted over the levels coarser than the reference",
+        "rates": "log-log slope of the differences between successive levels of each "
+        "method (|u_k - u_k+1| ~ C h_k^r), against h_k",
         "description": "no exact solution: the finest level of the most accurate method; "
         "relative L2 differences in arc length along every contact surface of the "
         "pressure and of the displacement (both sides)",
     }
 
 
+def series(
+    runs: list[Run], method: str, name: str, against: str, kind: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """The (x, value) points a rate is fitted to and a chart draws, coarse to fine.
+
+    x is h ("h") or the time after meshing ("time"). The value is the error against the
+    exact solution, or (self-convergence, `kind` "self") the difference from the same
+    method's next finer level: the finest level is the reference and has none, and the
+    differences of successive levels fall like h^r for any r, with no model of the
+    reference's own error.
+    """
+    pts = []
+    for r in runs:
+        if r.method != method or not r.ok:
+            continue
+        x = r.h if against == "h" else r.after_mesh
+        e = (r.successive if kind == "self" else r.errors).get(name)
+        if x and e is not None and e > 0:
+            pts.append((r.level, x, e))
+    pts.sort()
+    return np.array([p[1] for p in pts]), np.array([p[2] for p in pts])
+
+
+def monotone(errors: np.ndarray) -> bool:
+    """Whether errors (coarse to fine) above round-off fall at every level."""
+    e = errors[errors > ROUND_OFF]
+    return bool(np.all(np.diff(e) < 0.0))
+
+
 def fit_rates(
     runs: list[Run], methods: list[str], names: list[str], against: str, reference: dict[str, Any]
-) -> dict[str, dict[str, float | None]]:
-    """Fitted rate of each error against h ("h") or the time after meshing ("time").
+) -> tuple[dict[str, dict[str, float | None]], dict[str, dict[str, str]]]:
+    """Fitted rates of each error against h ("h") or the time after meshing ("time").
 
-    Against an exact solution: the log-log slope over every finished level. Against the
-    finest level (self-convergence): only the levels coarser than the reference's count
-    (on its own mesh another method differs by the methods, not by the mesh), and the rate
-    in h is that of err ~ C (h^r - h_ref^r) (measures.fit_rate_to_reference).
+    The log-log slope of `series`; returns (rates, flags), flags naming the non-monotone
+    series (the slope is reported but is not a convergence rate).
     """
-    ref = next(
-        (
-            r
-            for r in runs
-            if (r.method, r.level) == (reference.get("method"), reference.get("level"))
-        ),
-        None,
-    )
-    out: dict[str, dict[str, float | None]] = {}
+    kind = "self" if reference["kind"] == "self" else "exact"
+    rates: dict[str, dict[str, float | None]] = {}
+    flags: dict[str, dict[str, str]] = {}
     for m in methods:
-        done = [r for r in runs if r.method == m and r.ok and (ref is None or r.level < ref.level)]
-        xs = [r.h if against == "h" else r.after_mesh for r in done]
-        out[m] = {}
+        rates[m], flags[m] = {}, {}
         for n in names:
-            errs = [r.errors.get(n) for r in done]
-            if ref is not None and against == "h" and ref.h is not None:
-                out[m][n] = fit_rate_to_reference(xs, errs, ref.h)  # type: ignore[arg-type]
-            else:
-                out[m][n] = fit_rate(xs, errs)  # type: ignore[arg-type]
-    return out
+            xs, errs = series(runs, m, n, against, kind)
+            rates[m][n] = fit_rate(xs, errs)
+            if rates[m][n] is not None and not monotone(errs):
+                flags[m][n] = "non-monotone"
+    return rates, flags
 
 
 def run_study(
@@ -215,6 +257,7 @@ def run_study(
     progress = Progress(methods, len(levels), ratio, say)
     runs: list[Run] = []
     kind, name = None, "scene"
+    references: tuple[Reference, ...] = ()  # the scene's (the same on every level)
     for level in levels:
         progress.meshing(level)
         t0 = time.perf_counter()
@@ -227,12 +270,15 @@ def run_study(
             continue
         mesh_time = time.perf_counter() - t0
         kind, name = kind or reference_kind(scene), scene.name
+        references = references or scene.references
         for k, m in enumerate(methods):
             runs.append(solve_one(scene, m, level, mesh_time, kind, solver, options or {}))
             progress.finished(runs[-1], mesh_time if k == 0 else None)
         del scene
-    reference = apply_reference(kind or "self", runs, methods)
+    reference = apply_reference(kind or "self", runs, methods, references)
     names = list(dict.fromkeys(n for r in runs for n in r.errors))
+    rates, flags = fit_rates(runs, methods, names, "h", reference)
+    time_rates, _ = fit_rates(runs, methods, names, "time", reference)
     return Study(
         name,
         methods,
@@ -240,9 +286,10 @@ def run_study(
         runs,
         reference,
         names,
-        fit_rates(runs, methods, names, "h", reference),
-        fit_rates(runs, methods, names, "time", reference),
+        rates,
+        time_rates,
         time.perf_counter() - progress.t0,
         comm.size,
         dict(settings or {}),
+        flags,
     )

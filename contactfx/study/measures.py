@@ -34,36 +34,6 @@ def fit_rate(h: list[float] | np.ndarray, err: list[float | None] | np.ndarray) 
     return float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0])
 
 
-def fit_rate_to_reference(
-    h: list[float] | np.ndarray, err: list[float | None] | np.ndarray, h_ref: float
-) -> float | None:
-    """Rate r of differences from a finer reference: err ~ C (h^r - h_ref^r), least squares.
-
-    If u_h - u ~ h^r with one shape, ||u_h - u_ref|| ~ C (h^r - h_ref^r): the plain log-log
-    slope would overstate r near the reference (r = 1, ratio 2: 1.58 from the two levels
-    below it). Only runs coarser than the reference count; 0.0 when the differences fall
-    more slowly than any convergence towards the reference allows (e.g. a method converging
-    to another limit); None with fewer than 2 usable points.
-    """
-    from scipy.optimize import minimize_scalar
-
-    x = np.asarray(h, dtype=float)
-    y = np.asarray([np.nan if e is None else abs(e) for e in err], dtype=float)
-    ok = np.isfinite(x) & np.isfinite(y) & (x > h_ref * (1 + 1e-6)) & (y > ROUND_OFF)
-    if np.count_nonzero(ok) < 2 or np.ptp(np.log(x[ok])) == 0:
-        return None
-    x, ly = x[ok], np.log(y[ok])
-
-    def misfit(r: float) -> float:
-        g = np.log(x**r - h_ref**r)
-        return float(np.sum((ly - g - np.mean(ly - g)) ** 2))
-
-    r = float(
-        minimize_scalar(misfit, bounds=(1e-3, 8.0), method="bounded", options={"xatol": 1e-6}).x
-    )
-    return 0.0 if r < 0.01 else r
-
-
 def contact_size(summary: dict[str, Any]) -> float | None:
     """Median length of the active-surface elements with pressure at both ends (all pairs).
 

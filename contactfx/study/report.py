@@ -35,6 +35,8 @@ def run_json(run: Run, study: Study) -> dict[str, Any]:
         "times": run.times,
         "after_mesh": run.after_mesh,
         "errors": run.errors,
+        "successive": run.successive,
+        "forces": run.forces,
     }
 
 
@@ -53,6 +55,7 @@ def study_json(study: Study) -> dict[str, Any]:
         "error_names": study.error_names,
         "runs": [run_json(r, study) for r in study.runs],
         "rates": study.rates,
+        "rate_flags": study.flags,
         "time_rates": study.time_rates,
         "h": "median length of the active-surface elements carrying pressure",
     }
@@ -67,6 +70,9 @@ def write_study_json(study: Study, path: Path) -> Path:
 def write_study_csv(study: Study, path: Path) -> Path:
     """Write study.csv: one row per run, sizes, times and every error as columns."""
     size_keys = list(dict.fromkeys(k for lv in study.levels for k in lv.sizes))
+    pairs = max((len(r.forces) for r in study.runs if r.forces), default=0)
+    force_keys = [f"force{k}_{c}" for k in range(pairs) for c in "xy"]
+    succ = study.reference["kind"] == "self"
     head = [
         "method",
         "level",
@@ -80,6 +86,8 @@ def write_study_csv(study: Study, path: Path) -> Path:
         *(f"time_{k}" for k in TIME_KEYS),
         "time_after_mesh",
         *study.error_names,
+        *(f"successive_{n}" for n in study.error_names if succ),
+        *force_keys,
         "message",
     ]
     with path.open("w", newline="") as fh:
@@ -101,10 +109,19 @@ def write_study_csv(study: Study, path: Path) -> Path:
                     *(_cell(r.times.get(k)) for k in TIME_KEYS),
                     _cell(r.after_mesh),
                     *(_cell(r.errors.get(n)) for n in study.error_names),
+                    *(_cell(r.successive.get(n)) for n in study.error_names if succ),
+                    *(_cell(f) for f in _forces(r, pairs)),
                     r.message or "",
                 ]
             )
     return path
+
+
+def _forces(run: Run, pairs: int) -> list[float | None]:
+    """fx, fy of every pair (None for a failed run)."""
+    if not run.forces:
+        return [None] * (2 * pairs)
+    return [float(v) for f in run.forces for v in f]
 
 
 def _cell(v: float | int | None) -> str:
@@ -129,9 +146,10 @@ def _error_cell(study: Study, run: Run, name: str) -> str:
 
 
 def _rate_cell(study: Study, method: str, name: str, rate: float | None) -> str:
-    """The rate, or why there is none."""
+    """The rate (flagged if its data are not monotone), or why there is none."""
     if rate is not None:
-        return f"{rate:.2f}"
+        flag = study.flags.get(method, {}).get(name)
+        return f"{rate:.2f}" + (f" ({flag}: not a convergence rate)" if flag else "")
     found = [r.errors.get(name) for r in study.runs if r.method == method and r.ok]
     errs = [e for e in found if e is not None]
     return "none (exact to round-off)" if errs and max(errs) <= ROUND_OFF else "n/a"
@@ -185,6 +203,8 @@ def table_lines(study: Study) -> list[str]:
             else ""
         )
     )
+    if study.reference["kind"] == "self":
+        lines.append(f"rates: {study.reference['rates']} (study.json: runs[].successive)")
     for m, rates in study.rates.items():
         lines.append(
             f"fitted rates in h, {m}: "

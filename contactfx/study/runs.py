@@ -23,6 +23,9 @@ class Run:
     iterations: int | None = None
     times: dict[str, float] = field(default_factory=dict)
     errors: dict[str, float | None] = field(default_factory=dict)
+    # Self-convergence: the differences from the same method's next finer level.
+    successive: dict[str, float | None] = field(default_factory=dict)
+    forces: list[list[float]] | None = None  # the contact force [fx, fy] of every pair
     summary: dict[str, Any] | None = field(default=None, repr=False)
     profiles: Profiles | None = field(default=None, repr=False)
 
