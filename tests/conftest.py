@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
+import logging
 import os
 import subprocess
 import sys
+from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +32,31 @@ def run_cli(
     return subprocess.run(
         cmd, cwd=cwd or ROOT, env=ENV, capture_output=True, text=True, timeout=timeout
     )
+
+
+def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """Run `contactfx ...` in this process: its exit code, stdout (the log) and stderr.
+
+    For checks of what the CLI computes and writes. The exit-code and one-line-error contract
+    of a fresh process is tested with run_cli.
+    """
+    from contactfx.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    root = logging.getLogger()
+    saved = root.handlers[:]
+    root.handlers.clear()  # main() configures logging onto the captured stdout
+    try:
+        with contextlib.chdir(cwd or ROOT), redirect_stdout(out), redirect_stderr(err):
+            try:
+                code = main(list(args))
+            except SystemExit as exc:  # argparse's usage errors
+                code = int(exc.code or 0)
+    finally:
+        for handler in root.handlers:
+            handler.flush()
+        root.handlers[:] = saved
+    return subprocess.CompletedProcess(["contactfx", *args], code, out.getvalue(), err.getvalue())
 
 
 def run_mpi_script(
@@ -56,13 +85,31 @@ def mpi_script():
     return run_mpi_script
 
 
-def polyline(x: np.ndarray, y: np.ndarray, normal_up: bool, dof0: int) -> Surface:
-    """Surface through (x, y) in order; normals point to +y (lower body) or -y (upper body)."""
-    pts = np.column_stack([x, y]).astype(float)
+def make_surface(pts: np.ndarray, ref: np.ndarray, dof0: int) -> Surface:
+    """Polyline through pts; each segment normal is the perpendicular with n . ref > 0."""
+    pts = np.asarray(pts, dtype=float)
     n = len(pts)
     seg = np.column_stack([np.arange(n - 1), np.arange(1, n)])
     t = pts[seg[:, 1]] - pts[seg[:, 0]]
-    t /= np.linalg.norm(t, axis=1)[:, None]
-    nrm = np.column_stack([-t[:, 1], t[:, 0]])
-    nrm *= (np.sign(nrm[:, 1]) * (1.0 if normal_up else -1.0))[:, None]
+    nrm = np.column_stack([-t[:, 1], t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
+    nrm *= np.sign(np.einsum("md,md->m", nrm, np.broadcast_to(ref, nrm.shape)))[:, None]
     return Surface(pts, seg, nrm, dof0 + 2 * np.arange(n)[:, None] + np.arange(2))
+
+
+def polyline(x: np.ndarray, y: np.ndarray, normal_up: bool, dof0: int) -> Surface:
+    """Surface through (x, y) in order; normals point to +y (lower body) or -y (upper body)."""
+    up = np.array([0.0, 1.0 if normal_up else -1.0])
+    return make_surface(np.column_stack([x, y]), up, dof0)
+
+
+def reshuffled(s: Surface, seed: int) -> Surface:
+    """The same surface with every segment reversed and the segment order permuted."""
+    perm = np.random.default_rng(seed).permutation(s.n_segments)
+    return Surface(s.x, s.segments[perm, ::-1], s.normals[perm], s.dofs)
+
+
+def renumbered(s: Surface, order: np.ndarray) -> Surface:
+    """The same surface with its nodes renumbered: new node i is old node order[i]."""
+    new = np.empty_like(order)
+    new[order] = np.arange(len(order))
+    return Surface(s.x[order], new[s.segments], s.normals, s.dofs[order])

@@ -1,6 +1,10 @@
-"""Run every demo (quick mode) serially and under mpirun -n 2; each asserts its own result."""
+"""Run every demo (quick mode) serially, and under mpirun -n 2 those on distinct parallel paths.
 
-import os
+Each demo asserts its own result. On 2 ranks: the blocks (several pairs, every method) and the
+user scene (gmsh .geo, a TOML scene); the other demos' parallel paths (Hertz, Schwarz, penalty,
+obstacles) are compared with serial runs case by case in tests/test_ranks.py.
+"""
+
 import subprocess
 import sys
 from pathlib import Path
@@ -11,8 +15,15 @@ from conftest import ENV, MPIRUN, ROOT
 DEMOS = sorted((ROOT / "demos").glob("demo_*.py"))
 
 
-@pytest.mark.parametrize("ranks", [1, 2])
-@pytest.mark.parametrize("demo", DEMOS, ids=[d.stem for d in DEMOS])
+PARALLEL_DEMOS = ("demo_blocks", "demo_own_scene")
+CASES = [pytest.param(d, 1, id=f"{d.stem}-1") for d in DEMOS] + [
+    pytest.param(d, 2, id=f"{d.stem}-2", marks=pytest.mark.mpi)
+    for d in DEMOS
+    if d.stem in PARALLEL_DEMOS
+]
+
+
+@pytest.mark.parametrize(("demo", "ranks"), CASES)
 def test_demo(demo: Path, ranks: int, tmp_path: Path) -> None:
     """The demo runs to its final assertions."""
     env = {**ENV, "CONTACTFX_QUICK": "1", "CONTACTFX_RESULTS": str(tmp_path), "MPLBACKEND": "Agg"}
@@ -25,4 +36,5 @@ def test_demo(demo: Path, ranks: int, tmp_path: Path) -> None:
 
 def test_there_are_demos() -> None:
     """The demo folder is not empty (a glob that finds nothing would test nothing)."""
-    assert len(DEMOS) >= 1 and os.path.isdir(ROOT / "demos")
+    assert len(DEMOS) >= 1
+    assert {d.stem for d in DEMOS} >= set(PARALLEL_DEMOS)

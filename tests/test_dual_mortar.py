@@ -4,6 +4,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from conftest import make_surface, renumbered, reshuffled
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -21,16 +22,6 @@ KINDS = ["flat", "tilted", "wavy", "arc"]
 
 
 # ---------------------------------------------------------------- surfaces
-
-
-def make_surface(pts: np.ndarray, ref: np.ndarray, dof0: int) -> Surface:
-    """Polyline through pts; each segment normal is the perpendicular with n . ref > 0."""
-    n = len(pts)
-    seg = np.column_stack([np.arange(n - 1), np.arange(1, n)])
-    t = pts[seg[:, 1]] - pts[seg[:, 0]]
-    nrm = np.column_stack([-t[:, 1], t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
-    nrm *= np.sign(np.einsum("md,md->m", nrm, np.broadcast_to(ref, nrm.shape)))[:, None]
-    return Surface(pts, seg, nrm, dof0 + 2 * np.arange(n)[:, None] + np.arange(2))
 
 
 def steps(rng: np.random.Generator, n: int, x0: float) -> np.ndarray:
@@ -74,19 +65,6 @@ def build_pair(seed: int, kind: str) -> tuple[Surface, Surface, int]:
 
 
 pairs = st.builds(build_pair, st.integers(0, 2**32 - 1), st.sampled_from(KINDS))
-
-
-def reshuffled(s: Surface, seed: int) -> Surface:
-    """The same surface with every segment reversed and the segment order permuted."""
-    perm = np.random.default_rng(seed).permutation(s.n_segments)
-    return Surface(s.x, s.segments[perm, ::-1], s.normals[perm], s.dofs)
-
-
-def renumbered(s: Surface, order: np.ndarray) -> Surface:
-    """The same surface with its nodes renumbered: new node i is old node order[i]."""
-    new = np.empty_like(order)
-    new[order] = np.arange(len(order))
-    return Surface(s.x[order], new[s.segments], s.normals, s.dofs[order])
 
 
 def flat_pair(xp, xa, ya) -> tuple[Surface, Surface, int]:

@@ -15,30 +15,19 @@ from contactfx.methods.active_set import lcp_active_set
 from contactfx.results.references import exact_pressure, fit_half_width, l2_error
 from contactfx.scenes import BlockParams, HertzParams, hertz_exact
 
-# Coarse graded meshes: (size at the contact edge, slope), slope ~ sqrt(h) as in the demo.
-LEVELS = [(0.04, 0.283), (0.02, 0.2), (0.01, 0.141)]
-
 
 def _graded(h: float, slope: float) -> HertzParams:
+    """A coarse graded Hertz mesh: contact-edge size h, zone 4h, slope ~ sqrt(h)."""
     return HertzParams(refine=4 * h, refine_edge=h, slope=slope)
 
 
-_LEVELS_CACHE: dict[str, list[dict]] = {}
-
-
-def levels_of(method: str) -> list[dict]:
-    """Hertz summaries of `method` on three graded meshes (coarse to fine), computed once."""
-    if method not in _LEVELS_CACHE:
-        _LEVELS_CACHE[method] = [
-            run_case("hertz", _graded(h, s), method, comm=MPI.COMM_SELF)[1] for h, s in LEVELS
-        ]
-    return _LEVELS_CACHE[method]
-
-
 @pytest.fixture(scope="module")
-def mortar_levels() -> list[dict]:
-    """Hertz summaries of mortar on three graded meshes (coarse to fine)."""
-    return levels_of("mortar")
+def mortar_finest() -> dict:
+    """Mortar's summary on the finest of the study's cheap levels (h_e = 0.01, 1933 cells).
+
+    The rates over the three levels are asserted per method in tests/test_study.py.
+    """
+    return run_case("hertz", _graded(0.01, 0.141), "mortar", comm=MPI.COMM_SELF)[1]
 
 
 def test_exact_formulas_against_johnson() -> None:
@@ -47,8 +36,6 @@ def test_exact_formulas_against_johnson() -> None:
     assert ex["E_star"] == pytest.approx(3695.49, abs=0.01)
     assert ex["a"] == pytest.approx(1.4378, abs=1e-4)
     assert ex["p0"] == pytest.approx(44.28, abs=0.01)
-    # The load balance P = pi a p0 / 2 of the elliptical profile.
-    assert np.pi * ex["a"] * ex["p0"] / 2 == pytest.approx(100.0, rel=1e-12)
 
 
 def test_postprocessing_measures_on_the_exact_profile() -> None:
@@ -62,9 +49,9 @@ def test_postprocessing_measures_on_the_exact_profile() -> None:
     assert l2_error(xs, 1.1 * exact_pressure(xs, a, p0), a, p0) == pytest.approx(0.1, rel=0.02)
 
 
-def test_profile_matches_exact_on_coarse_graded_mesh(mortar_levels: list[dict]) -> None:
+def test_profile_matches_exact_on_coarse_graded_mesh(mortar_finest: dict) -> None:
     # 1933 elements: pointwise within 1.5 % of p0 away from the edge, edge bracket around a.
-    data = mortar_levels[-1]
+    data = mortar_finest
     assert data["elements"] < 2500
     hz = data["hertz"]
     x = np.array(data["interface"]["x"])
@@ -79,25 +66,6 @@ def test_profile_matches_exact_on_coarse_graded_mesh(mortar_levels: list[dict]) 
     assert hz["l2_error"] < 0.007
     # Equilibrium: the contact carries the whole load P/2 of the half model.
     assert data["contact_force"] == pytest.approx(50.0, rel=1e-8)
-
-
-def test_l2_rate(multiplier_method: str) -> None:
-    """Fitted rate of the L2 pressure error in the edge element size, in [0.6, 1.3].
-
-    Why this band: the exact pressure has a square-root edge at x = a. A piecewise-linear
-    pressure misses it by O(sqrt(h)) over the one element that straddles the edge, an L2
-    contribution of O(h); the smooth part converges like h^2. So the asymptotic rate is 1,
-    and no honest discretization beats it by much before the edge dominates (the upper bound
-    1.3 leaves room for pre-asymptotic levels). NTS's lumped, collocated pressure adds an
-    O(h) oscillation of its own on non-matching meshes, which slows the pre-asymptotic rate
-    (measured on these meshes: nts 0.71, sts 0.93, mortar 0.93). A method stuck at a plateau
-    (e.g. only the zone refined, rate 0.14 in tests/test_study.py) fails the lower bound.
-    """
-    hs = [h for h, _ in LEVELS]
-    errs = [d["hertz"]["l2_error"] for d in levels_of(multiplier_method)]
-    assert np.all(np.diff(errs) < 0), errs
-    rate = np.polyfit(np.log(hs), np.log(errs), 1)[0]
-    assert 0.6 <= rate <= 1.3, rate
 
 
 def test_active_set_iterations_bounded(multiplier_method: str) -> None:
@@ -135,6 +103,7 @@ def test_lcp_kernel_on_a_small_m_matrix() -> None:
     lam0 = np.array([3.0, 1.0, -2.0, -5.0])
     act = lcp_active_set(k, lam0)
     assert act is not None
+    accepted = []
     for bits in range(16):
         a = np.array([(bits >> i) & 1 for i in range(4)], dtype=bool)
         s = np.zeros(4)
@@ -142,7 +111,9 @@ def test_lcp_kernel_on_a_small_m_matrix() -> None:
             s[~a] = np.linalg.solve(k[np.ix_(~a, ~a)], -lam0[~a])
         lam = lam0 + k @ s
         if (s >= -1e-12).all() and (lam[a] >= -1e-12).all():
-            assert np.array_equal(a, act)
+            accepted.append(a)
+    # An M-matrix LCP has exactly one solution: the enumeration finds one set, the kernel's.
+    assert len(accepted) == 1 and np.array_equal(accepted[0], act)
 
 
 def test_pulling_load_is_a_clear_error() -> None:

@@ -36,13 +36,9 @@ def test_s1_agrees_with_mortar_away_from_corner(s1_pair) -> None:
     mortar, schwarz = s1_pair
     x = _arr(schwarz, "x")
     np.testing.assert_array_equal(x, _arr(mortar, "x"))
-    far = x < 0.9 * BLOCK_SCENES["S1"].l2 / 2
-    assert far.sum() >= 20
-    for key in ("pressure", "sigma_yy_1", "sigma_yy_2"):
-        a, m = _arr(schwarz, key)[far], _arr(mortar, key)[far]
-        assert np.max(np.abs(a / m - 1)) < 1e-3, key
-    # Stronger, because the Schwarz fixed point solves the mortar equations: the two agree to
-    # the iteration tolerance everywhere, the singular corner included (measured 6e-10 p).
+    # The paper's 0.1 % away from the corner is implied: the Schwarz fixed point solves the
+    # mortar equations, so the two agree to the iteration tolerance everywhere, the singular
+    # corner included (measured 6e-10 p).
     p = BLOCK_SCENES["S1"].p
     for key in ("pressure", "sigma_yy_1", "sigma_yy_2"):
         assert np.nanmax(np.abs(_arr(schwarz, key) - _arr(mortar, key))) < 1e-7 * p, key

@@ -39,7 +39,7 @@ def deformed_fields(
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     V = sol.fields.V
     # vtk_mesh is a singledispatch function: mypy sees only its Mesh signature.
-    topology, cell_types, x = plot.vtk_mesh(V)  # type: ignore[arg-type]
+    topology, cell_types, x = plot.vtk_mesh(V)
     grid = pyvista.UnstructuredGrid(topology, cell_types, x)
     u = sol.u.x.array.reshape(-1, 2)
     grid.point_data["u_y"] = u[:, 1]
@@ -53,7 +53,7 @@ def deformed_fields(
         outline(ob, x[:, :2]) + scale * np.asarray(ob.displacement) for ob in sol.scene.obstacles
     ]
     # pyvista annotates window_size as list[int]; it takes any sequence (as BasePlotter says).
-    plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)  # type: ignore[arg-type]
+    plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)
     for col, (name, label) in enumerate((("u_y", "u_y (cm)"), ("sigma_yy", "sigma_yy (MPa)"))):
         plotter.subplot(0, col)
         plotter.add_mesh(
@@ -72,7 +72,7 @@ def deformed_fields(
             pts = np.column_stack([xy, np.zeros(len(xy))])
             plotter.add_mesh(pyvista.lines_from_points(pts), color="black", line_width=2)
         plotter.add_text(f"{label}, deformation x{scale:g}", font_size=10)
-        plotter.view_xy()  # type: ignore[call-arg]  # pyvista's functools.wraps confuses mypy
+        plotter.view_xy()
         if window is not None:
             _zoom(plotter, window)
     path.parent.mkdir(parents=True, exist_ok=True)

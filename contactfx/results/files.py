@@ -39,7 +39,7 @@ def field_grid(sol: Solution) -> Any:
     msh = V.mesh
     ncells = msh.topology.index_map(msh.topology.dim).size_local
     # vtk_mesh is a singledispatch function: mypy sees only its Mesh signature.
-    topology, cell_types, x = plot.vtk_mesh(V)  # type: ignore[arg-type]
+    topology, cell_types, x = plot.vtk_mesh(V)
     width = 5  # VTK_QUAD: a count and four points per cell
     grid = pyvista.UnstructuredGrid(topology[: width * ncells], cell_types[:ncells], x)
     u = sol.u.x.array.reshape(-1, 2)
