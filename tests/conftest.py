@@ -45,6 +45,25 @@ def run_mpi_script(
 RANK_CASES = ROOT / "tests" / "rank_cases.py"
 
 
+class _NoMpirun(subprocess.Popen):
+    """Popen that refuses mpirun: for tests without the mpi marker."""
+
+    def __init__(self, args, *rest, **kwargs) -> None:
+        first = args[0] if isinstance(args, list | tuple) else str(args).split()[0]
+        if Path(str(first)).name in ("mpirun", "mpiexec"):
+            raise AssertionError("this test launches mpirun: mark it @pytest.mark.mpi")
+        super().__init__(args, *rest, **kwargs)
+
+
+@pytest.fixture(autouse=True)
+def _mpirun_only_under_the_mpi_marker(
+    request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`pytest -m "not mpi"` launches no mpirun: an unmarked test that tries fails."""
+    if request.node.get_closest_marker("mpi") is None:
+        monkeypatch.setattr(subprocess, "Popen", _NoMpirun)
+
+
 @pytest.fixture(scope="session")
 def two_rank_results(
     request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory

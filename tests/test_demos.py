@@ -11,7 +11,7 @@ from conftest import ENV, MPIRUN, ROOT
 DEMOS = sorted((ROOT / "demos").glob("demo_*.py"))
 
 
-@pytest.mark.parametrize("ranks", [1, 2])
+@pytest.mark.parametrize("ranks", [1, pytest.param(2, marks=pytest.mark.mpi)])
 @pytest.mark.parametrize("demo", DEMOS, ids=[d.stem for d in DEMOS])
 def test_demo(demo: Path, ranks: int, tmp_path: Path) -> None:
     """The demo runs to its final assertions."""

@@ -212,6 +212,7 @@ def _same(a: float | None, b: float | None) -> bool:
     return (a is None and b is None) or abs(a - b) <= 1e-6 * max(abs(a), abs(b))
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("which", ["hertz", "geo"])
 def test_two_ranks_give_the_serial_errors(
     which: str,
