@@ -1,4 +1,5 @@
-"""Shared helpers: run the CLI or a script under mpirun -n 2 as a user would."""
+"""Shared helpers: run the CLI or a script under mpirun -n 2 as a user would, and the one
+mpirun -n 2 launch of the rank-comparison cases (tests/rank_cases.py, tests/test_ranks.py)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import logging
 import os
 import subprocess
 import sys
+from collections.abc import Callable
 from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
 
@@ -67,6 +69,62 @@ def run_mpi_script(
     proc = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=timeout)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return proc
+
+
+RANK_CASES = ROOT / "tests" / "rank_cases.py"
+
+
+class _NoMpirun(subprocess.Popen):
+    """Popen that refuses mpirun: for tests without the mpi marker."""
+
+    def __init__(self, args, *rest, **kwargs) -> None:
+        first = args[0] if isinstance(args, list | tuple) else str(args).split()[0]
+        if Path(str(first)).name in ("mpirun", "mpiexec"):
+            raise AssertionError("this test launches mpirun: mark it @pytest.mark.mpi")
+        super().__init__(args, *rest, **kwargs)
+
+
+@pytest.fixture(autouse=True)
+def _mpirun_only_under_the_mpi_marker(
+    request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`pytest -m "not mpi"` launches no mpirun: an unmarked test that tries fails."""
+    if request.node.get_closest_marker("mpi") is None:
+        monkeypatch.setattr(subprocess, "Popen", _NoMpirun)
+
+
+@pytest.fixture(scope="session")
+def two_rank_results(
+    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
+) -> Callable[[str], dict[str, np.ndarray]]:
+    """One mpirun -n 2 of tests/rank_cases.py for every case the selected tests compare.
+
+    Returns case -> its 2-rank arrays; a case the run did not write fails with the run's
+    output (the run aborts at the first failing case: mpi4py -m).
+    """
+    names = sorted(
+        {
+            str(item.callspec.params["case"])
+            for item in request.session.items
+            if "two_rank_results" in getattr(item, "fixturenames", ())
+            and hasattr(item, "callspec")
+            and "case" in item.callspec.params
+        }
+    )
+    outdir = tmp_path_factory.mktemp("two_ranks")
+    cmd = [MPIRUN, "-n", "2", sys.executable, "-m", "mpi4py", str(RANK_CASES), str(outdir)]
+    proc = subprocess.run(
+        [*cmd, *names], cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=1800
+    )
+    log = f"exit {proc.returncode}\n{proc.stdout[-3000:]}{proc.stderr[-3000:]}"
+
+    def load(name: str) -> dict[str, np.ndarray]:
+        path = outdir / f"{name}.npz"
+        assert path.exists(), f"mpirun -n 2 rank_cases.py wrote no {name}: {log}"
+        with np.load(path) as data:
+            return {k: data[k] for k in data.files}
+
+    return load
 
 
 # The multiplier methods (one saddle-point discretization each): most tests run all three.

@@ -3,7 +3,6 @@ selected inverse on several ranks."""
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -75,37 +74,3 @@ def test_reference_timing_reports_both_factorizations(tmp_path: Path) -> None:
     times = json.loads(out.read_text())["times"]
     for key in ("reference_solve", "reference_lu", "reference_ldlt"):
         assert times[key] > 0.0
-
-
-SCRIPT = textwrap.dedent(
-    """
-    import sys
-    import numpy as np
-    from mpi4py import MPI
-    import contactfx
-    from contactfx.scenes import HertzParams, hertz
-
-    scene = hertz(HertzParams(refine=0.05), comm=MPI.COMM_WORLD)
-    sol = contactfx.solve(scene, "mortar", solver=sys.argv[1])
-    probes = sol.history[0]["probes"]
-    # Rows in the layout are ordered by owner rank: sort them by position to compare.
-    x = np.round(sol.layout.x, 9)
-    order = np.lexsort((x[:, 1], x[:, 0]))
-    np.save(sys.argv[2], np.concatenate([[probes], sol.pressure[order]]))
-    """
-)
-
-
-@pytest.mark.mpi
-@pytest.mark.parametrize("solver", ["mumps", "mumps-lu"])
-def test_two_ranks_probe_by_selected_inverse(tmp_path: Path, mpi_script, solver) -> None:
-    """On 2 ranks the probe step uses MUMPS' selected inverse too: every row probed in the
-    first step (as serially), the same pressures to 1e-8."""
-    script = tmp_path / "probe.py"
-    script.write_text(SCRIPT)
-    mpi_script(script, solver, str(tmp_path / "two.npy"), ranks=2)
-    mpi_script(script, solver, str(tmp_path / "one.npy"), ranks=1)
-    two, one = np.load(tmp_path / "two.npy"), np.load(tmp_path / "one.npy")
-    assert two[0] == one[0] > 0  # the same candidates probed in step 1
-    p1, p2 = one[1:], two[1:]
-    assert np.abs(p2 - p1).max() <= 1e-8 * np.abs(p1).max()

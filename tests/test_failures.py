@@ -295,6 +295,7 @@ def test_cli_one_line_no_json(tmp_path: Path, args: list[str], words: str) -> No
     assert_clean_failure(tmp_path, args, words)
 
 
+@pytest.mark.mpi
 def test_cli_failure_under_mpi(tmp_path: Path) -> None:
     line = assert_clean_failure(tmp_path, [*S4, "--p", "-50"], "body 'body2' is not held", mpi=2)
     assert "SingularSystemError" not in line

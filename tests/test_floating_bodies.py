@@ -9,7 +9,6 @@ load. Before the fix this ended with exit 0 and a JSON, b2 and b3 at arbitrary p
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -77,18 +76,6 @@ def test_far_pair_refused_on_two_ranks(tmp_path: Path) -> None:
     assert len(lines) == 1, proc.stderr
     assert_names_the_floating_bodies(lines[0])
     assert not out.exists()
-
-
-@pytest.mark.mpi
-def test_stacked_blocks_two_ranks_equal_serial(tmp_path: Path) -> None:
-    """The correct stack on two ranks: the serial forces (the new checks pass there too)."""
-    serial, two = tmp_path / "1.json", tmp_path / "2.json"
-    for ranks, path in ((1, serial), (2, two)):
-        proc = run_cli("solve", str(STACK), "--json", str(path), ranks=ranks)
-        assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
-    a, b = json.loads(serial.read_text()), json.loads(two.read_text())
-    for ca, cb in zip(a["contacts"], b["contacts"], strict=True):
-        np.testing.assert_allclose(ca["force"], cb["force"], atol=1e-8 * P * L)
 
 
 @pytest.mark.serial

@@ -1,9 +1,5 @@
 """Hertz scene (S5) against the exact plane-strain solution; the active-set loop's behaviour."""
 
-import json
-import textwrap
-from pathlib import Path
-
 import dolfinx_solver  # noqa: F401 - orders MPI ahead of the dolfinx bindings
 import numpy as np
 import pytest
@@ -131,34 +127,3 @@ def test_block_scenes_still_one_iteration(preset: str) -> None:
     _, data = run_case("blocks", BLOCK_SCENES[preset], "mortar", comm=MPI.COMM_SELF)
     assert data["iterations"] == 1
     assert data["active_nodes"] == data["multipliers"]
-
-
-MPI_SCRIPT = """
-import json, sys
-import dolfinx_solver  # noqa: F401
-from mpi4py import MPI
-from contactfx.api import run_case
-from contactfx.scenes import HertzParams
-_, d = run_case("hertz", HertzParams(refine=0.08, refine_edge=0.02, slope=0.2), "mortar")
-if MPI.COMM_WORLD.rank == 0:
-    json.dump({"hertz": d["hertz"], "x": d["interface"]["x"],
-               "p": d["interface"]["pressure"], "ranks": d["ranks"]}, open(sys.argv[1], "w"))
-"""
-
-
-@pytest.mark.mpi
-def test_mpi_equals_serial(tmp_path: Path, mpi_script) -> None:
-    script = tmp_path / "hertz_mpi.py"
-    script.write_text(textwrap.dedent(MPI_SCRIPT))
-    out = tmp_path / "mpi.json"
-    mpi_script(script, str(out), timeout=120)
-    par = json.loads(out.read_text())
-    assert par["ranks"] == 2
-    _, ser = run_case(
-        "hertz", HertzParams(refine=0.08, refine_edge=0.02, slope=0.2), "mortar", comm=MPI.COMM_SELF
-    )
-    assert np.allclose(par["x"], ser["interface"]["x"], rtol=0, atol=1e-12)
-    assert np.allclose(par["p"], ser["interface"]["pressure"], rtol=0, atol=1e-8)
-    for key in ("a", "p0", "l2_error"):
-        assert par["hertz"][key] == pytest.approx(ser["hertz"][key], rel=1e-8, abs=1e-12)
-    assert par["hertz"]["a_bracket"] == pytest.approx(ser["hertz"]["a_bracket"], abs=1e-12)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -147,47 +146,3 @@ def test_solvers_and_methods_that_refuse_obstacles() -> None:
         condensed = solve(s, method, solver="condensed", **options)
         ua, ub = u_at_points(direct), u_at_points(condensed)
         assert np.abs(ub[:, 2:] - ua[:, 2:]).max() < 1e-6 * np.abs(ua[:, 2:]).max()
-
-
-MPI_SCRIPT = textwrap.dedent("""
-    import sys
-    import numpy as np
-    from mpi4py import MPI
-    from contactfx import load_scene_file, run_scene
-    from contactfx.results.interface import u_at_points
-
-    path, method, basis, out = sys.argv[1:5]
-    sol, data = run_scene(load_scene_file(path), method, basis=basis)
-    u = u_at_points(sol)
-    if MPI.COMM_WORLD.rank == 0:
-        itf = data["contacts"][0]["interface"]
-        np.savez(out, u=u, x=np.asarray(itf["x"]), p=np.asarray(itf["pressure"]),
-                 f=np.asarray(data["contacts"][0]["force"]), ranks=data["ranks"])
-""")
-
-
-@pytest.mark.mpi
-@pytest.mark.parametrize(
-    ("scene", "method", "basis"),
-    [
-        ("demos/scenes/rigid_indenter.toml", "mortar", "standard"),
-        ("demos/scenes/rigid_punch.toml", "nts", "standard"),
-        ("tests/scenes/rigid_floor.toml", "mortar", "dual"),
-    ],
-)
-def test_two_ranks_equal_serial(tmp_path, mpi_script, scene, method, basis) -> None:
-    """mpirun -n 2 gives the serial displacements, pressures and forces to 1e-8."""
-    script = tmp_path / "run.py"
-    script.write_text(MPI_SCRIPT)
-    res = {}
-    for ranks in (1, 2):
-        out = tmp_path / f"r{ranks}.npz"
-        mpi_script(script, str(ROOT / scene), method, basis, str(out), ranks=ranks)
-        res[ranks] = np.load(out)
-    assert int(res[2]["ranks"]) == 2
-    u1, u2 = res[1]["u"], res[2]["u"]
-    np.testing.assert_allclose(u2[:, :2], u1[:, :2], atol=1e-12)
-    assert np.abs(u2[:, 2:] - u1[:, 2:]).max() < 1e-8 * np.abs(u1[:, 2:]).max()
-    np.testing.assert_allclose(res[2]["x"], res[1]["x"], atol=1e-12)
-    assert np.abs(res[2]["p"] - res[1]["p"]).max() < 1e-8 * np.abs(res[1]["p"]).max()
-    assert np.abs(res[2]["f"] - res[1]["f"]).max() < 1e-8 * np.abs(res[1]["f"]).max()

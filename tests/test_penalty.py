@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import itertools
 import json
-import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
 import dolfinx_solver  # noqa: F401
 import numpy as np
 import pytest
-from conftest import ENV, MPIRUN, cli
+from conftest import cli
 from mpi4py import MPI
 
 from contactfx.api import run_case
@@ -79,38 +77,6 @@ def test_cli_json_has_penalty_and_penetration(tmp_path: Path) -> None:
     h = float(np.median(sol.layout.weights))
     assert data["penalty"] == pytest.approx(DEFAULT_FACTOR * max(S4.E1, S4.E2) / h, rel=1e-12)
     assert data["penetration"] == pytest.approx(S4.p / data["penalty"], rel=1e-8)
-
-
-def test_penalty_mpi_matches_serial(tmp_path: Path) -> None:
-    args = [
-        "-m",
-        "contactfx",
-        "solve",
-        "hertz",
-        "--refine",
-        "0.1",
-        "--method",
-        "penalty",
-        "--penalty",
-        "1e6",
-        "-q",
-        "--json",
-    ]
-    subprocess.run(
-        [sys.executable, *args, str(tmp_path / "s.json")], check=True, env=ENV, timeout=120
-    )
-    subprocess.run(
-        [MPIRUN, "-n", "2", sys.executable, *args, str(tmp_path / "m.json")],
-        check=True,
-        env=ENV,
-        timeout=300,
-    )
-    s, m = (json.loads((tmp_path / f"{k}.json").read_text()) for k in "sm")
-    assert m["ranks"] == 2
-    assert m["iterations"] == s["iterations"]
-    ps, pm = np.array(s["interface"]["pressure"]), np.array(m["interface"]["pressure"])
-    assert np.max(np.abs(ps - pm)) < 1e-8 * np.max(ps)
-    assert m["penetration"] == pytest.approx(s["penetration"], rel=1e-8)
 
 
 def test_default_penalty_penetration_is_load_over_stiffness() -> None:

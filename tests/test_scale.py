@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import math
-import textwrap
 
 import numpy as np
 import pytest
@@ -219,37 +218,6 @@ def test_structured_hertz_geometry_and_contact() -> None:
     assert abs(xs.max() - a_exact) < 0.05 + 1e-9
     force = float((sol.pressure * sol.layout.weights).sum())
     assert force == pytest.approx(50.0, rel=1e-9)
-
-
-MPI_SCRIPT = textwrap.dedent("""
-    import sys
-    import numpy as np
-    from mpi4py import MPI
-    from contactfx.options import Method
-    from contactfx.methods.multipliers import solve_contact
-    from contactfx.scenes import HertzParams
-    from contactfx.scenes import hertz
-
-    scene = hertz(HertzParams(refine=0.05, h_far=2.0, mesh="structured"))
-    sol = solve_contact(scene, Method.MORTAR, sys.argv[2])
-    if MPI.COMM_WORLD.rank == 0:
-        np.savez(sys.argv[1], p=sol.pressure, x=sol.layout.x, it=sol.iterations)
-""")
-
-
-@pytest.mark.parametrize("solver", ["mumps", "fieldsplit-gamg"])
-def test_structured_hertz_two_ranks_equal_serial(tmp_path, mpi_script, solver) -> None:
-    """Persistent solver paths and the structured mesh give the serial answer on 2 ranks."""
-    script = tmp_path / "run.py"
-    script.write_text(MPI_SCRIPT)
-    out = {}
-    for ranks in (1, 2):
-        out[ranks] = tmp_path / f"r{ranks}.npz"
-        mpi_script(script, str(out[ranks]), solver, ranks=ranks)
-    r1, r2 = np.load(out[1]), np.load(out[2])
-    np.testing.assert_allclose(r2["x"], r1["x"], atol=1e-12)
-    tol = 1e-8 if solver == "mumps" else 1e-5
-    assert np.abs(r2["p"] - r1["p"]).max() <= tol * np.abs(r1["p"]).max()
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import logging
-import textwrap
 from dataclasses import replace
 
 import numpy as np
@@ -174,37 +173,3 @@ def test_cli_writes_the_usual_schema(tmp_path) -> None:
         assert key in data
     assert data["method"] == "schwarz" and data["iterations"] == 14
     assert set(data["interface"]) == {"x", "pressure", "sigma_yy_1", "sigma_yy_2"}
-
-
-SCRIPT = textwrap.dedent("""
-    import sys
-    import numpy as np
-    from mpi4py import MPI
-    from contactfx.api import run_case
-    from contactfx.results.interface import u_at_points
-    from contactfx.scenes import BLOCK_SCENES
-
-    scene, active, out = sys.argv[1:4]
-    sol, data = run_case("blocks", BLOCK_SCENES[scene], "schwarz", active=int(active))
-    u = u_at_points(sol)
-    if MPI.COMM_WORLD.rank == 0:
-        np.savez(out, u=u, p=np.asarray(data["interface"]["pressure"]), ranks=data["ranks"],
-                 its=data["iterations"])
-""")
-
-
-def test_two_ranks_equal_serial(tmp_path, mpi_script) -> None:
-    """mpirun -n 2 gives the serial displacement, multipliers and iteration count."""
-    script = tmp_path / "run.py"
-    script.write_text(SCRIPT)
-    res = {}
-    for ranks in (1, 2):
-        out = tmp_path / f"r{ranks}.npz"
-        mpi_script(script, "S2", "1", str(out), ranks=ranks)
-        res[ranks] = np.load(out)
-    assert int(res[2]["ranks"]) == 2
-    assert int(res[1]["its"]) == int(res[2]["its"])
-    u1, u2 = res[1]["u"], res[2]["u"]
-    np.testing.assert_allclose(u2[:, :2], u1[:, :2], atol=1e-12)
-    assert np.abs(u2[:, 2:] - u1[:, 2:]).max() < 1e-8 * np.abs(u1[:, 2:]).max()
-    assert np.abs(res[2]["p"] - res[1]["p"]).max() < 1e-8 * np.abs(res[1]["p"]).max()

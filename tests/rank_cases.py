@@ -1,0 +1,322 @@
+"""The cases that must give the serial answer on 2 ranks, and their 2-rank runner.
+
+Each case solves on MPI.COMM_WORLD and returns (Solution, arrays): the arrays in an order
+that does not depend on the partition (u at the sorted nodes, the x-sorted interface, the
+layout sorted by position), all ranks holding the same values. tests/test_ranks.py runs a
+case in the pytest process (1 rank) and compares it with this file's output on 2 ranks:
+
+    mpirun -n 2 python -m mpi4py tests/rank_cases.py OUTDIR case1 case2 ...
+
+runs the named cases in one process pair; rank 0 writes OUTDIR/<case>.npz with the arrays,
+`_ranks` and `_owned_cells` (each rank's owned cells: both must own part of the mesh).
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+from unittest import mock
+
+import dolfinx_solver  # noqa: F401  (before dolfinx and petsc4py)
+import numpy as np
+from mpi4py import MPI
+from rank_checks import Abs, Approx, Check, Exact, Rel, u_checks
+
+from contactfx import cli, load_scene_file, run_scene, solve
+from contactfx.api import run_case
+from contactfx.cli import solve as cli_solve
+from contactfx.methods.solution import Solution
+from contactfx.results.interface import u_at_points
+from contactfx.scenes import BLOCK_SCENES, HertzParams, hertz
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "tests" / "scenes"
+DEMO_SCENES = ROOT / "demos" / "scenes"
+Arrays = dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class Case:
+    """A run on COMM_WORLD and one check per array it returns."""
+
+    run: Callable[[], tuple[Solution, Arrays]]
+    checks: Mapping[str, Check]
+
+
+CASES: dict[str, Case] = {}
+
+
+def u_split(sol: Solution) -> Arrays:
+    """(x, y) and (ux, uy) of every node, sorted by position (collective)."""
+    u = u_at_points(sol)
+    return {"u_xy": u[:, :2], "u": u[:, 2:]}
+
+
+def by_position(sol: Solution) -> np.ndarray:
+    """The layout rows sorted by position (rows are ordered by owner rank)."""
+    x = np.round(sol.layout.x, 9)
+    return np.lexsort((x[:, 1], x[:, 0]))
+
+
+@contextmanager
+def cli_solution() -> Iterator[list[Solution]]:
+    """Record the Solution that `contactfx solve` computes (its run_scene, unchanged)."""
+    seen: list[Solution] = []
+
+    def recording(*args: Any, **kwargs: Any) -> tuple[Solution, dict[str, Any]]:
+        sol, data = run_scene(*args, **kwargs)
+        seen.append(sol)
+        return sol, data
+
+    with mock.patch.object(cli_solve, "run_scene", recording):
+        yield seen
+
+
+def cli_json(argv: list[str]) -> tuple[Solution, dict[str, Any]]:
+    """`contactfx solve argv --json F` in this process; its Solution and F (on every rank)."""
+    import json
+
+    comm = MPI.COMM_WORLD
+    with tempfile.TemporaryDirectory() as tmp:
+        path = comm.bcast(str(Path(tmp) / "r.json"))
+        with cli_solution() as seen:
+            code = cli.main([*argv, "--json", path, "-q"])
+        assert code == 0, f"contactfx {' '.join(argv)}: exit {code}"
+        data = json.loads(Path(path).read_text()) if comm.rank == 0 else None
+        comm.barrier()  # rank 0 has read the file before the directory goes
+    return seen[-1], comm.bcast(data)
+
+
+# --- the built-in block scenes (test_parallel, test_schwarz) ------------------------------
+
+
+def blocks(scene: str, method: str, active: int, solver: str) -> Callable[[], Any]:
+    """The paper's block scene `scene`: u, interface x and pressure."""
+
+    def run() -> tuple[Solution, Arrays]:
+        sol, data = run_case("blocks", BLOCK_SCENES[scene], method, active=active, solver=solver)
+        itf = data["interface"]
+        return sol, {**u_split(sol), "x": np.asarray(itf["x"]), "p": np.asarray(itf["pressure"])}
+
+    return run
+
+
+BLOCK_CHECKS = {**u_checks(), "x": Abs(1e-12), "p": Rel(1e-8)}
+for _scene, _method, _active, _solver in (
+    ("S2", "nts", 2, "mumps"),
+    ("S3", "sts", 1, "mumps"),
+    ("S4", "mortar", 2, "mumps"),
+    ("S2", "mortar", 1, "fieldsplit"),
+):
+    CASES[f"blocks-{_scene}-{_method}-a{_active}-{_solver}"] = Case(
+        blocks(_scene, _method, _active, _solver), BLOCK_CHECKS
+    )
+
+
+def schwarz_s2() -> tuple[Solution, Arrays]:
+    """Schwarz on S2 (active body 1): u, pressure and the iteration count."""
+    sol, data = run_case("blocks", BLOCK_SCENES["S2"], "schwarz", active=1)
+    p = np.asarray(data["interface"]["pressure"])
+    return sol, {**u_split(sol), "p": p, "its": np.asarray(data["iterations"])}
+
+
+CASES["schwarz-S2-a1"] = Case(schwarz_s2, {**u_checks(), "p": Rel(1e-8), "its": Exact()})
+
+
+# --- scene files (test_own_scene, test_obstacle_input, test_floating_bodies) ---------------
+
+
+def user_scene(path: Path, method: str) -> Callable[[], Any]:
+    """A scene file: u, and every pair's arc length, pressure and sigma_nn (active side)."""
+
+    def run() -> tuple[Solution, Arrays]:
+        sol, data = run_scene(load_scene_file(path), method)
+        itf = [c["interface"] for c in data["contacts"]]
+        snn = [v for i in itf for v in i["sigma_nn_active"]]
+        return sol, {
+            **u_split(sol),
+            "s": np.concatenate([i["s"] for i in itf]),
+            "p": np.concatenate([i["pressure"] for i in itf]),
+            "snn": np.array(snn, dtype=float),
+        }
+
+    return run
+
+
+SCENE_CHECKS = {**u_checks(), "s": Abs(1e-12), "p": Rel(1e-8), "snn": Rel(1e-8)}
+CASES["scene-three-bodies-mortar"] = Case(
+    user_scene(DEMO_SCENES / "cylinder_between_blocks.toml", "mortar"), SCENE_CHECKS
+)
+CASES["scene-inclined-patch-sts"] = Case(
+    user_scene(SCENES / "inclined_patch.toml", "sts"), SCENE_CHECKS
+)
+
+
+def obstacle(path: Path, method: str, basis: str) -> Callable[[], Any]:
+    """A rigid-obstacle scene: u, pair 0's x and pressure, its force."""
+
+    def run() -> tuple[Solution, Arrays]:
+        sol, data = run_scene(load_scene_file(path), method, basis=basis)
+        c = data["contacts"][0]
+        return sol, {
+            **u_split(sol),
+            "x": np.asarray(c["interface"]["x"]),
+            "p": np.asarray(c["interface"]["pressure"]),
+            "f": np.asarray(c["force"]),
+        }
+
+    return run
+
+
+OBSTACLE_CHECKS = {**u_checks(), "x": Abs(1e-12), "p": Rel(1e-8), "f": Rel(1e-8)}
+for _name, _path, _method, _basis in (
+    ("indenter-mortar", DEMO_SCENES / "rigid_indenter.toml", "mortar", "standard"),
+    ("punch-nts", DEMO_SCENES / "rigid_punch.toml", "nts", "standard"),
+    ("floor-mortar-dual", SCENES / "rigid_floor.toml", "mortar", "dual"),
+):
+    CASES[f"obstacle-{_name}"] = Case(obstacle(_path, _method, _basis), OBSTACLE_CHECKS)
+
+
+def stacked_blocks() -> tuple[Solution, Arrays]:
+    """`contactfx solve stacked_blocks.toml`: every pair's force (the floating checks pass)."""
+    sol, data = cli_json(["solve", str(SCENES / "stacked_blocks.toml")])
+    return sol, {"forces": np.array([c["force"] for c in data["contacts"]], dtype=float)}
+
+
+# 1e-8 p L with p = 10 on the blocks' width L = 2.
+CASES["cli-stacked-blocks"] = Case(stacked_blocks, {"forces": Abs(1e-8 * 10.0 * 2.0)})
+
+
+# --- Hertz (test_hertz, test_scale, test_dual_condensed, test_direct_floor, test_penalty) ----
+
+
+def hertz_graded() -> tuple[Solution, Arrays]:
+    """The graded gmsh Hertz scene, mortar: the pressure profile and the Hertz measures."""
+    params = HertzParams(refine=0.08, refine_edge=0.02, slope=0.2)
+    sol, d = run_case("hertz", params, "mortar")
+    h = d["hertz"]
+    return sol, {
+        "x": np.asarray(d["interface"]["x"]),
+        "p": np.asarray(d["interface"]["pressure"]),
+        "measures": np.array([h["a"], h["p0"], h["l2_error"]], dtype=float),
+        "a_bracket": np.asarray(h["a_bracket"], dtype=float),
+    }
+
+
+CASES["hertz-graded-mortar"] = Case(
+    hertz_graded,
+    {"x": Abs(1e-12), "p": Abs(1e-8), "measures": Approx(1e-8), "a_bracket": Abs(1e-12)},
+)
+
+
+def structured_hertz(solver: str, refine: float, h_far: float) -> Callable[[], Any]:
+    """The structured Hertz mesh, mortar, a persistent solver: layout x and pressure."""
+
+    def run() -> tuple[Solution, Arrays]:
+        from contactfx.methods.multipliers import solve_contact
+        from contactfx.options import Method
+
+        scene = hertz(HertzParams(refine=refine, h_far=h_far, mesh="structured"))
+        sol = solve_contact(scene, Method.MORTAR, solver)
+        return sol, {"x": sol.layout.x, "p": sol.pressure}
+
+    return run
+
+
+# fieldsplit-gamg on the mesh 4x coarser: 8 active-set steps, each a GAMG setup and ~60
+# FGMRES iterations, 2-3 s. At refine 0.05 the loop takes 17 steps (no probes: the set is
+# released 1-3 rows a step) and on 2 ranks FGMRES needs ~220 iterations, past its restart
+# length 200 (serial: ~94): 80 s on 2 ranks for the same path.
+for _solver, _refine, _h_far, _tol in (
+    ("mumps", 0.05, 2.0, 1e-8),
+    ("fieldsplit-gamg", 0.2, 8.0, 1e-5),
+):
+    CASES[f"hertz-structured-{_solver}"] = Case(
+        structured_hertz(_solver, _refine, _h_far), {"x": Abs(1e-12), "p": Rel(_tol)}
+    )
+
+
+def condensed_nts() -> tuple[Solution, Arrays]:
+    """The condensed solver (CG-GAMG), NTS, structured Hertz: active flags and pressures."""
+    sol = solve(hertz(HertzParams(refine=0.08, h_far=0.8, mesh="structured")), "nts",
+                solver="condensed")  # fmt: skip
+    order = np.lexsort(sol.layout.x.T[::-1])
+    return sol, {"act": sol.active[order], "p": sol.pressure[order]}
+
+
+# CG to rtol 1e-9 on the residual: 1e-6 on the pressures.
+CASES["hertz-condensed-nts"] = Case(condensed_nts, {"act": Exact(), "p": Rel(1e-6)})
+
+
+def probe_by_selected_inverse(solver: str) -> Callable[[], Any]:
+    """Mortar on Hertz: the rows probed in step 1 (selected inverse) and the pressures."""
+
+    def run() -> tuple[Solution, Arrays]:
+        sol = solve(hertz(HertzParams(refine=0.05)), "mortar", solver=solver)
+        probes = np.asarray(sol.history[0]["probes"])
+        return sol, {"probes": probes, "p": sol.pressure[by_position(sol)]}
+
+    return run
+
+
+for _solver in ("mumps", "mumps-lu"):
+    CASES[f"hertz-probe-{_solver}"] = Case(
+        probe_by_selected_inverse(_solver), {"probes": Exact(positive=True), "p": Rel(1e-8)}
+    )
+
+
+def penalty_cli() -> tuple[Solution, Arrays]:
+    """`contactfx solve hertz --method penalty`: iterations, pressure, penetration."""
+    argv = ["solve", "hertz", "--refine", "0.1", "--method", "penalty", "--penalty", "1e6"]
+    sol, data = cli_json(argv)
+    p = np.asarray(data["interface"]["pressure"])
+    assert p.min() >= 0.0  # so that max |p| (Rel's scale) is max p
+    return sol, {
+        "its": np.asarray(data["iterations"]),
+        "p": p,
+        "penetration": np.asarray(data["penetration"]),
+    }
+
+
+CASES["cli-hertz-penalty"] = Case(
+    penalty_cli, {"its": Exact(), "p": Rel(1e-8), "penetration": Approx(1e-8)}
+)
+
+
+# --- the runner -----------------------------------------------------------------------------
+
+
+def owned_cells(sol: Solution) -> np.ndarray:
+    """Each rank's owned cell count (collective)."""
+    mine = sol.scene.mesh.topology.index_map(sol.scene.mesh.topology.dim).size_local
+    return np.array(sol.scene.comm.allgather(mine))
+
+
+def run(name: str) -> tuple[Arrays, np.ndarray]:
+    """Case `name` on COMM_WORLD: its arrays and each rank's owned cells."""
+    sol, arrays = CASES[name].run()
+    return arrays, owned_cells(sol)
+
+
+def main(outdir: str, names: list[str]) -> None:
+    """Run `names` on COMM_WORLD; rank 0 writes outdir/<name>.npz."""
+    unknown = sorted(set(names) - set(CASES))
+    assert not unknown, f"unknown cases {unknown}"
+    comm = MPI.COMM_WORLD
+    for name in names:
+        t0 = time.perf_counter()
+        arrays, owned = run(name)
+        if comm.rank == 0:
+            extra = {"_ranks": comm.size, "_owned_cells": owned}
+            np.savez(Path(outdir) / f"{name}.npz", **arrays, **extra)
+            print(f"{name}: {time.perf_counter() - t0:.1f} s", flush=True)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2:])
