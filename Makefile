@@ -25,12 +25,14 @@ $(STAMP): pyproject.toml setup.py
 demo: $(STAMP)
 	$(PY) demos/demo_blocks.py
 
+# In-process tests on both cores (pytest-xdist); then the mpirun -n 2 tests, one at a time.
 test: $(STAMP)
 	$(PY) -m ruff check contactfx meshes tests demos benchmarks
 	$(PY) -m ruff format --check contactfx meshes tests demos benchmarks
 	$(PY) -m mypy
 	$(VENV)/bin/lint-imports
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n 2 -m serial tests
+	$(PY) -m pytest -q -m mpi tests
 
 bench: $(STAMP)
 	$(PY) benchmarks/run.py

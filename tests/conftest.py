@@ -24,6 +24,13 @@ MPIRUN = str(Path(sys.executable).parent / "mpirun")
 ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
 
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Every test that launches no mpirun runs in this process on one rank: mark it serial."""
+    for item in items:
+        if item.get_closest_marker("mpi") is None and item.get_closest_marker("serial") is None:
+            item.add_marker(pytest.mark.serial)
+
+
 def run_cli(
     *args: str, cwd: Path | None = None, ranks: int = 1, timeout: float = 300
 ) -> subprocess.CompletedProcess[str]:

@@ -3,7 +3,7 @@
 import json
 
 import pytest
-from conftest import run_cli
+from conftest import cli, run_cli
 
 KEYS = {
     "scene",
@@ -23,7 +23,7 @@ KEYS = {
 def test_blocks_nts_writes_schema(tmp_path) -> None:
     """`solve blocks --method nts --json r.json` writes every documented key."""
     out = tmp_path / "r.json"
-    proc = run_cli(
+    proc = cli(
         "solve", "blocks", "--method", "nts", "--json", str(out), "--out", str(tmp_path / "fields")
     )
     assert proc.returncode == 0, proc.stderr
@@ -49,7 +49,7 @@ def test_blocks_nts_writes_schema(tmp_path) -> None:
 def test_mortar_patch_test_from_the_issue(tmp_path) -> None:
     """The issue's acceptance command: mortar on S4 geometry gives sigma_yy = -p to 1e-8."""
     out = tmp_path / "r.json"
-    proc = run_cli(
+    proc = cli(
         "solve",
         "blocks",
         "--method",
@@ -88,10 +88,11 @@ def test_mortar_patch_test_from_the_issue(tmp_path) -> None:
     ],
 )
 def test_bad_input_one_line_no_traceback(tmp_path, args: list[str], needle: str) -> None:
-    """Bad input: non-zero exit, one line on stderr naming the problem, no JSON written."""
+    """Bad input: exit 2, one line on stderr naming the problem, no JSON written (in this
+    process: main() turns the error into its line; the fresh-process contract is below)."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", *args, "--json", str(out))
-    assert proc.returncode != 0
+    proc = cli("solve", *args, "--json", str(out))
+    assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], proc.stderr
     assert "Traceback" not in proc.stderr + proc.stdout
@@ -101,7 +102,7 @@ def test_bad_input_one_line_no_traceback(tmp_path, args: list[str], needle: str)
 def test_hertz_structured_mesh_from_the_cli(tmp_path) -> None:
     """`--mesh structured` builds the Hertz scene in DOLFINx and lands near the exact a."""
     out = tmp_path / "h.json"
-    proc = run_cli(
+    proc = cli(
         "solve",
         "hertz",
         "--mesh",
@@ -123,5 +124,21 @@ def test_hertz_structured_mesh_from_the_cli(tmp_path) -> None:
 
 def test_mesh_option_is_hertz_only(tmp_path) -> None:
     """--mesh on the blocks scene is refused with one line."""
-    proc = run_cli("solve", "blocks", "--mesh", "structured", "--json", str(tmp_path / "r.json"))
+    proc = cli("solve", "blocks", "--mesh", "structured", "--json", str(tmp_path / "r.json"))
     assert proc.returncode == 2 and "hertz scene only" in proc.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [(["blocks", "--E2", "0"], "Young"), (["blocks", "--solver", "cg"], "unknown solver")],
+    ids=["model-error", "usage-error"],
+)
+def test_bad_input_in_a_fresh_process_exits_2(tmp_path, args: list[str], needle: str) -> None:
+    """`python -m contactfx` itself: exit status 2, one stderr line, no traceback, no JSON."""
+    out = tmp_path / "r.json"
+    proc = run_cli("solve", *args, "--json", str(out))
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], proc.stderr
+    assert "Traceback" not in proc.stderr + proc.stdout
+    assert not out.exists()

@@ -11,6 +11,7 @@ import dolfinx_solver  # noqa: F401
 import numpy as np
 import pytest
 from conftest import ENV, MPIRUN
+from conftest import cli as run_in_process
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
@@ -56,14 +57,20 @@ def shift_body(scene: Scene, body: int, dx: float, dy: float) -> None:
 
 
 def cli(tmp_path: Path, *args: str, mpi: int = 0) -> tuple[int, list[str], Path]:
-    """Run the CLI; return the exit code, the non-empty stderr lines and the JSON path."""
+    """Run the CLI; return the exit code, the non-empty stderr lines and the JSON path.
+
+    Serially in this process (main() is what turns an error into its line and exit code);
+    with `mpi`, as the README runs it, in fresh processes under mpirun.
+    """
     out = tmp_path / "run.json"
-    cmd = [sys.executable, "-m", "contactfx", "solve", *args, "--json", str(out), "-q"]
+    args = ("solve", *args, "--json", str(out), "-q")
     if mpi:
-        # As the README runs it: every rank raises the same (collective) error and exits 2;
-        # under `-m mpi4py` a non-zero exit would become an MPI_Abort with its own message.
-        cmd = [MPIRUN, "-n", str(mpi), *cmd]
-    res = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+        # Every rank raises the same (collective) error and exits 2; under `-m mpi4py` a
+        # non-zero exit would become an MPI_Abort with its own message.
+        cmd = [MPIRUN, "-n", str(mpi), sys.executable, "-m", "contactfx", *args]
+        res = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+    else:
+        res = run_in_process(*args)
     return res.returncode, [ln for ln in res.stderr.splitlines() if ln.strip()], out
 
 

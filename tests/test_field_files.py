@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ENV, ROOT, run_cli
+from conftest import ENV, ROOT, cli, run_cli
 
 STACK = ROOT / "tests" / "scenes" / "stacked_blocks.toml"
 P, H = 10.0, 1.0
@@ -78,7 +78,8 @@ def exact_u(x: np.ndarray, cell_y: np.ndarray) -> np.ndarray:
 
 def solve_with_out(tmp: Path, ranks: int) -> tuple[Path, dict]:
     out, js = tmp / "out", tmp / "r.json"
-    proc = run_cli("solve", str(STACK), "--out", str(out), "--json", str(js), ranks=ranks)
+    args = ("solve", str(STACK), "--out", str(out), "--json", str(js))
+    proc = cli(*args) if ranks == 1 else run_cli(*args, ranks=ranks)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     return out, json.loads(js.read_text())
 

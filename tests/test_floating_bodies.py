@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, run_cli
+from conftest import ROOT, cli, run_cli
 
 from contactfx import load_scene_file, run_scene
 from contactfx.errors import SingularSystemError
@@ -57,7 +57,7 @@ def test_far_pair_leaves_two_bodies_floating_and_is_refused(method: str) -> None
 def test_far_pair_cli_exit_2_one_line_no_json(tmp_path: Path) -> None:
     """The CLI: exit 2, one error line naming the bodies and pairs, no JSON, no files."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", str(FAR), "--json", str(out), "--out", str(tmp_path / "out"))
+    proc = cli("solve", str(FAR), "--json", str(out), "--out", str(tmp_path / "out"))
     assert proc.returncode == 2, proc.stdout[-2000:] + proc.stderr[-2000:]
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("contactfx: error: "), proc.stderr

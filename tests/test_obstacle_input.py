@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, run_cli
+from conftest import ROOT, cli
 
 from contactfx import InputError, Obstacle, load_scene_file, scene_from_gmsh, solve
 from contactfx.results.interface import u_at_points
@@ -95,7 +95,7 @@ def test_bad_obstacles_cli_one_line(tmp_path: Path, obstacle: str, needle: str) 
     an initial penetration, a plane whose normal points away from the body: exit 2, one
     line, no traceback, no JSON."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", str(scene_file(tmp_path, obstacle)), "--json", str(out))
+    proc = cli("solve", str(scene_file(tmp_path, obstacle)), "--json", str(out))
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], proc.stderr
@@ -109,7 +109,7 @@ def test_out_writes_the_obstacle(tmp_path: Path) -> None:
     import pyvista
 
     out, js = tmp_path / "out", tmp_path / "r.json"
-    proc = run_cli("solve", str(INDENTER), "--method", "nts", "--json", str(js), "--out", str(out))
+    proc = cli("solve", str(INDENTER), "--method", "nts", "--json", str(js), "--out", str(out))
     assert proc.returncode == 0, proc.stderr
     data = json.loads(js.read_text())
     c = data["contacts"][0]

@@ -13,7 +13,7 @@ from pathlib import Path
 import gmsh
 import numpy as np
 import pytest
-from conftest import ROOT, run_cli
+from conftest import ROOT, cli
 
 from contactfx import Scene, load_scene_file, run_scene, scene_from_gmsh
 from contactfx.errors import GeometryError, InputError, MeshError, SingularSystemError
@@ -208,7 +208,7 @@ def test_small_user_scene_point_support_and_cli(tmp_path: Path) -> None:
     _blocks_geo(tmp_path / "b.geo")
     scene = _toml(tmp_path / "s.toml", "b.geo", '[[dirichlet]]\ngroup = "left"\nux = 0.0\n')
     out = tmp_path / "r.json"
-    proc = run_cli(
+    proc = cli(
         "solve", str(scene), "--method", "mortar", "--json", str(out), "--out", str(tmp_path / "o")
     )
     assert proc.returncode == 0, proc.stderr
@@ -305,7 +305,7 @@ def test_bad_scene_file_cli_one_line(tmp_path: Path) -> None:
     )
     for name, needle in (("s.toml", "does not exist"), ("t.toml", "unknown key 'pasive'")):
         out = tmp_path / "r.json"
-        proc = run_cli("solve", str(tmp_path / name), "--json", str(out))
+        proc = cli("solve", str(tmp_path / name), "--json", str(out))
         assert proc.returncode == 2
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and needle in lines[0], proc.stderr

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import run_cli
+from conftest import cli
 from contactfx.meshes.hertz_structured import graded_points, hertz_grid
 from mpi4py import MPI
 
@@ -170,7 +170,7 @@ def test_gamg_fieldsplit_agrees_with_mumps(kind, params, method) -> None:
 def test_reference_timing_in_json(tmp_path) -> None:
     """--reference-timing adds times.reference_solve; per-iteration solver data is there."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", "hertz", "--method", "mortar", "--reference-timing", "--json", str(out))
+    proc = cli("solve", "hertz", "--method", "mortar", "--reference-timing", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     assert data["times"]["reference_solve"] > 0.0

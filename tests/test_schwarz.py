@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import run_cli
+from conftest import cli
 
 from contactfx.api import run_case
 from contactfx.errors import ConvergenceError, InputError
@@ -155,7 +155,7 @@ def test_hertz_is_rejected() -> None:
 def test_cli_writes_the_usual_schema(tmp_path) -> None:
     """python -m contactfx solve blocks --method schwarz --json r.json."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", "blocks", "--method", "schwarz", "--json", str(out))
+    proc = cli("solve", "blocks", "--method", "schwarz", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     for key in (

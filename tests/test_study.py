@@ -183,7 +183,7 @@ def test_msh_scene_cannot_be_refined(tmp_path: Path) -> None:
         .read_text()
         .replace('mesh = "two_cylinders.geo"', 'mesh = "two_cylinders.msh"')
     )
-    proc = run_cli("study", str(toml), "--out", str(tmp_path / "out"))
+    proc = cli("study", str(toml), "--out", str(tmp_path / "out"))
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "cannot be refined" in lines[0] and ".geo" in lines[0], lines

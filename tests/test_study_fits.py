@@ -20,7 +20,7 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 import pytest
-from conftest import ROOT, run_cli
+from conftest import ROOT, cli
 
 matplotlib.use("Agg")
 from matplotlib.figure import Figure
@@ -46,7 +46,7 @@ def rotated_scene(tmp: Path, reference: bool) -> Path:
 
 def study(args: tuple[str, ...], out: Path) -> tuple[dict, str]:
     """Run `contactfx study ...`; its study.json and stdout."""
-    proc = run_cli("study", *args, "--out", str(out))
+    proc = cli("study", *args, "--out", str(out))
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return json.loads((out / "study.json").read_text()), proc.stdout
 
