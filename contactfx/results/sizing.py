@@ -1,0 +1,92 @@
+"""A new mesh size from the error indicators: equidistribution at the element's rate.
+
+For Q1 elements the energy error converges like h^p, p = 1, so a cell's indicator scales
+like eta_K ~ h_K^(p + 1) in 2D (h^p times the square root of the area). A cell of size h'
+in K's place has eta' = eta_K (h'/h_K)^(p+1); asking every new cell for the same eta_t
+gives h'_K = h_K (eta_t / eta_K)^(1/(p+1)), N' = sum_K (eta_K/eta_t)^(2/(p+1)) cells and
+a predicted total eta'^2 = N' eta_t^2. eta_t is the larger of the value that meets the
+tolerance and the value that keeps N' within the growth and DOF budget; the change of size
+per level is clipped (x 1/4 .. x 2: the indicators are asymptotic statements).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..methods.solution import Solution
+from ..scenes import SizeField
+from .estimate import Estimate
+
+
+@dataclass(frozen=True)
+class SizingRule:
+    """How the next mesh is sized: the rate, the budget and the clipping of each step."""
+
+    rate: float = 1.0  # p: energy-norm convergence rate of the element (Q1: 1)
+    growth: float = 4.0  # at most this many times the cells per level
+    finest: float = 0.25  # a cell's size shrinks at most to this fraction per level
+    coarsest: float = 2.0  # and grows at most by this factor
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The next mesh: its size field (on rank 0) and the cells it is planned to have."""
+
+    field: SizeField
+    cells: float
+    predicted: float  # predicted relative estimate on it
+
+
+def _local_cells(sol: Solution, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertices (n, 4, 2) in gmsh order, local vertex ids (n, 4), eta) of the local cells."""
+    msh = sol.scene.mesh
+    tdim = msh.topology.dim
+    n = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
+    msh.topology.create_connectivity(tdim, 0)
+    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)[:n]
+    geo = msh.geometry.dofmaps[0][:n]
+    # DOLFINx orders a quad's vertices (0,0),(1,0),(0,1),(1,1); gmsh goes round the cell.
+    order = [0, 1, 3, 2]
+    return msh.geometry.x[geo][:, order, :2], c2v[:, order], eta[:n]
+
+
+def plan_mesh(
+    sol: Solution, est: Estimate, tol: float, max_cells: float, rule: SizingRule = SizingRule()
+) -> Plan:
+    """The size field of the next level (collective; the field's arrays on rank 0)."""
+    comm = sol.scene.comm
+    Q = est.eta.function_space
+    msh = sol.scene.mesh
+    ntot = msh.topology.index_map(2).size_local + msh.topology.index_map(2).num_ghosts
+    eta_cell = est.eta.x.array[Q.dofmap.list[:ntot, 0]]
+    quads, verts, eta = _local_cells(sol, eta_cell)
+    nloc = msh.topology.index_map(2).size_local
+    d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
+    h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
+    q = rule.rate + 1.0
+    eta = np.maximum(eta, 1e-300)
+    S = comm.allreduce(float(np.sum(eta[:nloc] ** (2 / q))))
+    ncells = msh.topology.index_map(2).size_global
+    budget = min(rule.growth * ncells, max_cells)
+    target = tol * est.energy
+    eta_budget = (S / budget) ** (q / 2)
+    eta_tol = (target**2 / S) ** (1 / (2 - 2 / q))
+    eta_t = max(eta_budget, eta_tol)
+    factor = np.clip((eta_t / eta) ** (1 / q), rule.finest, rule.coarsest)
+    new_h = h * factor
+    cells = comm.allreduce(float(np.sum(factor[:nloc] ** -2.0)))
+    predicted = float(
+        np.sqrt(comm.allreduce(float(np.sum((eta[:nloc] * factor[:nloc] ** (q - 1)) ** 2))))
+    )
+    # Sizes at the vertices: the smallest of the cells around each (continuous, safe).
+    node = np.full(verts.max() + 1, np.inf)
+    np.minimum.at(node, verts.ravel(), np.repeat(new_h, 4))
+    sizes = node[verts]
+    parts = comm.gather((quads[:nloc], sizes[:nloc]), root=0)
+    if parts is None:
+        field = SizeField(np.zeros((0, 4, 2)), np.zeros((0, 4)))
+    else:
+        field = SizeField(np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]))
+    return Plan(field, cells, predicted / est.energy)
