@@ -33,6 +33,7 @@ from mpi4py import MPI
 from ..contact.geometry import nodal_normals, project
 from ..discretize.elasticity import sigma
 from ..discretize.mesh_utils import vertex_to_block
+from ..errors import InputError
 from ..methods.solution import Solution
 from ..scenes import Pressure
 
@@ -199,6 +200,13 @@ def estimate(sol: Solution) -> Estimate:
     """The residual estimate of a multiplier-method (or penalty) solution (collective)."""
     scene = sol.scene
     msh = scene.mesh
+    if msh.comm.size > 1:
+        # The traction jumps are interior-facet integrals, which DOLFINx computes across
+        # ranks only on meshes ghosted by shared facet; the scenes' partitioner ghosts none.
+        raise InputError(
+            "the error estimate (solve --estimate, adapt) runs on one rank only for now: "
+            "run it without mpirun"
+        )
     u, E, nu = sol.u, sol.fields.E, sol.fields.nu
     Q = fem.functionspace(msh, ("DG", 0))
     w = ufl.TestFunction(Q)

@@ -60,7 +60,7 @@ def write_msh(sol: Solution, path: Path) -> Path | None:
     out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(names))]
     out += [f"{g.dim} {g.tag} \"{name}\"" for name, g in sorted(names.items())]
     out += ["$EndPhysicalNames", "$Nodes", str(len(gids))]
-    out += [f"{i + 1} {x!r} {y!r} 0" for i, (x, y) in zip(gids, xy, strict=True)]
+    out += [f"{i + 1} {float(x)!r} {float(y)!r} 0" for i, (x, y) in zip(gids, xy, strict=True)]
     out += ["$EndNodes", "$Elements", str(len(lines) + len(quads))]
     k = 0
     for (a, b), t in zip(lines, ltag, strict=True):

@@ -170,17 +170,23 @@ def uniform_levels(
     paper_interface: bool = False,
     say: Callable[[str], None] | None = None,
 ) -> list[AdaptLevel]:
-    """The same scene refined uniformly (every size / ratio per level) up to max_dofs."""
+    """The same scene refined uniformly (every size / ratio per level) up to max_dofs.
+
+    The last level is the first at or beyond max_dofs (so that the uniform curve spans the
+    adaptive one), unless it would exceed ratio^2 max_dofs.
+    """
     comm = scene.comm
     say = say or (lambda line: print(line, flush=True) if comm.rank == 0 else None)
     out: list[AdaptLevel] = []
     current, mesh_time = scene, 0.0
     for k in range(max_levels):
-        if _mesh_dofs(current) > max_dofs:
+        if _mesh_dofs(current) > ratio**2 * max_dofs:
             break
         level = solve_level(current, k, mesh_time, method, solver, options or {}, paper_interface)
         out.append(level)
         say("uniform " + level_line(level))
+        if level.dofs >= max_dofs:
+            break
         t0 = time.perf_counter()
         current = scene.remeshed(ratio ** -(k + 1))
         mesh_time = time.perf_counter() - t0
