@@ -7,13 +7,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import run_cli
 
 import contactfx
 from contactfx.results.estimate import BULK_TERMS, CONTACT_TERMS, estimate
 from contactfx.results.true_error import energy_error
 from contactfx.scenes import BlockParams, HertzParams, blocks, hertz
-
-from conftest import run_cli
 
 
 def _hertz(h: float, slope: float = 0.3) -> contactfx.Scene:
@@ -70,8 +69,15 @@ def test_true_error_of_itself_is_zero() -> None:
 
 def test_solve_estimate_cli(tmp_path: Path) -> None:
     proc = run_cli(
-        "solve", "hertz", "--refine", "0.1", "--estimate", "--json", str(tmp_path / "r.json"),
-        "--out", str(tmp_path / "out"),
+        "solve",
+        "hertz",
+        "--refine",
+        "0.1",
+        "--estimate",
+        "--json",
+        str(tmp_path / "r.json"),
+        "--out",
+        str(tmp_path / "out"),
     )
     assert proc.returncode == 0, proc.stderr
     data = json.loads((tmp_path / "r.json").read_text())

@@ -73,8 +73,10 @@ def run_adapt(args: argparse.Namespace) -> int:
     mesh_time = time.perf_counter() - t0
     options = {"max_iterations": args.max_iterations}
     paper = not is_scene_file(args.scene)
-    say(f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
-        f"{comm.size} rank{'s' * (comm.size > 1)}")
+    say(
+        f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
+        f"{comm.size} rank{'s' * (comm.size > 1)}"
+    )
     result = adapt(
         scene,
         args.method,

@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         basis=args.basis,
     )
     data["solver"] = "mumps (each body)" if method is Method.SCHWARZ else args.solver
-    cells = ()
+    cells: tuple[Any, ...] = ()
     if args.estimate:
         est = estimate(sol)
         data["estimate"] = est.summary()

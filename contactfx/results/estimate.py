@@ -67,7 +67,7 @@ class Estimate:
 
     @property
     def relative(self) -> float:
-        """total / ||u_h||_E."""
+        """Total / ||u_h||_E."""
         return self.total / self.energy
 
     def summary(self) -> dict[str, Any]:
@@ -180,7 +180,12 @@ def _boundary_tags(sol: Solution) -> tuple[mesh.MeshTags, list[tuple[int, Any, A
     value[ext] = 1 + mask[ext] * nl + load[ext] + 1
     value[ext[mask[ext] == 0]] = 0  # fully prescribed: no residual
     groups = sorted(
-        {g for pv in sol.pairs for g in (pv.pair.active, pv.pair.passive) if g in scene.groups.by_name}
+        {
+            g
+            for pv in sol.pairs
+            for g in (pv.pair.active, pv.pair.passive)
+            if g in scene.groups.by_name
+        }
     )
     contact_tags = []
     for j, group in enumerate(groups):
@@ -191,8 +196,8 @@ def _boundary_tags(sol: Solution) -> tuple[mesh.MeshTags, list[tuple[int, Any, A
     mt = mesh.meshtags(msh, tdim - 1, keep, value[keep])
     classes = []
     for tag in np.unique(value[(value > 0) & (value < _CONTACT_TAG0)]):
-        m, ld = divmod(int(tag) - 1, nl)
-        classes.append((int(tag), (m & 1, (m >> 1) & 1), scene.loads[ld - 1] if ld else None))
+        m, k = divmod(int(tag) - 1, nl)
+        classes.append((int(tag), (m & 1, (m >> 1) & 1), scene.loads[k - 1] if k else None))
     return mt, classes, contact_tags
 
 
@@ -213,7 +218,7 @@ def estimate(sol: Solution) -> Estimate:
     n = ufl.FacetNormal(msh)
     hK = ufl.CellDiameter(msh)
     # A Q1 facet is straight and its reference edge has length 1: |J_f| is its length.
-    he = abs(ufl.geometry.FacetJacobianDeterminant(msh))
+    he: Any = abs(ufl.geometry.FacetJacobianDeterminant(msh))  # type: ignore[arg-type]
     sig = sigma(u, E, nu)
     tn = ufl.dot(sig, n)
     mt, classes, contact_tags = _boundary_tags(sol)

@@ -32,8 +32,9 @@ def _gathered(sol: Solution) -> tuple | None:
     msh.topology.create_connectivity(tdim, 0)
     msh.topology.create_connectivity(tdim - 1, 0)
     c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
-    v2g = np.zeros(msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts,
-                   dtype=np.int64)
+    v2g = np.zeros(
+        msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts, dtype=np.int64
+    )
     v2g[c2v.ravel()] = geo[: c2v.shape[0]].ravel()
     lines, ltag = np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
     nfac = msh.topology.index_map(tdim - 1).size_local
@@ -58,7 +59,7 @@ def write_msh(sol: Solution, path: Path) -> Path | None:
     gids, xy, quads, ctag, lines, ltag = data
     names = sol.scene.groups.by_name
     out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(names))]
-    out += [f"{g.dim} {g.tag} \"{name}\"" for name, g in sorted(names.items())]
+    out += [f'{g.dim} {g.tag} "{name}"' for name, g in sorted(names.items())]
     out += ["$EndPhysicalNames", "$Nodes", str(len(gids))]
     out += [f"{i + 1} {float(x)!r} {float(y)!r} 0" for i, (x, y) in zip(gids, xy, strict=True)]
     out += ["$EndNodes", "$Elements", str(len(lines) + len(quads))]

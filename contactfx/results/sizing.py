@@ -88,5 +88,7 @@ def plan_mesh(
     if parts is None:
         field = SizeField(np.zeros((0, 4, 2)), np.zeros((0, 4)))
     else:
-        field = SizeField(np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]))
+        field = SizeField(
+            np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+        )
     return Plan(field, cells, predicted / est.energy)

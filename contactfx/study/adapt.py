@@ -33,7 +33,7 @@ class AdaptOptions:
     tol: float = 0.05  # relative estimate to reach
     max_dofs: int = 200_000
     max_levels: int = 8
-    rule: SizingRule = SizingRule()
+    rule: SizingRule = field(default_factory=SizingRule)
 
     def check(self) -> None:
         """InputError for a value out of range."""
