@@ -74,13 +74,20 @@ def _study_parser(sub: Any) -> None:
         "(default 1: the scene as given; e.g. 8 to start coarser)",
     )
     st.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    st.add_argument(
+        "--adaptive",
+        action="store_true",
+        help="also run the adaptive loop (contactfx adapt) of each method from level 0 up "
+        "to its finest level's DOFs: the adaptive levels on the time chart, in study.json "
+        "(`adaptive`) and on accuracy_vs_dofs.png (one rank; not schwarz)",
+    )
     _solver_options(s)
     o = s.add_argument_group("output")
     o.add_argument(
         "--out",
         type=Path,
         required=True,
-        help="directory for study.json, study.csv and the two charts",
+        help="directory for study.json, study.csv and the charts",
     )
     o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
     o.add_argument(
