@@ -86,6 +86,7 @@ def main() -> None:
     ap.add_argument("--max-dofs", type=int, default=60000)
     ap.add_argument("--uniform-dofs", type=int, default=None, help="default: --max-dofs")
     ap.add_argument("--growth", type=float, default=4.0, help="adapt's --growth")
+    ap.add_argument("--weight-contact", type=float, default=10.0, help="adapt's --weight-contact")
     ap.add_argument("--slopes", default="0.08,0.04", help="the two reference gradings")
     ap.add_argument("--json", type=Path, default=Path("punch_adapt.json"))
     args = ap.parse_args()
@@ -110,7 +111,12 @@ def main() -> None:
     result = adapt(
         start,
         "nts",
-        AdaptOptions(1e-9, args.max_dofs, 12, SizingRule(growth=args.growth)),
+        AdaptOptions(
+            1e-9,
+            args.max_dofs,
+            12,
+            SizingRule(growth=args.growth, contact_weight=args.weight_contact),
+        ),
         say=print,
     )
     uni = uniform_levels(start, "nts", args.uniform_dofs or args.max_dofs, say=quiet)

@@ -98,3 +98,9 @@ def test_two_ranks_refused(tmp_path: Path) -> None:
     assert proc.returncode == 2, proc.stderr
     assert "one rank only" in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "o" / "adapt.json").exists()
+
+
+def test_weight_below_one_refused(tmp_path: Path) -> None:
+    proc = run_cli("adapt", *COARSE_HERTZ, "--weight-contact", "0.5", "--out", str(tmp_path / "o"))
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert "--weight-contact" in proc.stderr and not (tmp_path / "o").exists()

@@ -1,10 +1,11 @@
 """The adaptive loop on a singular scene: the rigid flat punch (demos/scenes/rigid_punch.toml).
 
-From the same ungraded mesh (every size 0.5), two adaptive levels (--growth 2: 12k DOFs) against one
-uniform refinement (13k DOFs). Measured by benchmarks/punch_adapt.py: pressure at
-|x| <= b/2 against Sadowsky 0.75 % adaptive, 6.45 % uniform (the finite block's own model
-error there is 0.11 %, measured on a 125k-DOF mesh graded towards the edge); energy-norm
-error 4.2 % against 13.3 %.
+From the same ungraded mesh (every size 0.5): two adaptive levels (--growth 2, 16.9k DOFs)
+against the uniform mesh with every size 0.2 (more DOFs). benchmarks/punch_adapt.py
+measures at 16.9k DOFs a pressure error at |x| <= b/2 against Sadowsky of 0.67 % adaptive,
+against 6.45 % for the uniform mesh at 13.1k DOFs (the finite block's own model error
+there is 0.11 %, measured on a 125k-DOF mesh graded towards the edge), and an energy-norm
+error of 4.0 % against 13.3 %.
 """
 
 from __future__ import annotations
@@ -50,15 +51,14 @@ def sadowsky(data: dict, b: float = 1.0) -> tuple[float, float, bool]:
 
 def test_adaptive_beats_uniform_on_the_flat_punch(tmp_path: Path) -> None:
     start = load_scene_file(uniform_punch(tmp_path, 0.5))
-    result = adapt(
-        start, "nts", AdaptOptions(1e-9, 100_000, 3, SizingRule(growth=2)), say=lambda line: None
-    )
-    finest = result.levels[-1]
-    uniform = start.remeshed(0.5)
-    _, data = run_scene(uniform, "nts")
-    assert finest.dofs <= data["dofs"]
+    opts = AdaptOptions(1e-9, 100_000, 3, SizingRule(growth=2))
+    finest = adapt(start, "nts", opts, say=lambda line: None).levels[-1]
+    # The uniform mesh with every size 0.2 has more DOFs than the adaptive one (gmsh
+    # meets a planned size field only within ~10 %, so "equal" is "at least as many").
+    _, data = run_scene(start.remeshed(0.4), "nts")
+    assert finest.dofs <= data["dofs"], (finest.dofs, data["dofs"])
     F_a, p_a, face_a = sadowsky(finest.summary)
     F_u, p_u, face_u = sadowsky(data)
     assert face_a and face_u
-    assert p_a < 0.25 * p_u, (p_a, p_u)
+    assert p_a < 0.25 * p_u, (p_a, p_u, finest.dofs)
     assert F_a < F_u, (F_a, F_u)  # a smaller energy error (see sadowsky)

@@ -48,6 +48,7 @@ def adapt_json(args: argparse.Namespace, result: AdaptResult, opts: AdaptOptions
             "max_levels": opts.max_levels,
             "rate": opts.rule.rate,
             "growth": opts.rule.growth,
+            "weight_contact": opts.rule.contact_weight,
             "solver": args.solver,
         },
         "stop": result.stop,
@@ -63,7 +64,12 @@ def run_adapt(args: argparse.Namespace) -> int:
         logging.getLogger("contactfx").setLevel(logging.WARNING)
     if args.method in (Method.SCHWARZ.value,):
         raise InputError("adapt needs a multiplier or penalty method (nts, sts, mortar, penalty)")
-    opts = AdaptOptions(args.tol, args.max_dofs, args.max_levels, SizingRule(growth=args.growth))
+    opts = AdaptOptions(
+        args.tol,
+        args.max_dofs,
+        args.max_levels,
+        SizingRule(growth=args.growth, contact_weight=args.weight_contact),
+    )
     opts.check()
     check_remeshable(args)
     spec = spec_from_args(args)

@@ -221,6 +221,15 @@ def _adapt_parser(sub: Any) -> None:
         help="most cells of a level relative to the previous one (default 4)",
     )
     a.add_argument(
+        "--weight-contact",
+        type=float,
+        default=10.0,
+        metavar="W",
+        help="size the next mesh with each cell's contact terms times W (the estimate "
+        "itself is unweighted; docs/adapt.md: W > 1 resolves the contact zone for the "
+        "pressure; default 10, 1 sizes by the energy estimate alone)",
+    )
+    a.add_argument(
         "--compare-uniform",
         action="store_true",
         help="also refine the starting mesh uniformly (sizes / 2 per level) up to the "

@@ -49,6 +49,17 @@ class Estimate:
     eta: fem.Function  # DG0: eta_K, all terms of cell K
     terms: dict[str, float]  # sqrt of the sum over the cells of each term
     energy: float  # ||u_h||_E = sqrt(a(u_h, u_h))
+    # Per owned cell: the sum of its contact terms (squared units, as eta_K^2).
+    contact_cells: np.ndarray | None = None
+
+    def marking(self, contact_weight: float = 1.0) -> np.ndarray:
+        """Per owned cell: eta_K with the contact terms times `contact_weight` (for sizing)."""
+        Q = self.eta.function_space
+        nloc = Q.mesh.topology.index_map(Q.mesh.topology.dim).size_local
+        eta = self.eta.x.array[Q.dofmap.list[:nloc, 0]]
+        if contact_weight == 1.0 or self.contact_cells is None:
+            return eta
+        return np.sqrt(eta**2 + (contact_weight**2 - 1.0) * self.contact_cells)
 
     @property
     def bulk(self) -> float:
@@ -255,17 +266,19 @@ def estimate(sol: Solution) -> Estimate:
     forms["gap"] = E * cf.pen / he * w * dsc
     nloc = msh.topology.index_map(msh.topology.dim).size_local
     cell_dof = Q.dofmap.list[:nloc, 0]
-    total = np.zeros(nloc)
+    total, contact = np.zeros(nloc), np.zeros(nloc)
     terms = {}
     for key, form in forms.items():
         vec = fem.assemble_vector(fem.form(form))
         vec.scatter_reverse(la.InsertMode.add)
         vals = np.maximum(vec.array[cell_dof], 0.0)
         total += vals
+        if key in CONTACT_TERMS:
+            contact += vals
         terms[key] = float(np.sqrt(msh.comm.allreduce(float(vals.sum()), op=MPI.SUM)))
     eta = fem.Function(Q, name="eta")
     eta.x.array[cell_dof] = np.sqrt(total)
     eta.x.scatter_forward()
     energy_form = fem.form(ufl.inner(sig, ufl.sym(ufl.grad(u))) * ufl.dx)
     energy = float(np.sqrt(msh.comm.allreduce(fem.assemble_scalar(energy_form), op=MPI.SUM)))
-    return Estimate(eta, terms, energy)
+    return Estimate(eta, terms, energy, contact)

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from mpi4py import MPI
 
 from ..methods.solution import Solution
 from ..scenes import SizeField
@@ -28,6 +29,11 @@ class SizingRule:
     growth: float = 4.0  # at most this many times the cells per level
     finest: float = 0.25  # a cell's size shrinks at most to this fraction per level
     coarsest: float = 2.0  # and grows at most by this factor
+    # Sizing (not the estimate) takes each cell's contact terms times this weight: the
+    # energy estimate is bulk-dominated, a pressure needs the contact zone resolved.
+    # 10 from measurements (docs/adapt.md): Hertz L2 0.118 % at 56k DOFs against 0.503 %
+    # unweighted; 30 and 100 did worse; the flat punch's energy error is unchanged.
+    contact_weight: float = 10.0
 
 
 @dataclass(frozen=True)
@@ -52,6 +58,32 @@ def _local_cells(sol: Solution, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return msh.geometry.x[geo][:, order, :2], c2v[:, order], eta[:n]
 
 
+def _budget_target(
+    comm: MPI.Comm, eta: np.ndarray, budget: float, q: float, rule: SizingRule
+) -> float:
+    """The eta_t whose clipped sizes give `budget` cells (bisection in log eta_t).
+
+    Without clipping eta_t = (S / budget)^(q/2); clipping changes the count (weighted
+    indicators coarsen the bulk to the x 2 limit while the contact zone is held at x 1/4),
+    so the count is matched after clipping: it falls monotonically with eta_t.
+    """
+
+    def cells(t: float) -> float:
+        f = np.clip((t / eta) ** (1 / q), rule.finest, rule.coarsest)
+        return float(comm.allreduce(float(np.sum(f**-2.0))))
+
+    S = comm.allreduce(float(np.sum(eta ** (2 / q))))
+    lo = hi = (S / budget) ** (q / 2)
+    while cells(lo) < budget and lo > 1e-300:
+        lo /= 4.0
+    while cells(hi) > budget and hi < 1e300:
+        hi *= 4.0
+    for _ in range(60):
+        mid = np.sqrt(lo * hi)
+        lo, hi = (mid, hi) if cells(mid) > budget else (lo, mid)
+    return float(hi)
+
+
 def plan_mesh(
     sol: Solution, est: Estimate, tol: float, max_cells: float, rule: SizingRule = SizingRule()
 ) -> Plan:
@@ -61,8 +93,11 @@ def plan_mesh(
     msh = sol.scene.mesh
     ntot = msh.topology.index_map(2).size_local + msh.topology.index_map(2).num_ghosts
     eta_cell = est.eta.x.array[Q.dofmap.list[:ntot, 0]]
-    quads, verts, eta = _local_cells(sol, eta_cell)
+    quads, verts, eta_true = _local_cells(sol, eta_cell)
     nloc = msh.topology.index_map(2).size_local
+    # One rank (the estimate refuses more): the owned cells are all the cells.
+    eta = eta_true.copy()
+    eta[:nloc] = est.marking(rule.contact_weight)
     d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
     h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
     q = rule.rate + 1.0
@@ -71,14 +106,14 @@ def plan_mesh(
     ncells = msh.topology.index_map(2).size_global
     budget = min(rule.growth * ncells, max_cells)
     target = tol * est.energy
-    eta_budget = (S / budget) ** (q / 2)
     eta_tol = (target**2 / S) ** (1 / (2 - 2 / q))
-    eta_t = max(eta_budget, eta_tol)
+    eta_t = max(_budget_target(comm, eta[:nloc], budget, q, rule), eta_tol)
     factor = np.clip((eta_t / eta) ** (1 / q), rule.finest, rule.coarsest)
     new_h = h * factor
     cells = comm.allreduce(float(np.sum(factor[:nloc] ** -2.0)))
+    eta_true = np.maximum(eta_true, 1e-300)
     predicted = float(
-        np.sqrt(comm.allreduce(float(np.sum((eta[:nloc] * factor[:nloc] ** (q - 1)) ** 2))))
+        np.sqrt(comm.allreduce(float(np.sum((eta_true[:nloc] * factor[:nloc] ** (q - 1)) ** 2))))
     )
     # Sizes at the vertices: the smallest of the cells around each (continuous, safe).
     node = np.full(verts.max() + 1, np.inf)

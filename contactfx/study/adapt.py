@@ -41,6 +41,8 @@ class AdaptOptions:
             raise InputError(f"--tol must be > 0 (got {self.tol})")
         if self.max_dofs < 10:
             raise InputError(f"--max-dofs must be at least 10 (got {self.max_dofs})")
+        if not (self.rule.contact_weight >= 1.0):
+            raise InputError(f"--weight-contact must be >= 1 (got {self.rule.contact_weight})")
         if self.max_levels < 1:
             raise InputError(f"--max-levels must be at least 1 (got {self.max_levels})")
 
