@@ -1,6 +1,12 @@
 """Two stacked elastic blocks, half model by symmetry (scenes S1-S4)."""
 
 import gmsh
+import numpy as np
+
+from .size_field import apply_size_view, restore_options
+
+# Unstructured quads (adaptive remeshing): Frontal-Delaunay for quads + Blossom recombination.
+_QUAD_OPTIONS = {"Mesh.Algorithm": 8, "Mesh.RecombinationAlgorithm": 3, "Mesh.RecombineAll": 1}
 
 
 def _divisions(length: float, size: float) -> int:
@@ -46,8 +52,13 @@ def build_blocks(
     size2: float,
     grading1: float = 1.0,
     grading2: float = 1.0,
+    size_field: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> None:
-    """Add the two-block half model (S1-S4) to the current gmsh model and mesh it with quads."""
+    """Add the two-block half model (S1-S4) to the current gmsh model and mesh it with quads.
+
+    Structured (transfinite) by default; with `size_field` = (quads, sizes) unstructured
+    quads sized by it (meshes.size_field: the adaptive loop's background mesh).
+    """
     if min(l1, l2, h1, h2, size1, size2, grading1, grading2) <= 0.0:
         raise ValueError("block dimensions, mesh sizes and gradings must be positive")
     half1, half2 = 0.5 * l1, 0.5 * l2
@@ -60,10 +71,18 @@ def build_blocks(
     gmsh.model.geo.synchronize()
 
     # Mesh constraints only after the last synchronize: gmsh drops them otherwise.
-    for tag, nodes, ratio in cons1 + cons2:
-        gmsh.model.mesh.setTransfiniteCurve(tag, nodes, "Progression", ratio)
-    for surf, corners in zip(s1 + s2, corners1 + corners2, strict=True):
-        gmsh.model.mesh.setTransfiniteSurface(surf, cornerTags=corners)
+    saved: dict[str, float] = {}
+    if size_field is None:
+        for tag, nodes, ratio in cons1 + cons2:
+            gmsh.model.mesh.setTransfiniteCurve(tag, nodes, "Progression", ratio)
+        for surf, corners in zip(s1 + s2, corners1 + corners2, strict=True):
+            gmsh.model.mesh.setTransfiniteSurface(surf, cornerTags=corners)
+    else:
+        saved = {name: gmsh.option.getNumber(name) for name in _QUAD_OPTIONS}
+        for name, value in _QUAD_OPTIONS.items():
+            gmsh.option.setNumber(name, value)
+        saved.update(apply_size_view(*size_field))
+    for surf in s1 + s2:
         gmsh.model.mesh.setRecombine(2, surf)
 
     groups = [
@@ -77,4 +96,7 @@ def build_blocks(
     ]
     for dim, tags, name in groups:
         gmsh.model.addPhysicalGroup(dim, tags, name=name)
-    gmsh.model.mesh.generate(2)
+    try:
+        gmsh.model.mesh.generate(2)
+    finally:
+        restore_options(saved)

@@ -3,6 +3,9 @@
 import math
 
 import gmsh
+import numpy as np
+
+from .size_field import apply_size_view, restore_options
 
 # Growth of the element size with distance from the refined zone (size per unit distance).
 # The elastic field decays like 1/r in 2D, so every decade of distance adds about the same
@@ -22,12 +25,15 @@ def build_hertz(
     contact_extent: float | None = None,
     slope: float = _SLOPE,
     edge: tuple[float, float] | None = None,
+    size_field: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> None:
     """Add the Hertz half model (quarter disc on a block) to the current gmsh model and mesh it.
 
     The size is h_contact along both contact surfaces for x <= r_refine and, if `edge` =
     (x_edge, h_edge) is given, h_edge at x_edge (the expected edge of the contact zone, where
     the pressure has its square-root singularity); it grows by `slope` per unit distance.
+    `size_field` = (quads, sizes) replaces all that by sizes at the vertices of quads
+    (meshes.size_field: the adaptive loop's background mesh).
     """
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
@@ -79,14 +85,18 @@ def build_hertz(
     d_line = f"Abs(y - {height!r})"
     d_arc = f"Abs({R!r} - Sqrt(x^2 + (y - {yc!r})^2))"
     dist = f"Sqrt(Max(x - {r_refine!r}, 0)^2 + Min({d_line}, {d_arc})^2)"
-    field = gmsh.model.mesh.field.add("MathEval")
     size = f"{h_contact!r} + {slope!r} * {dist}"
     if edge is not None:
         xe, he = edge
         de = f"Sqrt((x - {xe!r})^2 + Min({d_line}, {d_arc})^2)"
         size = f"Min({size}, {he!r} + {slope!r} * {de})"
-    gmsh.model.mesh.field.setString(field, "F", f"Min({h_far!r}, {size})")
-    gmsh.model.mesh.field.setAsBackgroundMesh(field)
+    size_saved = {}
+    if size_field is None:
+        field = gmsh.model.mesh.field.add("MathEval")
+        gmsh.model.mesh.field.setString(field, "F", f"Min({h_far!r}, {size})")
+        gmsh.model.mesh.field.setAsBackgroundMesh(field)
+    else:
+        size_saved = apply_size_view(*size_field)
     # The field alone sets the size: point sizes and curvature would override it.
     options = {
         "Mesh.MeshSizeExtendFromBoundary": 0,
@@ -120,6 +130,7 @@ def build_hertz(
     finally:
         for name, value in saved.items():
             gmsh.option.setNumber(name, value)
+        restore_options(size_saved)
 
     types, _, _ = gmsh.model.mesh.getElements(2)
     if any(t != QUAD4 for t in types):

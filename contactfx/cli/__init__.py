@@ -11,6 +11,7 @@ import sys
 from mpi4py import MPI
 
 from ..errors import ContactFxError
+from .adapt import run_adapt
 from .parser import parser
 from .solve import run
 from .study import run_command
@@ -26,6 +27,8 @@ def main(argv: list[str] | None = None) -> int:
         stream=sys.stdout,
     )
     try:
+        if args.command == "adapt":
+            return run_adapt(args)
         return run_command(args) if args.command == "study" else run(args)
     except ContactFxError as err:
         if rank == 0:

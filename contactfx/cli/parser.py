@@ -74,13 +74,20 @@ def _study_parser(sub: Any) -> None:
         "(default 1: the scene as given; e.g. 8 to start coarser)",
     )
     st.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    st.add_argument(
+        "--adaptive",
+        action="store_true",
+        help="also run the adaptive loop (contactfx adapt) of each method from level 0 up "
+        "to its finest level's DOFs: the adaptive levels on the time chart, in study.json "
+        "(`adaptive`) and on accuracy_vs_dofs.png (one rank; not schwarz)",
+    )
     _solver_options(s)
     o = s.add_argument_group("output")
     o.add_argument(
         "--out",
         type=Path,
         required=True,
-        help="directory for study.json, study.csv and the two charts",
+        help="directory for study.json, study.csv and the charts",
     )
     o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
     o.add_argument(
@@ -162,6 +169,12 @@ def _solve_parser(sub: Any) -> None:
         "floor) and report it as times.reference_solve",
     )
     o = s.add_argument_group("output")
+    o.add_argument(
+        "--estimate",
+        action="store_true",
+        help="estimate the error (residual estimator, docs/adapt.md): `estimate` in the "
+        "JSON, the indicators eta in the fields of --out",
+    )
     o.add_argument("--json", type=Path, help="write the JSON summary here")
     o.add_argument(
         "--out",
@@ -172,6 +185,62 @@ def _solve_parser(sub: Any) -> None:
     o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
 
 
+def _adapt_parser(sub: Any) -> None:
+    s = sub.add_parser(
+        "adapt",
+        help="adaptive meshing: solve, estimate, remesh with gmsh until the estimate is small",
+        description="Adapt the mesh of one scene: each level solves, estimates the error "
+        "(residual estimator, docs/adapt.md), sizes the next mesh from the indicators and "
+        "remeshes the geometry with gmsh. Stops at --tol, --max-levels, or when the next "
+        "mesh would exceed --max-dofs. Writes adapt.json, mesh.msh, fields.pvtu (with the "
+        "indicators eta) and the charts adapt_dofs.png, adapt_time.png to --out.",
+    )
+    s.add_argument("scene", help="blocks, hertz or a scene .toml file whose mesh is a .geo")
+    _builtin_scene_options(s)
+    m = s.add_argument_group("method")
+    m.add_argument(
+        "--method",
+        default=Method.MORTAR.value,
+        choices=[v.value for v in Method if v is not Method.SCHWARZ],
+        help="contact discretization (default mortar)",
+    )
+    m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
+    _solver_options(s)
+    a = s.add_argument_group("adaptivity")
+    a.add_argument(
+        "--tol", type=float, default=0.05, help="relative estimate to reach (default 0.05)"
+    )
+    a.add_argument(
+        "--max-dofs", type=int, default=200_000, help="DOF budget of a mesh (default 200000)"
+    )
+    a.add_argument("--max-levels", type=int, default=8, help="most levels (default 8)")
+    a.add_argument(
+        "--growth",
+        type=float,
+        default=4.0,
+        help="most cells of a level relative to the previous one (default 4)",
+    )
+    a.add_argument(
+        "--weight-contact",
+        type=float,
+        default=10.0,
+        metavar="W",
+        help="size the next mesh with each cell's contact terms times W (the estimate "
+        "itself is unweighted; docs/adapt.md: W > 1 resolves the contact zone for the "
+        "pressure; default 10, 1 sizes by the energy estimate alone)",
+    )
+    a.add_argument(
+        "--compare-uniform",
+        action="store_true",
+        help="also refine the starting mesh uniformly (sizes / 2 per level) up to the "
+        "same DOFs, for the charts",
+    )
+    o = s.add_argument_group("output")
+    o.add_argument("--out", type=Path, required=True, help="directory for the outputs")
+    o.add_argument("-q", "--quiet", action="store_true", help="log warnings only")
+    o.add_argument("-v", "--verbose", action="store_true", help="log the solver's iterations")
+
+
 def parser() -> argparse.ArgumentParser:
     """The argument parser (defaults of scene parameters are the paper's, filled in later)."""
     ap = argparse.ArgumentParser(
@@ -180,4 +249,5 @@ def parser() -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="command", required=True)
     _solve_parser(sub)
     _study_parser(sub)
+    _adapt_parser(sub)
     return ap

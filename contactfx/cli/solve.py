@@ -12,6 +12,7 @@ from mpi4py import MPI
 from ..api import run_scene
 from ..errors import InputError
 from ..options import Method
+from ..results.estimate import estimate
 from ..results.figures import contact_window, deformed_fields, plot_interface, plot_pair
 from ..results.files import write_contact_surfaces, write_fields, write_json
 from ..timers import Timers
@@ -45,6 +46,12 @@ def terminal_summary(data: dict[str, Any]) -> list[str]:
             f"{h['p0_exact']:.4g}, {100 * (h['p0'] / h['p0_exact'] - 1):+.2f} %), "
             f"L2 error {100 * h['l2_error']:.2f} %"
         )
+    if "estimate" in data:
+        e = data["estimate"]
+        lines.append(
+            f"estimate (relative to the energy norm): {100 * e['total']:.3g} % (contact "
+            f"{100 * e['contact']:.3g} %, bulk {100 * e['bulk']:.3g} %)"
+        )
     return lines
 
 
@@ -55,6 +62,8 @@ def run(args: argparse.Namespace) -> int:
     spec = spec_from_args(args)
     if args.penalty is not None and method is not Method.PENALTY:
         raise InputError("--penalty applies to --method penalty only")
+    if args.estimate and method is Method.SCHWARZ:
+        raise InputError("--estimate needs a multiplier or penalty method, not schwarz")
     t_start = time.perf_counter()
     timers = Timers()
     with timers("mesh"):
@@ -73,8 +82,13 @@ def run(args: argparse.Namespace) -> int:
         basis=args.basis,
     )
     data["solver"] = "mumps (each body)" if method is Method.SCHWARZ else args.solver
+    cells: tuple[Any, ...] = ()
+    if args.estimate:
+        est = estimate(sol)
+        data["estimate"] = est.summary()
+        cells = (est.eta,)
     if args.out is not None:
-        write_fields(sol, args.out)
+        write_fields(sol, args.out, cells)
     log = logging.getLogger("contactfx")
     if comm.rank == 0:
         if args.json is not None:

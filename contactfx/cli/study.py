@@ -11,8 +11,9 @@ from mpi4py import MPI
 from ..errors import InputError
 from ..options import SOLVERS, Method
 from ..study import builtin_levels, run_study, scene_file_levels, size_factors, write_outputs
+from ..study.adaptive import adaptive_methods, adaptive_runs
 from ..study.levels import Level
-from ..study.report import level_lines, table_lines
+from ..study.report import adaptive_lines, level_lines, table_lines
 from .params import is_scene_file, reject_builtin_options, scene_params, spec_from_args
 
 
@@ -40,6 +41,21 @@ def levels_from_args(args: argparse.Namespace, comm: MPI.Comm) -> list[Level]:
     return builtin_levels(args.scene, scene_params(args), factors, args.active or 2, comm)
 
 
+def check_adaptive(args: argparse.Namespace, methods: list[str], comm: MPI.Comm) -> None:
+    """InputError before anything runs if --adaptive cannot be done."""
+    if comm.size > 1:
+        raise InputError(
+            "study --adaptive runs on one rank only for now (the error estimate needs a "
+            "mesh ghosted across shared facets): run it without mpirun"
+        )
+    if not adaptive_methods(methods):
+        raise InputError("study --adaptive needs a method with an estimate (not only schwarz)")
+    if not is_scene_file(args.scene) and args.mesh == "structured":
+        raise InputError(
+            "study --adaptive: the structured Hertz mesh cannot be adapted: use --mesh gmsh"
+        )
+
+
 def run_command(args: argparse.Namespace) -> int:
     """Run the study the arguments describe, write its files on rank 0 and print the table."""
     comm = MPI.COMM_WORLD
@@ -53,6 +69,8 @@ def run_command(args: argparse.Namespace) -> int:
             "schwarz factorizes each body with MUMPS: --solver and --petsc-option "
             "do not apply to it"
         )
+    if args.adaptive:
+        check_adaptive(args, methods, comm)
     levels = levels_from_args(args, comm)
     say = print if comm.rank == 0 else (lambda *a, **k: None)
     say(
@@ -76,9 +94,19 @@ def run_command(args: argparse.Namespace) -> int:
             "petsc_options": list(args.petsc_option),
         },
     )
+    if args.adaptive:
+        study.adaptive = adaptive_runs(
+            study,
+            levels[0].build(),
+            solver=spec,
+            options={"max_iterations": args.max_iterations},
+            paper_interface=levels[0].paper_interface,
+            max_levels=3 * len(levels),
+            say=lambda line: say(line, flush=True),
+        )
     if comm.rank == 0:
         written = write_outputs(study, args.out)
-        for line in ["", *level_lines(study), "", *table_lines(study)]:
+        for line in ["", *level_lines(study), "", *table_lines(study), *adaptive_lines(study)]:
             print(line)
         print("wrote " + ", ".join(str(p) for p in written))
     return 0

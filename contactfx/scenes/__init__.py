@@ -26,6 +26,7 @@ from .model import (
     Recipe,
     Reference,
     Scene,
+    SizeField,
     Traction,
     UniformStress,
 )
@@ -51,6 +52,7 @@ __all__ = [
     "Reference",
     "Scene",
     "SceneParts",
+    "SizeField",
     "Traction",
     "UniformStress",
     "blocks",

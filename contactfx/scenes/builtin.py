@@ -24,6 +24,7 @@ from .model import (
     Pressure,
     Reference,
     Scene,
+    SizeField,
     UniformStress,
 )
 from .structured import build_hertz_structured
@@ -127,9 +128,15 @@ class BuiltinRecipe:
 
     params: BlockParams | HertzParams
     active: int = 2
+    size_field: SizeField | None = None  # set: the gmsh geometry meshed with these sizes
 
     def resized(self, factor: float) -> BuiltinRecipe:
-        """Blocks: both element sizes times f; Hertz: contact, edge and far sizes times f."""
+        """Blocks: both element sizes times f; Hertz: contact, edge and far sizes times f.
+
+        An adapted recipe scales its size field instead.
+        """
+        if self.size_field is not None:
+            return replace(self, size_field=self.size_field.scaled(factor))
         p = self.params
         if isinstance(p, BlockParams):
             scaled: BlockParams | HertzParams = replace(
@@ -144,11 +151,20 @@ class BuiltinRecipe:
             )
         return replace(self, params=scaled)
 
+    def adapted(self, field: SizeField) -> BuiltinRecipe:
+        """The same scene meshed by gmsh with the sizes of `field` (not the structured mesh)."""
+        if isinstance(self.params, HertzParams) and self.params.mesh != "gmsh":
+            raise InputError(
+                "the structured Hertz mesh cannot be adapted: use --mesh gmsh (gmsh "
+                "remeshes the geometry from a size field)"
+            )
+        return replace(self, size_field=field)
+
     def build(self, comm: MPI.Comm) -> Scene:
         """Mesh the scene."""
         if isinstance(self.params, BlockParams):
-            return blocks(self.params, self.active, comm)
-        return hertz(self.params, self.active, comm)
+            return blocks(self.params, self.active, comm, self.size_field)
+        return hertz(self.params, self.active, comm, self.size_field)
 
 
 def _two_body_scene(
@@ -159,6 +175,7 @@ def _two_body_scene(
     name: str,
     references: tuple[Reference, ...],
     extra: dict[str, Any],
+    size_field: SizeField | None = None,
 ) -> Scene:
     """The common shape of the paper's scenes: body1 below, body2 on top, rollers, one load."""
     if active not in (1, 2):
@@ -184,30 +201,58 @@ def _two_body_scene(
         references,
         name=name,
         params={**asdict(params), "active": active, **extra},
-        recipe=BuiltinRecipe(params, active),
+        recipe=BuiltinRecipe(params, active, size_field),
     )
     return check_scene(scene)
 
 
+def _field(size_field: SizeField | None) -> tuple[Any, Any] | None:
+    """The (quads, sizes) a mesh builder takes, or None."""
+    return None if size_field is None else (size_field.quads, size_field.sizes)
+
+
 def blocks(
-    params: BlockParams = BlockParams(), active: int = 2, comm: MPI.Comm = MPI.COMM_WORLD
+    params: BlockParams = BlockParams(),
+    active: int = 2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    size_field: SizeField | None = None,
 ) -> Scene:
-    """Two stacked blocks (S1-S4): pressure p on top, rollers on the axis and the base."""
+    """Two stacked blocks (S1-S4): pressure p on top, rollers on the axis and the base.
+
+    `size_field`: unstructured quads with these sizes instead of the transfinite mesh.
+    """
     validate(params)
     p = params
-    build = partial(build_blocks, p.l1, p.l2, p.h1, p.h2, p.size1, p.size2, p.grading1, p.grading2)
+    build = partial(
+        build_blocks,
+        p.l1,
+        p.l2,
+        p.h1,
+        p.h2,
+        p.size1,
+        p.size2,
+        p.grading1,
+        p.grading2,
+        size_field=_field(size_field),
+    )
     data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
     # Equal widths make the stress uniaxial and uniform: the contact patch test.
     refs: tuple[Reference, ...] = (
         (UniformStress(((0.0, 0.0), (0.0, -p.p))),) if p.l1 == p.l2 else ()
     )
-    return _two_body_scene(data, p, p.p, active, "blocks", refs, {})
+    return _two_body_scene(data, p, p.p, active, "blocks", refs, {}, size_field)
 
 
 def hertz(
-    params: HertzParams = HertzParams(), active: int = 2, comm: MPI.Comm = MPI.COMM_WORLD
+    params: HertzParams = HertzParams(),
+    active: int = 2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    size_field: SizeField | None = None,
 ) -> Scene:
-    """A quarter cylinder on a block (S5), line load P, on the gmsh or the structured mesh."""
+    """A quarter cylinder on a block (S5), line load P, on the gmsh or the structured mesh.
+
+    `size_field`: the gmsh geometry meshed with these sizes instead of the graded field.
+    """
     validate(params)
     exact = hertz_exact(params)
     if params.r_refine == 0.0:
@@ -233,11 +278,12 @@ def hertz(
             h_far=h_far,
             slope=h.slope,
             edge=edge,
+            size_field=_field(size_field),
         )
         data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
     ref = (HertzReference(pair=0, R=h.R, P=h.P, symmetric=True),)
     extra: dict[str, Any] = {"hertz_exact": exact}
-    return _two_body_scene(data, h, h.P / (2 * h.R), active, "hertz", ref, extra)
+    return _two_body_scene(data, h, h.P / (2 * h.R), active, "hertz", ref, extra, size_field)
 
 
 def build_scene(

@@ -23,6 +23,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import ContactFxError, InputError, MeshError, error_type
 from ..meshes import QUAD4
+from ..meshes.size_field import apply_size_view, restore_options
 from .checks import check_scene
 from .model import (
     Body,
@@ -34,6 +35,7 @@ from .model import (
     Obstacle,
     Reference,
     Scene,
+    SizeField,
 )
 
 # The other 2D element types of gmsh, named for the error message.
@@ -196,14 +198,20 @@ def to_dolfinx(
             _close(fresh, previous)
 
 
-def open_mesh_file(path: Path, size_factor: float = 1.0) -> Callable[[], None]:
-    """A build step that reads a .msh, or meshes a .geo in 2D with sizes times `size_factor`."""
+def open_mesh_file(
+    path: Path, size_factor: float = 1.0, size_field: SizeField | None = None
+) -> Callable[[], None]:
+    """A build step that reads a .msh, or meshes a .geo in 2D with sizes times `size_factor`.
+
+    `size_field` (a .geo only): gmsh meshes with these sizes times `size_factor`, in place
+    of the .geo's own (its transfinite curves and surfaces keep their node counts).
+    """
     suffix = path.suffix.lower()
     if suffix not in (".msh", ".geo"):
         raise InputError(f"mesh file {path}: expected a gmsh .msh or .geo file")
     if not path.is_file():
         raise InputError(f"mesh file {path} does not exist")
-    if suffix == ".msh" and size_factor != 1.0:
+    if suffix == ".msh" and (size_factor != 1.0 or size_field is not None):
         raise InputError(f"mesh file {path} is a .msh: it cannot be refined (give a .geo)")
 
     def build() -> None:
@@ -211,7 +219,14 @@ def open_mesh_file(path: Path, size_factor: float = 1.0) -> Callable[[], None]:
             gmsh.open(str(path))
         except Exception as exc:
             raise MeshError(f"cannot read mesh file {path}: {exc}") from None
-        if suffix == ".geo":
+        if suffix == ".geo" and size_field is not None:
+            saved = apply_size_view(size_field.quads, size_field.sizes * size_factor)
+            try:
+                gmsh.model.mesh.clear()
+                gmsh.model.mesh.generate(2)
+            finally:
+                restore_options(saved)
+        elif suffix == ".geo":
             factor = gmsh.option.getNumber("Mesh.MeshSizeFactor")
             gmsh.option.setNumber("Mesh.MeshSizeFactor", factor * size_factor)
             try:
@@ -222,10 +237,15 @@ def open_mesh_file(path: Path, size_factor: float = 1.0) -> Callable[[], None]:
     return build
 
 
-def load_meshdata(model_or_path: Any, comm: MPI.Comm, size_factor: float = 1.0) -> MeshData:
+def load_meshdata(
+    model_or_path: Any,
+    comm: MPI.Comm,
+    size_factor: float = 1.0,
+    size_field: SizeField | None = None,
+) -> MeshData:
     """Distributed MeshData of a gmsh .msh/.geo path, or of the gmsh module's current model."""
     if isinstance(model_or_path, str | Path):
-        build = open_mesh_file(Path(model_or_path), size_factor)
+        build = open_mesh_file(Path(model_or_path), size_factor, size_field)
         return to_dolfinx(comm, build, balanced_partitioner())
 
     # A model the user built with the gmsh API: mesh it if it has no 2D elements yet.
@@ -257,14 +277,21 @@ class GeoRecipe:
     parts: SceneParts
     size_factor: float = 1.0
     params: Mapping[str, Any] | None = None
+    size_field: SizeField | None = None  # set: the .geo meshed with these sizes
 
     def resized(self, factor: float) -> GeoRecipe:
         """The same .geo meshed with every size times `factor`."""
         return replace(self, size_factor=self.size_factor * factor)
 
+    def adapted(self, field: SizeField) -> GeoRecipe:
+        """The same .geo meshed with the sizes of `field` (times no factor)."""
+        return replace(self, size_field=field, size_factor=1.0)
+
     def build(self, comm: MPI.Comm) -> Scene:
         """Mesh the .geo and return the checked Scene."""
-        return scene_from_gmsh(self.path, self.parts, comm, self.size_factor, self.params)
+        return scene_from_gmsh(
+            self.path, self.parts, comm, self.size_factor, self.params, self.size_field
+        )
 
 
 def scene_from_gmsh(
@@ -273,15 +300,16 @@ def scene_from_gmsh(
     comm: MPI.Comm,
     size_factor: float = 1.0,
     params: Mapping[str, Any] | None = None,
+    size_field: SizeField | None = None,
 ) -> Scene:
     """Load the mesh, build the Scene and check it against the mesh's groups."""
     for body, mat in parts.bodies.items():
         mat.check(f"body '{body}'")
-    data = load_meshdata(model_or_path, comm, size_factor)
+    data = load_meshdata(model_or_path, comm, size_factor, size_field)
     assert data.cell_tags is not None  # one cell type (all quads, checked on rank 0): tagged
     path = Path(model_or_path) if isinstance(model_or_path, str | Path) else None
     recipe = (
-        GeoRecipe(path, parts, size_factor, params)
+        GeoRecipe(path, parts, size_factor, params, size_field)
         if path is not None and path.suffix.lower() == ".geo"
         else None
     )

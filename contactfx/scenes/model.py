@@ -222,15 +222,36 @@ class Groups:
         return group.tag
 
 
+@dataclass(frozen=True, eq=False)
+class SizeField:
+    """A mesh size given at the vertices of quadrilaterals: a background mesh for gmsh.
+
+    `quads` (n, 4, 2) and `sizes` (n, 4) are the whole field on rank 0 (where gmsh runs);
+    the other ranks hold empty arrays. The adaptive loop makes it (study/adapt.py).
+    """
+
+    quads: np.ndarray
+    sizes: np.ndarray
+
+    def scaled(self, factor: float) -> SizeField:
+        """Every size times `factor`."""
+        return SizeField(self.quads, self.sizes * factor)
+
+
 class Recipe(Protocol):
     """How a scene's mesh was made, as data: remade with every mesh size times a factor.
 
     Built-in scenes keep their parameters (scenes/builtin.py), scene files their .geo
-    (scenes/gmsh_io.py); the coarse predictor and refinement studies call `resized`.
+    (scenes/gmsh_io.py); the coarse predictor and refinement studies call `resized`, the
+    adaptive loop `adapted`.
     """
 
     def resized(self, factor: float) -> Recipe:
         """The same recipe with every mesh size times `factor`."""
+        ...
+
+    def adapted(self, field: SizeField) -> Recipe:
+        """The same geometry meshed with the sizes of `field` (InputError if it cannot be)."""
         ...
 
     def build(self, comm: MPI.Comm) -> Scene:
@@ -299,6 +320,15 @@ class Scene:
                 "meshes can (a .msh or an in-memory gmsh model has no geometry to remesh)"
             )
         return self.recipe.resized(factor).build(self.comm)
+
+    def remeshed_to(self, field: SizeField) -> Scene:
+        """The same scene's geometry meshed by gmsh with the sizes of `field` (collective)."""
+        if self.recipe is None:
+            raise InputError(
+                f"scene '{self.name}' cannot be remeshed: there is no geometry to remesh "
+                "(a .msh or an in-memory gmsh model; give the scene's mesh as a .geo)"
+            )
+        return self.recipe.adapted(field).build(self.comm)
 
     def body_of_curve(self, name: str) -> Body:
         """The body that the contact curve group `name` lies on."""

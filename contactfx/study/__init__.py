@@ -34,14 +34,19 @@ __all__ = [
 def write_outputs(study: Study, out: Path, extra: Sequence[tuple[str, Study]] = ()) -> list[Path]:
     """study.json, study.csv, convergence.png and accuracy_vs_time.png in `out` (rank 0 only).
 
+    With adaptive levels (study --adaptive) also accuracy_vs_dofs.png.
+
     `extra`: (label, study) pairs the charts also draw, dashed (e.g. another mesh family).
     """
-    from .charts import plot_convergence, plot_time
+    from .charts import plot_convergence, plot_dofs, plot_time
 
     out.mkdir(parents=True, exist_ok=True)
-    return [
+    written = [
         write_study_json(study, out / "study.json"),
         write_study_csv(study, out / "study.csv"),
         plot_convergence(study, out / "convergence.png", extra),
         plot_time(study, out / "accuracy_vs_time.png", extra),
     ]
+    if study.adaptive:
+        written.append(plot_dofs(study, out / "accuracy_vs_dofs.png"))
+    return written

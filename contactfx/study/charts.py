@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullFormatter
 
 from .core import Study, series
-from .measures import ROUND_OFF
+from .measures import ROUND_OFF, fit_rate
 from .report import main_errors
 
 COLORS = {
@@ -151,13 +151,95 @@ def plot_convergence(study: Study, path: Path, extra: Sequence[tuple[str, Study]
     return _finish(fig, path, f"Error against mesh size\n{_title(study)}")
 
 
+def _adaptive_points(study: Study, method: str, name: str, x: str) -> np.ndarray:
+    """(x, error) rows of a method's adaptive levels; x is "dofs" or "cumulative" (time)."""
+    pts = [
+        (float(getattr(r, x)), float(e))
+        for r in study.adaptive
+        if r.method == method and (e := r.errors.get(name)) is not None and e > 0
+    ]
+    return np.array(pts).reshape(-1, 2)
+
+
+def _draw_adaptive(ax: plt.Axes, study: Study, name: str, x: str) -> None:
+    """Every method's adaptive levels (study --adaptive), dotted with star markers."""
+    for m in dict.fromkeys(r.method for r in study.adaptive):
+        pts = _adaptive_points(study, m, name, x)
+        if not len(pts):
+            continue
+        rate = fit_rate(pts[:, 0], pts[:, 1])
+        what = "cumulative time" if x == "cumulative" else "DOFs N"
+        text = "" if rate is None else f": error ~ {'t' if x == 'cumulative' else 'N'}^{rate:.2f}"
+        ax.loglog(
+            pts[:, 0],
+            pts[:, 1],
+            marker="*",
+            color=COLORS.get(m),
+            lw=1.8,
+            ms=10,
+            ls=":",
+            label=f"{m}, adaptive ({what}){text}",
+        )
+
+
+def _draw_dofs(ax: plt.Axes, study: Study, name: str) -> None:
+    """Every method's uniform levels against DOFs, with the slope in N."""
+    for m in study.methods:
+        pts = [
+            (float(r.dofs), float(e))
+            for r in study.runs
+            if r.method == m and r.ok and r.dofs and (e := r.errors.get(name)) is not None
+        ]
+        pts = [p for p in pts if p[1] > 0]
+        if not pts:
+            continue
+        xs, e = np.array(pts).T
+        rate = fit_rate(xs, e)
+        ax.loglog(
+            xs,
+            e,
+            marker=MARKERS.get(m, "o"),
+            color=COLORS.get(m),
+            lw=1.8,
+            ms=7,
+            label=f"{m}, uniform" + ("" if rate is None else f": error ~ N^{rate:.2f}"),
+        )
+
+
+def plot_dofs(study: Study, path: Path) -> Path:
+    """Error against displacement DOFs: uniform and adaptive levels (study --adaptive).
+
+    Without an exact solution both are the difference from the study's reference (the
+    finest uniform level of the most accurate method), not from the next finer level.
+    """
+    fig, axes, names = _figure(study, "dofs")
+    for ax, name in zip(axes, names, strict=True):
+        _draw_dofs(ax, study, name)
+        _draw_adaptive(ax, study, name, "dofs")
+        ax.set_xlabel("displacement DOFs N", fontsize=11)
+        label = LABELS.get(name, name)
+        if study.reference["kind"] == "self":
+            label = f"{name}: relative L2 difference\nfrom the reference (along s)"
+        ax.set_ylabel(label, fontsize=11)
+        ax.grid(True, which="both", alpha=0.3)
+        _ticks(ax)
+        ax.legend(fontsize=9, title="lower left is better", title_fontsize=10)
+    return _finish(fig, path, f"Accuracy against DOFs\n{_title(study)}")
+
+
 def plot_time(study: Study, path: Path, extra: Sequence[tuple[str, Study]] = ()) -> Path:
-    """Error against wall time after meshing, every method on each panel."""
+    """Error against wall time after meshing, every method on each panel.
+
+    With study --adaptive also the adaptive levels, at their cumulative time (solves,
+    estimates and remeshing of all levels up to each); without an exact solution those are
+    differences from the reference, the uniform runs' from the next finer level.
+    """
     fig, axes, names = _figure(study, "time")
     for ax, name in zip(axes, names, strict=True):
         _draw(ax, study, name, "time")
         for label, other in extra:
             _draw(ax, other, name, "time", label)
+        _draw_adaptive(ax, study, name, "cumulative")
         ax.set_xlabel("wall time after meshing (s): assembly, search, solves", fontsize=11)
         ax.set_ylabel(_label(study, name), fontsize=11)
         ax.grid(True, which="both", alpha=0.3)

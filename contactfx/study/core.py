@@ -32,7 +32,7 @@ from .measures import (
 )
 from .measures import self_errors as compare_profiles
 from .progress import Progress
-from .runs import Run
+from .runs import AdaptiveRun, Run
 
 # Most accurate first: the self-convergence reference is the finest level of the first of
 # these that the study ran (mortar passes the patch test on non-matching meshes).
@@ -56,6 +56,8 @@ class Study:
     settings: dict[str, Any] = field(default_factory=dict)
     # Per method and error: why its rate is not a convergence rate ("non-monotone").
     flags: dict[str, dict[str, str]] = field(default_factory=dict)
+    # `study --adaptive`: the adaptive levels of every method (study/adaptive.py).
+    adaptive: list[AdaptiveRun] = field(default_factory=list)
 
 
 def reference_kind(scene: Scene) -> str:

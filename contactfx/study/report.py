@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -58,6 +59,19 @@ def study_json(study: Study) -> dict[str, Any]:
         "rate_flags": study.flags,
         "time_rates": study.time_rates,
         "h": "median length of the active-surface elements carrying pressure",
+        **({"adaptive": adaptive_json(study)} if study.adaptive else {}),
+    }
+
+
+def adaptive_json(study: Study) -> dict[str, Any]:
+    """study.json's `adaptive` block: how the levels were made and measured, and the levels."""
+    return {
+        "description": "each method's adaptive loop (contactfx adapt) from level 0's mesh up "
+        "to the DOFs of its finest uniform level; errors measured as the uniform runs' "
+        "(without an exact solution: against the reference, not the next level)",
+        "time": "cumulative: the solves, estimates and remeshing of the levels up to each "
+        "(level 0's mesh excluded); after_mesh is the level's own solve",
+        "runs": [asdict(r) for r in study.adaptive],
     }
 
 
@@ -214,4 +228,21 @@ def table_lines(study: Study) -> list[str]:
         f"study: {len(study.runs)} runs on {study.ranks} rank"
         f"{'s' * (study.ranks > 1)} in {format_seconds(study.wall)}"
     )
+    return lines
+
+
+def adaptive_lines(study: Study) -> list[str]:
+    """The adaptive levels (study --adaptive): DOFs, estimate, errors, cumulative time."""
+    if not study.adaptive:
+        return []
+    names = main_errors(study)
+    lines = ["", "adaptive levels (time: cumulative solves, estimates and remeshing):"]
+    for r in study.adaptive:
+        errs = ", ".join(f"{n} {_num(r.errors.get(n))}" for n in names)
+        lines.append(
+            f"  {r.method} level {r.level}: {r.dofs} dofs, estimate {r.estimate:.3g}, "
+            f"{errs}, {r.cumulative:.2f} s"
+        )
+    stops = dict.fromkeys((r.method, r.stop) for r in study.adaptive)
+    lines += [f"  {m} stopped: {stop}" for m, stop in stops]
     return lines

@@ -38,3 +38,21 @@ class Run:
     def after_mesh(self) -> float | None:
         """Wall time after meshing: assembly, search and the active-set solves (s)."""
         return self.times["total"] - self.times["mesh"] if self.ok else None
+
+
+@dataclass
+class AdaptiveRun:
+    """One level of a method's adaptive loop in a study (`study --adaptive`)."""
+
+    method: str
+    level: int
+    dofs: int
+    elements: int
+    h: float | None
+    iterations: int
+    after_mesh: float  # this level's assembly, search and solves (s)
+    time: float  # this level's remeshing + solve + estimate (s)
+    cumulative: float  # the loop's time up to and with this level (s)
+    estimate: float  # relative estimate
+    errors: dict[str, float | None] = field(default_factory=dict)
+    stop: str = ""  # why the method's loop stopped (the same on each of its levels)

@@ -1,0 +1,124 @@
+"""`contactfx adapt SCENE ...`: the adaptive loop, its JSON, final mesh, fields and charts."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import time
+from pathlib import Path
+from typing import Any
+
+from mpi4py import MPI
+
+from ..errors import InputError
+from ..options import Method
+from ..results.files import write_fields, write_json
+from ..results.mesh_file import write_msh
+from ..results.sizing import SizingRule
+from ..scenes import parse_scene_file
+from ..study.adapt import AdaptOptions, AdaptResult, adapt, level_record, uniform_levels
+from ..study.adapt_charts import plot_adapt
+from .params import build_from_args, is_scene_file, spec_from_args
+
+
+def check_remeshable(args: argparse.Namespace) -> None:
+    """InputError before anything runs: a .msh scene, or the structured Hertz mesh."""
+    if is_scene_file(args.scene):
+        mesh = parse_scene_file(Path(args.scene))[0]
+        if mesh.suffix.lower() != ".geo":
+            raise InputError(
+                f"scene {Path(args.scene).name}: its mesh {mesh.name} is a {mesh.suffix} "
+                "file: there is no geometry to remesh (give the mesh as a .geo)"
+            )
+    elif args.mesh == "structured":
+        raise InputError(
+            "the structured Hertz mesh cannot be adapted: use --mesh gmsh (gmsh remeshes "
+            "the geometry from a size field)"
+        )
+
+
+def adapt_json(args: argparse.Namespace, result: AdaptResult, opts: AdaptOptions) -> dict[str, Any]:
+    """adapt.json: the settings, every level's summary (estimate a number), why it stopped."""
+    return {
+        "scene": args.scene,
+        "method": args.method,
+        "settings": {
+            "tol": opts.tol,
+            "max_dofs": opts.max_dofs,
+            "max_levels": opts.max_levels,
+            "rate": opts.rule.rate,
+            "growth": opts.rule.growth,
+            "weight_contact": opts.rule.contact_weight,
+            "solver": args.solver,
+        },
+        "stop": result.stop,
+        "levels": [level_record(lv) for lv in result.levels],
+        **({"uniform": [level_record(lv) for lv in result.uniform]} if result.uniform else {}),
+    }
+
+
+def run_adapt(args: argparse.Namespace) -> int:
+    """Run the adaptive loop the arguments describe and write DIR's files."""
+    comm = MPI.COMM_WORLD
+    if not args.verbose:
+        logging.getLogger("contactfx").setLevel(logging.WARNING)
+    if args.method in (Method.SCHWARZ.value,):
+        raise InputError("adapt needs a multiplier or penalty method (nts, sts, mortar, penalty)")
+    opts = AdaptOptions(
+        args.tol,
+        args.max_dofs,
+        args.max_levels,
+        SizingRule(growth=args.growth, contact_weight=args.weight_contact),
+    )
+    opts.check()
+    check_remeshable(args)
+    spec = spec_from_args(args)
+    say = (lambda line: print(line, flush=True)) if comm.rank == 0 else (lambda line: None)
+    t0 = time.perf_counter()
+    scene = build_from_args(args)
+    mesh_time = time.perf_counter() - t0
+    options = {"max_iterations": args.max_iterations}
+    paper = not is_scene_file(args.scene)
+    say(
+        f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
+        f"{comm.size} rank{'s' * (comm.size > 1)}"
+    )
+    result = adapt(
+        scene,
+        args.method,
+        opts,
+        solver=spec,
+        options=options,
+        paper_interface=paper,
+        say=say,
+        mesh_time=mesh_time,
+    )
+    if args.compare_uniform:
+        result.uniform = uniform_levels(
+            scene,
+            args.method,
+            max(opts.max_dofs, result.levels[-1].dofs),
+            max_levels=max(opts.max_levels, 2),
+            solver=spec,
+            options=options,
+            paper_interface=paper,
+            say=say,
+        )
+    out = args.out
+    final = result.levels[-1]
+    written = write_fields(final.solution, out, (final.est.eta,))
+    msh = write_msh(final.solution, out / "mesh.msh")
+    if comm.rank == 0:
+        assert msh is not None
+        data = adapt_json(args, result, opts)
+        write_json(out / "adapt.json", data)
+        uni = data.get("uniform", [])
+        title = f"{args.scene}, {args.method}: adaptive against uniform refinement"
+        written += [
+            out / "adapt.json",
+            msh,
+            plot_adapt(data["levels"], uni, out / "adapt_dofs.png", "dofs", title),
+            plot_adapt(data["levels"], uni, out / "adapt_time.png", "time", title),
+        ]
+        print("wrote " + ", ".join(str(p) for p in written))
+    return 0

@@ -1,0 +1,284 @@
+"""A residual a posteriori error estimate of a multiplier-method solve, cell by cell.
+
+The estimator of Hild & Nicaise (2007) and Wohlmuth (2007) for frictionless contact in
+plane-strain elasticity, in the energy scaling (each squared term divided by the cell's
+Young's modulus, so that it has the units of the energy a(u, u)):
+
+    eta_K^2 = h_K^2 |div sigma(u_h)|^2_K / E                          element residual
+            + sum_{interior e in dK} h_e / 2 |[sigma(u_h) n]|^2_e / E  traction jumps
+            + sum_{boundary e in dK} h_e |M (sigma(u_h) n - t)|^2_e / E  Neumann residual
+            + sum_{contact e in dK} h_e (sigma_nn + p_h)^2_e / E       normal stress vs. multiplier
+            + sum_{contact e in dK} h_e sigma_nt^2_e / E                tangential stress (= 0)
+            + int_{contact e} p_h g_h^+                                complementarity
+            + int_{contact e} E g_h^-^2 / h_e                          gap (penetration)
+
+M masks the components a Dirichlet condition prescribes (rollers leave the other one
+traction-free); sigma_nn, sigma_nt are each body's own traction on the contact frame (the
+passive normal nu the multipliers act along, as results/interface.py resolves it), p_h the
+piecewise-linear interpolant of the multipliers on the active surface and, on the passive
+surface, at the projection of each passive node. docs/adapt.md has the references and the
+measured effectivity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import ufl
+from dolfinx import fem, la, mesh
+from mpi4py import MPI
+
+from ..contact.geometry import nodal_normals, project
+from ..discretize.elasticity import sigma
+from ..discretize.mesh_utils import vertex_to_block
+from ..errors import InputError
+from ..methods.solution import Solution
+from ..scenes import Pressure
+
+BULK_TERMS = ("element", "jump", "neumann")
+CONTACT_TERMS = ("normal", "tangential", "complementarity", "gap")
+_CONTACT_TAG0 = 1000  # facet tags of the contact surfaces start here
+
+
+@dataclass
+class Estimate:
+    """The cell indicators and their sums; every number relative to the energy norm too."""
+
+    eta: fem.Function  # DG0: eta_K, all terms of cell K
+    terms: dict[str, float]  # sqrt of the sum over the cells of each term
+    energy: float  # ||u_h||_E = sqrt(a(u_h, u_h))
+    # Per owned cell: the sum of its contact terms (squared units, as eta_K^2).
+    contact_cells: np.ndarray | None = None
+
+    def marking(self, contact_weight: float = 1.0) -> np.ndarray:
+        """Per owned cell: eta_K with the contact terms times `contact_weight` (for sizing)."""
+        Q = self.eta.function_space
+        nloc = Q.mesh.topology.index_map(Q.mesh.topology.dim).size_local
+        eta = self.eta.x.array[Q.dofmap.list[:nloc, 0]]
+        if contact_weight == 1.0 or self.contact_cells is None:
+            return eta
+        return np.sqrt(eta**2 + (contact_weight**2 - 1.0) * self.contact_cells)
+
+    @property
+    def bulk(self) -> float:
+        """The element, jump and Neumann terms together."""
+        return float(np.sqrt(sum(self.terms[k] ** 2 for k in BULK_TERMS)))
+
+    @property
+    def contact(self) -> float:
+        """The contact terms together."""
+        return float(np.sqrt(sum(self.terms[k] ** 2 for k in CONTACT_TERMS)))
+
+    @property
+    def total(self) -> float:
+        """The whole estimate, sqrt(sum_K eta_K^2)."""
+        return float(np.hypot(self.bulk, self.contact))
+
+    @property
+    def relative(self) -> float:
+        """Total / ||u_h||_E."""
+        return self.total / self.energy
+
+    def summary(self) -> dict[str, Any]:
+        """The JSON block `estimate`: relative total, contact and bulk parts, each term."""
+        e = self.energy
+        return {
+            "total": self.relative,
+            "contact": self.contact / e,
+            "bulk": self.bulk / e,
+            "terms": {k: v / e for k, v in self.terms.items()},
+            "absolute": self.total,
+            "energy_norm": e,
+            "norm": "energy: sqrt(int sigma(u_h) : eps(u_h)); every value above but "
+            "absolute relative to it",
+        }
+
+
+def _surface_nodes(sol: Solution, gblock: np.ndarray, S: fem.FunctionSpace) -> np.ndarray:
+    """Local dofs of the scalar Q1 space S at global nodes `gblock` of V (-1 if not here)."""
+    V = sol.fields.V
+    local = V.dofmap.index_map.global_to_local(gblock.astype(np.int64))
+    v2b = vertex_to_block(V)
+    block_to_vertex = np.full(v2b.max() + 1, -1, dtype=np.int64)
+    block_to_vertex[v2b[v2b >= 0]] = np.flatnonzero(v2b >= 0)
+    s_of_v = vertex_to_block(S)
+    out = np.full(len(gblock), -1, dtype=np.int64)
+    ok = local >= 0
+    out[ok] = s_of_v[block_to_vertex[local[ok]]]
+    return out
+
+
+class _ContactFields:
+    """Q1 fields on the contact surfaces: the frame normal N, the multiplier p, the gap terms."""
+
+    def __init__(self, sol: Solution) -> None:
+        msh = sol.scene.mesh
+        self.S = fem.functionspace(msh, ("Lagrange", 1))
+        self.p = fem.Function(self.S)
+        self.comp = fem.Function(self.S)  # p g^+ at the active nodes
+        self.pen = fem.Function(self.S)  # (g^-)^2 at the active nodes
+        self.N = [fem.Function(self.S), fem.Function(self.S)]
+        for k in range(len(sol.pairs)):
+            self._pair(sol, k)
+
+    def _set(self, f: fem.Function, dofs: np.ndarray, values: np.ndarray) -> None:
+        ok = dofs >= 0
+        f.x.array[dofs[ok]] = values[ok]
+
+    def _pair(self, sol: Solution, k: int) -> None:
+        pv = sol.pairs[k]
+        surf = pv.active.surface
+        p_nodes = np.zeros(surf.n_nodes)
+        p_nodes[pv.nodes] = sol.pressure[pv.rows]
+        normal = nodal_normals(surf)
+        normal[pv.nodes] = pv.frame[0]
+        gap = sol.gap[pv.rows]
+        dofs = _surface_nodes(sol, pv.active.gblock, self.S)
+        self._set(self.p, dofs, p_nodes)
+        for c in range(2):
+            self._set(self.N[c], dofs, normal[:, c])
+        rows = dofs[pv.nodes]
+        self._set(self.comp, rows, sol.pressure[pv.rows] * np.maximum(gap, 0.0))
+        self._set(self.pen, rows, np.minimum(gap, 0.0) ** 2)
+        if pv.passive is None:
+            return
+        # The passive side carries the multiplier at the projection of each of its nodes.
+        ps = pv.passive.surface
+        seg, xi, found = project(ps.x, surf)
+        ends = surf.segments[seg]
+        p_pass = np.where(found, (1 - xi) * p_nodes[ends[:, 0]] + xi * p_nodes[ends[:, 1]], 0.0)
+        dofs_p = _surface_nodes(sol, pv.passive.gblock, self.S)
+        self._set(self.p, dofs_p, p_pass)
+        normal_p = nodal_normals(ps)
+        for c in range(2):
+            self._set(self.N[c], dofs_p, normal_p[:, c])
+
+
+def _boundary_tags(sol: Solution) -> tuple[mesh.MeshTags, list[tuple[int, Any, Any]], list[int]]:
+    """Tags of the exterior facets: contact surfaces, and one class per (mask, load).
+
+    Returns the tags, the Neumann classes (tag, mask, load or None) and the contact tags.
+    """
+    scene = sol.scene
+    msh = scene.mesh
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    nfac = msh.topology.index_map(tdim - 1).size_local
+    ext = mesh.exterior_facet_indices(msh.topology)
+    ext = ext[ext < nfac]
+    tags = scene.facet_tags
+
+    def find(group: str) -> np.ndarray:
+        dim, tag = scene.groups.by_name[group]
+        if dim != tdim - 1 or tags is None:
+            return np.zeros(0, dtype=np.int32)
+        return tags.find(tag)
+
+    mask = np.full(nfac, 3, dtype=np.int64)  # bit c set: component c is traction-free/loaded
+    for bc in scene.dirichlet:
+        facets = find(bc.group)
+        facets = facets[facets < nfac]
+        for comp, _ in bc.components():
+            mask[facets] &= ~(1 << comp)
+    load = np.full(nfac, -1, dtype=np.int64)
+    for i, ld in enumerate(scene.loads):
+        facets = find(ld.group)
+        load[facets[facets < nfac]] = i
+    value = np.zeros(nfac, dtype=np.int32)
+    nl = len(scene.loads) + 1
+    value[ext] = 1 + mask[ext] * nl + load[ext] + 1
+    value[ext[mask[ext] == 0]] = 0  # fully prescribed: no residual
+    groups = sorted(
+        {
+            g
+            for pv in sol.pairs
+            for g in (pv.pair.active, pv.pair.passive)
+            if g in scene.groups.by_name
+        }
+    )
+    contact_tags = []
+    for j, group in enumerate(groups):
+        facets = find(group)
+        value[facets[facets < nfac]] = _CONTACT_TAG0 + j
+        contact_tags.append(_CONTACT_TAG0 + j)
+    keep = np.flatnonzero(value > 0).astype(np.int32)
+    mt = mesh.meshtags(msh, tdim - 1, keep, value[keep])
+    classes = []
+    for tag in np.unique(value[(value > 0) & (value < _CONTACT_TAG0)]):
+        m, k = divmod(int(tag) - 1, nl)
+        classes.append((int(tag), (m & 1, (m >> 1) & 1), scene.loads[k - 1] if k else None))
+    return mt, classes, contact_tags
+
+
+def estimate(sol: Solution) -> Estimate:
+    """The residual estimate of a multiplier-method (or penalty) solution (collective)."""
+    scene = sol.scene
+    msh = scene.mesh
+    if msh.comm.size > 1:
+        # The traction jumps are interior-facet integrals, which DOLFINx computes across
+        # ranks only on meshes ghosted by shared facet; the scenes' partitioner ghosts none.
+        raise InputError(
+            "the error estimate (solve --estimate, adapt) runs on one rank only for now: "
+            "run it without mpirun"
+        )
+    u, E, nu = sol.u, sol.fields.E, sol.fields.nu
+    Q = fem.functionspace(msh, ("DG", 0))
+    w = ufl.TestFunction(Q)
+    n = ufl.FacetNormal(msh)
+    hK = ufl.CellDiameter(msh)
+    # A Q1 facet is straight and its reference edge has length 1: |J_f| is its length.
+    he: Any = abs(ufl.geometry.FacetJacobianDeterminant(msh))  # type: ignore[arg-type]
+    sig = sigma(u, E, nu)
+    tn = ufl.dot(sig, n)
+    mt, classes, contact_tags = _boundary_tags(sol)
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=mt)
+    cf = _ContactFields(sol)
+    N = ufl.as_vector([cf.N[0], cf.N[1]])
+    N = N / ufl.sqrt(ufl.dot(N, N) + 1e-300)
+    forms: dict[str, Any] = {
+        "element": hK**2 * ufl.inner(ufl.div(sig), ufl.div(sig)) / E * w * ufl.dx,
+        "jump": 0.5
+        * ufl.avg(he)
+        * ufl.inner(ufl.jump(sig, n), ufl.jump(sig, n))
+        / ufl.avg(E)
+        * (w("+") + w("-"))
+        * ufl.dS,
+    }
+    neumann = fem.Constant(msh, 0.0) * w * ufl.dx
+    for tag, (mx, my), load in classes:
+        if load is None:
+            t = ufl.as_vector([0.0, 0.0])
+        elif isinstance(load, Pressure):
+            t = -load.p * n
+        else:
+            t = ufl.as_vector(list(load.t))
+        r = tn - t
+        neumann += he * (mx * r[0] ** 2 + my * r[1] ** 2) / E * w * ds(tag)
+    forms["neumann"] = neumann
+    dsc = ds(tuple(contact_tags)) if contact_tags else ds(_CONTACT_TAG0)
+    tnn = ufl.dot(tn, N)
+    tt = tn - tnn * N
+    forms["normal"] = he * (tnn + cf.p) ** 2 / E * w * dsc
+    forms["tangential"] = he * ufl.dot(tt, tt) / E * w * dsc
+    forms["complementarity"] = cf.comp * w * dsc
+    forms["gap"] = E * cf.pen / he * w * dsc
+    nloc = msh.topology.index_map(msh.topology.dim).size_local
+    cell_dof = Q.dofmap.list[:nloc, 0]
+    total, contact = np.zeros(nloc), np.zeros(nloc)
+    terms = {}
+    for key, form in forms.items():
+        vec = fem.assemble_vector(fem.form(form))
+        vec.scatter_reverse(la.InsertMode.add)
+        vals = np.maximum(vec.array[cell_dof], 0.0)
+        total += vals
+        if key in CONTACT_TERMS:
+            contact += vals
+        terms[key] = float(np.sqrt(msh.comm.allreduce(float(vals.sum()), op=MPI.SUM)))
+    eta = fem.Function(Q, name="eta")
+    eta.x.array[cell_dof] = np.sqrt(total)
+    eta.x.scatter_forward()
+    energy_form = fem.form(ufl.inner(sig, ufl.sym(ufl.grad(u))) * ufl.dx)
+    energy = float(np.sqrt(msh.comm.allreduce(fem.assemble_scalar(energy_form), op=MPI.SUM)))
+    return Estimate(eta, terms, energy, contact)

@@ -1,0 +1,221 @@
+"""The adaptive loop: solve, estimate, mark (size the next mesh), remesh with gmsh; repeat.
+
+DOLFINx cannot refine quadrilaterals, so every level remeshes the scene's geometry (a
+built-in scene's gmsh model or a .geo) from a background size field built from the
+indicators (results/sizing.py). The loop stops when the relative estimate is at most `tol`,
+after `max_levels` levels, or when the next mesh would exceed `max_dofs`. `uniform_levels`
+refines the same starting scene uniformly, for the comparison charts.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from mpi4py import MPI
+
+from ..api import run_scene
+from ..errors import InputError
+from ..methods.solution import Solution
+from ..options import SolverSpec
+from ..results.estimate import Estimate, estimate
+from ..results.sizing import SizingRule, plan_mesh
+from ..scenes import Scene
+from ..timers import Timers
+
+
+@dataclass(frozen=True)
+class AdaptOptions:
+    """When the loop stops and how it sizes meshes."""
+
+    tol: float = 0.05  # relative estimate to reach
+    max_dofs: int = 200_000
+    max_levels: int = 8
+    rule: SizingRule = field(default_factory=SizingRule)
+
+    def check(self) -> None:
+        """InputError for a value out of range."""
+        if not (self.tol > 0):
+            raise InputError(f"--tol must be > 0 (got {self.tol})")
+        if self.max_dofs < 10:
+            raise InputError(f"--max-dofs must be at least 10 (got {self.max_dofs})")
+        if not (self.rule.contact_weight >= 1.0):
+            raise InputError(f"--weight-contact must be >= 1 (got {self.rule.contact_weight})")
+        if self.max_levels < 1:
+            raise InputError(f"--max-levels must be at least 1 (got {self.max_levels})")
+
+
+@dataclass
+class AdaptLevel:
+    """One solved level: its summary (with `estimate`), the solution and the estimate."""
+
+    index: int
+    summary: dict[str, Any]
+    solution: Solution
+    est: Estimate
+    time: float  # seconds: meshing (remesh) + solve + estimate
+
+    @property
+    def dofs(self) -> int:
+        """Displacement DOFs of the level."""
+        return int(self.summary["dofs"])
+
+
+@dataclass
+class AdaptResult:
+    """The levels, why the loop stopped, and the uniform levels if asked for."""
+
+    levels: list[AdaptLevel]
+    stop: str
+    uniform: list[AdaptLevel] = field(default_factory=list)
+
+
+def solve_level(
+    scene: Scene,
+    index: int,
+    mesh_time: float,
+    method: str,
+    solver: SolverSpec | str,
+    options: dict[str, Any],
+    paper_interface: bool,
+) -> AdaptLevel:
+    """Solve one mesh and estimate its error; the summary gets `estimate` (a number)."""
+    t0 = time.perf_counter()
+    sol, data = run_scene(
+        scene,
+        method,
+        solver=solver,
+        timers=Timers(),
+        paper_interface=paper_interface,
+        **options,
+    )
+    est = estimate(sol)
+    data["estimate"] = est.relative
+    data["estimate_parts"] = est.summary()
+    data["times"]["mesh"] = mesh_time
+    data["level"] = index
+    elapsed = mesh_time + time.perf_counter() - t0
+    data["time"] = elapsed
+    return AdaptLevel(index, data, sol, est, elapsed)
+
+
+def _mesh_dofs(scene: Scene) -> int:
+    """Displacement DOFs a scene's mesh will have (Q1: two per vertex)."""
+    return 2 * scene.mesh.topology.index_map(0).size_global
+
+
+def adapt(
+    scene: Scene,
+    method: str,
+    opts: AdaptOptions,
+    *,
+    solver: SolverSpec | str = "mumps",
+    options: dict[str, Any] | None = None,
+    paper_interface: bool = False,
+    say: Callable[[str], None] | None = None,
+    mesh_time: float = 0.0,
+) -> AdaptResult:
+    """Run the adaptive loop from `scene` (collective); `say` prints progress (rank 0)."""
+    opts.check()
+    if scene.recipe is None:
+        raise InputError(
+            f"scene '{scene.name}' cannot be adapted: there is no geometry to remesh "
+            "(give the scene's mesh as a .geo)"
+        )
+    comm = scene.comm
+    say = say or (lambda line: print(line, flush=True) if comm.rank == 0 else None)
+    levels: list[AdaptLevel] = []
+    stop = f"max levels ({opts.max_levels})"
+    for k in range(opts.max_levels):
+        level = solve_level(scene, k, mesh_time, method, solver, options or {}, paper_interface)
+        levels.append(level)
+        say(level_line(level))
+        if level.est.relative <= opts.tol:
+            stop = f"estimate {level.est.relative:.3g} <= tol {opts.tol:g}"
+            break
+        if k + 1 == opts.max_levels:
+            break
+        ratio = level.dofs / max(level.summary["elements"], 1)
+        # 10 % margin: gmsh meets a size field only approximately.
+        budget = 0.9 * opts.max_dofs / ratio
+        plan = plan_mesh(level.solution, level.est, opts.tol, budget, opts.rule)
+        if plan.predicted > opts.tol and plan.cells < 1.1 * level.summary["elements"]:
+            stop = f"the next mesh would exceed --max-dofs {opts.max_dofs}"
+            break
+        t0 = time.perf_counter()
+        nxt = scene.remeshed_to(plan.field)
+        mesh_time = time.perf_counter() - t0
+        dofs = _mesh_dofs(nxt)
+        if dofs > opts.max_dofs:
+            stop = f"the next mesh would have {dofs} DOFs > --max-dofs {opts.max_dofs}"
+            break
+        say(
+            f"  remeshed: {dofs} DOFs planned for a relative estimate of "
+            f"{plan.predicted:.3g} ({mesh_time:.2f} s)"
+        )
+        scene = nxt
+    say(f"stopped: {stop}")
+    return AdaptResult(levels, stop)
+
+
+def uniform_levels(
+    scene: Scene,
+    method: str,
+    max_dofs: int,
+    *,
+    ratio: float = 2.0,
+    max_levels: int = 8,
+    solver: SolverSpec | str = "mumps",
+    options: dict[str, Any] | None = None,
+    paper_interface: bool = False,
+    say: Callable[[str], None] | None = None,
+) -> list[AdaptLevel]:
+    """The same scene refined uniformly (every size / ratio per level) up to max_dofs.
+
+    The last level is the first at or beyond max_dofs (so that the uniform curve spans the
+    adaptive one), unless it would exceed ratio^2 max_dofs.
+    """
+    comm = scene.comm
+    say = say or (lambda line: print(line, flush=True) if comm.rank == 0 else None)
+    out: list[AdaptLevel] = []
+    current, mesh_time = scene, 0.0
+    for k in range(max_levels):
+        if _mesh_dofs(current) > ratio**2 * max_dofs:
+            break
+        level = solve_level(current, k, mesh_time, method, solver, options or {}, paper_interface)
+        out.append(level)
+        say("uniform " + level_line(level))
+        if level.dofs >= max_dofs:
+            break
+        t0 = time.perf_counter()
+        current = scene.remeshed(ratio ** -(k + 1))
+        mesh_time = time.perf_counter() - t0
+    return out
+
+
+def level_line(level: AdaptLevel) -> str:
+    """One progress line: DOFs, estimate (contact and bulk), the reference error, time."""
+    d = level.summary
+    e = d["estimate_parts"]
+    ref = ""
+    if "hertz" in d:
+        ref = f", Hertz L2 {100 * d['hertz']['l2_error']:.3f} %"
+    elif "patch" in d:
+        ref = f", patch max {d['patch']['max']:.2e}"
+    return (
+        f"level {level.index}: {d['dofs']} DOFs, estimate {100 * e['total']:.3g} % "
+        f"(contact {100 * e['contact']:.3g} %, bulk {100 * e['bulk']:.3g} %){ref}, "
+        f"{level.time:.2f} s"
+    )
+
+
+def level_record(level: AdaptLevel) -> dict[str, Any]:
+    """The JSON of one level (the summary, with `estimate` the relative total)."""
+    return dict(level.summary)
+
+
+def rank_zero(comm: MPI.Comm) -> bool:
+    """Whether this is the rank that writes files."""
+    return comm.rank == 0

@@ -1,0 +1,112 @@
+"""`study --adaptive`: the adaptive loop beside the uniform levels, on the same charts.
+
+After the uniform study, each method (but schwarz, which has no estimate) runs the adaptive
+loop (study/adapt.py) from level 0's mesh, up to the DOFs of that method's finest uniform
+level. Each adaptive level is measured like a uniform run: against the exact solution
+(Hertz, patch test) or, without one, against the study's self-convergence reference (the
+finest uniform level of the most accurate method). Its time on the charts is cumulative:
+the solves, estimates and remeshings of all the levels up to it (level 0's mesh excluded, as
+the uniform runs' time after meshing excludes theirs), since a level cannot be had without
+the ones before it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from ..options import Method, SolverSpec
+from ..results.sizing import SizingRule
+from ..scenes import Scene
+from .adapt import AdaptLevel, AdaptOptions, adapt
+from .core import Study, exact_errors, self_reference
+from .measures import contact_size, profiles
+from .measures import self_errors as compare_profiles
+from .runs import AdaptiveRun, Run
+
+# The loop is steered by the DOF budget only: no tolerance is reached before it.
+NO_TOL = 1e-12
+# Cells per level at most x 2 (adapt's default is x 4): gmsh makes meshes finer than planned
+# on coarse levels (vertex sizes are the smallest of the cells around), and a study's DOF
+# range is one or two decades, which x 4 steps would cross in one or two levels.
+GROWTH = 2.0
+
+
+def adaptive_methods(methods: list[str]) -> list[str]:
+    """The study's methods that have an error estimate (all but schwarz)."""
+    return [m for m in methods if m != Method.SCHWARZ.value]
+
+
+def budget(study: Study, method: str) -> int | None:
+    """DOFs of the method's finest finished uniform level (None if none finished)."""
+    dofs = [r.dofs for r in study.runs if r.method == method and r.ok and r.dofs]
+    return max(dofs) if dofs else None
+
+
+def _errors(study: Study, level: AdaptLevel, ref: Run | None) -> dict[str, float | None]:
+    """The level's errors, measured as the study measures its uniform runs."""
+    if study.reference["kind"] == "exact":
+        kind = "hertz" if study.reference["type"] == "hertz" else "patch"
+        return exact_errors(kind, level.summary)
+    if ref is None or ref.profiles is None:
+        return {}
+    return compare_profiles(profiles(level.solution, level.summary), ref.profiles)
+
+
+def _prefixed(say: Callable[[str], None] | None, prefix: str) -> Callable[[str], None] | None:
+    """`say` with every line prefixed (None stays None: the loop's own rank-0 print)."""
+    if say is None:
+        return None
+    speak = say
+    return lambda line: speak(prefix + line)
+
+
+def adaptive_runs(
+    study: Study,
+    scene: Scene,
+    *,
+    solver: SolverSpec | str = "mumps",
+    options: dict[str, Any] | None = None,
+    paper_interface: bool = False,
+    max_levels: int = 12,
+    growth: float = GROWTH,
+    say: Callable[[str], None] | None = None,
+) -> list[AdaptiveRun]:
+    """Run the adaptive loop of every method from `scene` (level 0) and measure its levels."""
+    ref = self_reference(study.runs, study.methods) if study.reference["kind"] == "self" else None
+    out: list[AdaptiveRun] = []
+    for m in adaptive_methods(study.methods):
+        cap = budget(study, m)
+        if cap is None:
+            continue
+        result = adapt(
+            scene,
+            m,
+            AdaptOptions(NO_TOL, cap, max_levels, SizingRule(growth=growth)),
+            solver=solver,
+            options=options,
+            paper_interface=paper_interface,
+            say=_prefixed(say, f"adaptive {m}: "),
+        )
+        cumulative = 0.0
+        for lv in result.levels:
+            cumulative += lv.time
+            d = lv.summary
+            out.append(
+                AdaptiveRun(
+                    m,
+                    lv.index,
+                    lv.dofs,
+                    int(d["elements"]),
+                    contact_size(d),
+                    int(d["iterations"]),
+                    float(d["times"]["total"]),
+                    lv.time,
+                    cumulative,
+                    float(lv.est.relative),
+                    _errors(study, lv, ref),
+                    result.stop,
+                )
+            )
+        del result
+    return out

@@ -1,0 +1,106 @@
+"""contactfx adapt: the loop, adapt.json, the final mesh, refusals, two ranks."""
+
+from __future__ import annotations
+
+import itertools
+import json
+from pathlib import Path
+
+import pytest
+from conftest import ROOT, run_cli
+
+COARSE_HERTZ = ("hertz", "--refine", "2", "--h-far", "2", "--refine-edge", "0", "--slope", "0.3")
+
+
+def _adapt(tmp: Path, *args: str, ranks: int = 1) -> dict:
+    proc = run_cli("adapt", *args, "--out", str(tmp), ranks=ranks)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "level 0:" in proc.stdout and "stopped:" in proc.stdout
+    return json.loads((tmp / "adapt.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def hertz_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    out = tmp_path_factory.mktemp("adapt_hertz")
+    return _adapt(out, *COARSE_HERTZ, "--max-dofs", "12000", "--compare-uniform"), out
+
+
+def test_hertz_levels(hertz_run: tuple[dict, Path]) -> None:
+    data, out = hertz_run
+    levels = data["levels"]
+    assert len(levels) >= 2
+    for lv in levels:
+        assert isinstance(lv["estimate"], float) and lv["time"] > 0
+        assert {"hertz", "contacts", "dofs", "estimate_parts"} <= set(lv)
+    est = [lv["estimate"] for lv in levels]
+    assert all(b < a for a, b in itertools.pairwise(est)), est
+    # The adapted mesh is better than the uniform one of about the same size.
+    assert levels[-1]["hertz"]["l2_error"] < levels[0]["hertz"]["l2_error"]
+    assert levels[-1]["dofs"] <= 12000 and "max-dofs" in data["stop"]
+    uni = data["uniform"]
+    assert len(uni) >= 2 and uni[0]["dofs"] == levels[0]["dofs"]
+    for name in ("fields.pvtu", "mesh.msh", "adapt_dofs.png", "adapt_time.png"):
+        assert (out / name).is_file(), name
+
+
+def test_final_mesh_loads_back(hertz_run: tuple[dict, Path], tmp_path: Path) -> None:
+    """mesh.msh as a scene file's mesh: the same DOFs and the same contact force."""
+    data, out = hertz_run
+    scene = tmp_path / "final.toml"
+    scene.write_text(
+        f'mesh = "{out / "mesh.msh"}"\n'
+        "[bodies.body1]\nE = 7000.0\nnu = 0.23\n[bodies.body2]\nE = 7000.0\nnu = 0.23\n"
+        '[[contact]]\nactive = "contact2"\npassive = "contact1"\n'
+        '[[dirichlet]]\ngroup = "symmetry"\nux = 0.0\n'
+        '[[dirichlet]]\ngroup = "support"\nuy = 0.0\n'
+        f'[[pressure]]\ngroup = "load"\np = {100.0 / 120.0!r}\n'
+    )
+    proc = run_cli("solve", str(scene), "--json", str(tmp_path / "r.json"))
+    assert proc.returncode == 0, proc.stderr
+    r = json.loads((tmp_path / "r.json").read_text())
+    last = data["levels"][-1]
+    assert r["dofs"] == last["dofs"] and r["elements"] == last["elements"]
+    assert abs(r["contact_force"] - last["contact_force"]) < 1e-8 * last["contact_force"]
+
+
+def test_blocks(tmp_path: Path) -> None:
+    data = _adapt(tmp_path, "blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2")
+    levels = data["levels"]
+    assert len(levels) == 2 and levels[1]["estimate"] < levels[0]["estimate"]
+    assert all(abs(lv["contact_force"] - 150.0) < 1e-8 for lv in levels)
+
+
+def test_geo_scene(tmp_path: Path) -> None:
+    scene = ROOT / "tests" / "scenes" / "two_cylinders.toml"
+    data = _adapt(tmp_path, str(scene), "--max-levels", "2", "--max-dofs", "60000")
+    assert len(data["levels"]) == 2
+    assert data["levels"][1]["estimate"] < data["levels"][0]["estimate"]
+    assert "hertz" in data["levels"][0]
+
+
+def test_msh_refused(tmp_path: Path) -> None:
+    (tmp_path / "m.msh").write_text("")
+    scene = tmp_path / "s.toml"
+    scene.write_text(
+        'mesh = "m.msh"\n[bodies.a]\nE = 1.0\nnu = 0.3\n[bodies.b]\nE = 1.0\nnu = 0.3\n'
+        '[[contact]]\nactive = "x"\npassive = "y"\n'
+    )
+    proc = run_cli("adapt", str(scene), "--out", str(tmp_path / "o"))
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1
+    assert "no geometry to remesh" in proc.stderr
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.mpi
+def test_two_ranks_refused(tmp_path: Path) -> None:
+    """mpirun -n 2: not supported yet (the jumps need a facet-ghosted mesh): one line, exit 2."""
+    proc = run_cli("adapt", *COARSE_HERTZ, "--out", str(tmp_path / "o"), ranks=2)
+    assert proc.returncode == 2, proc.stderr
+    assert "one rank only" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "o" / "adapt.json").exists()
+
+
+def test_weight_below_one_refused(tmp_path: Path) -> None:
+    proc = run_cli("adapt", *COARSE_HERTZ, "--weight-contact", "0.5", "--out", str(tmp_path / "o"))
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert "--weight-contact" in proc.stderr and not (tmp_path / "o").exists()

@@ -1,0 +1,97 @@
+"""The residual error estimate: zero on an exact solution, reliable against an overkill one."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import run_cli
+
+import contactfx
+from contactfx.results.estimate import BULK_TERMS, CONTACT_TERMS, estimate
+from contactfx.results.true_error import energy_error
+from contactfx.scenes import BlockParams, HertzParams, blocks, hertz
+
+
+def _hertz(h: float, slope: float = 0.3) -> contactfx.Scene:
+    return hertz(HertzParams(refine=h, refine_edge=0.0, slope=slope))
+
+
+def test_patch_test_has_no_residual() -> None:
+    """Equal widths: mortar is exact (uniform stress), so every residual term vanishes."""
+    sol = contactfx.solve(blocks(BlockParams(l2=10.0, size1=0.5, size2=0.4)), "mortar")
+    est = estimate(sol)
+    assert est.energy > 0
+    # Every residual at round-off; complementarity is the square root of p times a gap
+    # at round-off (1e-16 cm), hence larger.
+    rel = {k: v / est.energy for k, v in est.terms.items()}
+    assert all(v < 1e-11 for k, v in rel.items() if k != "complementarity"), rel
+    assert rel["complementarity"] < 1e-7, rel
+
+
+def test_parts_add_up_and_json() -> None:
+    sol = contactfx.solve(_hertz(0.1), "mortar")
+    est = estimate(sol)
+    s = est.summary()
+    assert set(s["terms"]) == set(BULK_TERMS) | set(CONTACT_TERMS)
+    assert np.isclose(s["total"] ** 2, s["bulk"] ** 2 + s["contact"] ** 2)
+    assert np.isclose(sum(v**2 for v in s["terms"].values()), s["total"] ** 2)
+    # The cell indicators sum to the total.
+    eta = est.eta.x.array
+    assert np.isclose(np.sqrt(np.sum(eta**2)), est.total, rtol=1e-10)
+    # Converged active set: complementarity and penetration at the nodes vanish.
+    assert s["terms"]["complementarity"] < 1e-6 * s["total"]
+    assert s["terms"]["gap"] < 1e-6 * s["total"]
+
+
+def test_effectivity_against_overkill() -> None:
+    """Three meshes: estimate / true energy error within [1, 10], spread within 3."""
+    ref = contactfx.solve(hertz(HertzParams(refine=0.01, refine_edge=0.0, h_far=4.0)), "mortar")
+    effs, ests = [], []
+    for h in (0.1, 0.05):
+        sol = contactfx.solve(_hertz(h, 0.2), "mortar")
+        est = estimate(sol)
+        err = energy_error(sol, ref)
+        assert err is not None
+        effs.append(est.total / err["error"])
+        ests.append(est.relative)
+    assert all(1.0 < e < 10.0 for e in effs), effs
+    assert max(effs) / min(effs) < 3.0, effs
+
+
+def test_true_error_of_itself_is_zero() -> None:
+    sol = contactfx.solve(_hertz(0.1), "mortar")
+    err = energy_error(sol, sol)
+    assert err is not None and err["relative"] < 1e-10
+
+
+def test_solve_estimate_cli(tmp_path: Path) -> None:
+    proc = run_cli(
+        "solve",
+        "hertz",
+        "--refine",
+        "0.1",
+        "--estimate",
+        "--json",
+        str(tmp_path / "r.json"),
+        "--out",
+        str(tmp_path / "out"),
+    )
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads((tmp_path / "r.json").read_text())
+    e = data["estimate"]
+    assert 0 < e["contact"] < e["total"] and 0 < e["bulk"] <= e["total"]
+    assert "estimate (relative to the energy norm)" in proc.stdout
+    pyvista = pytest.importorskip("pyvista")
+    grid = pyvista.read(str(tmp_path / "out" / "fields.pvtu"))
+    eta = np.asarray(grid.cell_data["eta"])
+    assert eta.shape == (data["elements"],)
+    assert np.isclose(np.sqrt(np.sum(eta**2)), e["absolute"], rtol=1e-8)
+
+
+def test_schwarz_estimate_refused() -> None:
+    proc = run_cli("solve", "blocks", "--method", "schwarz", "--estimate")
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "--estimate" in proc.stderr

@@ -1,0 +1,54 @@
+"""`contactfx study --adaptive`: the adaptive loop's levels beside the uniform ones."""
+
+from __future__ import annotations
+
+import itertools
+import json
+from pathlib import Path
+
+import pytest
+from conftest import run_cli
+
+# The cheap Hertz study of test_study.py (920 to 4180 DOFs), mortar only.
+HERTZ = ("study", "hertz", "--levels", "3", "--size-factor", "8", "--methods", "mortar")
+
+
+@pytest.fixture(scope="module")
+def adaptive_study(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, str, Path]:
+    out = tmp_path_factory.mktemp("study_adaptive")
+    proc = run_cli(*HERTZ, "--adaptive", "--out", str(out))
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    return json.loads((out / "study.json").read_text()), proc.stdout, out
+
+
+def test_adaptive_levels_in_the_json(adaptive_study: tuple[dict, str, Path]) -> None:
+    data, stdout, out = adaptive_study
+    runs = data["adaptive"]["runs"]
+    uniform = [r for r in data["runs"] if r["status"] == "ok"]
+    assert len(runs) >= 2 and {r["method"] for r in runs} == {"mortar"}
+    # Level 0 is the study's level 0 mesh: the same DOFs and the same errors.
+    assert runs[0]["dofs"] == uniform[0]["dofs"]
+    for name in ("l2", "a", "p0"):
+        assert runs[0]["errors"][name] == pytest.approx(uniform[0]["errors"][name], rel=1e-10)
+    # Within the finest uniform level's DOFs; the estimate falls; the time accumulates.
+    assert all(r["dofs"] <= max(u["dofs"] for u in uniform) for r in runs)
+    assert all(b["estimate"] < a["estimate"] for a, b in itertools.pairwise(runs))
+    for a, b in itertools.pairwise(runs):
+        assert b["cumulative"] == pytest.approx(a["cumulative"] + b["time"])
+    assert runs[-1]["stop"] in stdout and "adaptive levels" in stdout
+    for name in ("accuracy_vs_time.png", "accuracy_vs_dofs.png", "convergence.png"):
+        assert (out / name).stat().st_size > 10_000, name
+
+
+def test_structured_mesh_refused(tmp_path: Path) -> None:
+    proc = run_cli(*HERTZ, "--mesh", "structured", "--adaptive", "--out", str(tmp_path / "o"))
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+    assert "--mesh gmsh" in proc.stderr and not (tmp_path / "o").exists()
+
+
+@pytest.mark.mpi
+def test_two_ranks_refused(tmp_path: Path) -> None:
+    proc = run_cli(*HERTZ, "--adaptive", "--out", str(tmp_path / "o"), ranks=2)
+    assert proc.returncode == 2, proc.stderr
+    assert "one rank only" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (tmp_path / "o").exists()
