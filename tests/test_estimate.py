@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import run_cli
+from conftest import cli
 
 import contactfx
 from contactfx.results.estimate import BULK_TERMS, CONTACT_TERMS, estimate
@@ -68,7 +68,7 @@ def test_true_error_of_itself_is_zero() -> None:
 
 
 def test_solve_estimate_cli(tmp_path: Path) -> None:
-    proc = run_cli(
+    proc = cli(
         "solve",
         "hertz",
         "--refine",
@@ -92,6 +92,6 @@ def test_solve_estimate_cli(tmp_path: Path) -> None:
 
 
 def test_schwarz_estimate_refused() -> None:
-    proc = run_cli("solve", "blocks", "--method", "schwarz", "--estimate")
+    proc = cli("solve", "blocks", "--method", "schwarz", "--estimate")
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "--estimate" in proc.stderr

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import run_cli
+from conftest import cli, run_cli
 
 # The cheap Hertz study of test_study.py (920 to 4180 DOFs), mortar only.
 HERTZ = ("study", "hertz", "--levels", "3", "--size-factor", "8", "--methods", "mortar")
@@ -16,7 +16,7 @@ HERTZ = ("study", "hertz", "--levels", "3", "--size-factor", "8", "--methods", "
 @pytest.fixture(scope="module")
 def adaptive_study(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, str, Path]:
     out = tmp_path_factory.mktemp("study_adaptive")
-    proc = run_cli(*HERTZ, "--adaptive", "--out", str(out))
+    proc = cli(*HERTZ, "--adaptive", "--out", str(out))
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return json.loads((out / "study.json").read_text()), proc.stdout, out
 
@@ -41,7 +41,7 @@ def test_adaptive_levels_in_the_json(adaptive_study: tuple[dict, str, Path]) -> 
 
 
 def test_structured_mesh_refused(tmp_path: Path) -> None:
-    proc = run_cli(*HERTZ, "--mesh", "structured", "--adaptive", "--out", str(tmp_path / "o"))
+    proc = cli(*HERTZ, "--mesh", "structured", "--adaptive", "--out", str(tmp_path / "o"))
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
     assert "--mesh gmsh" in proc.stderr and not (tmp_path / "o").exists()
 

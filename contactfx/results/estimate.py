@@ -229,7 +229,7 @@ def estimate(sol: Solution) -> Estimate:
     n = ufl.FacetNormal(msh)
     hK = ufl.CellDiameter(msh)
     # A Q1 facet is straight and its reference edge has length 1: |J_f| is its length.
-    he: Any = abs(ufl.geometry.FacetJacobianDeterminant(msh))  # type: ignore[arg-type]
+    he: Any = abs(ufl.geometry.FacetJacobianDeterminant(msh))
     sig = sigma(u, E, nu)
     tn = ufl.dot(sig, n)
     mt, classes, contact_tags = _boundary_tags(sol)
