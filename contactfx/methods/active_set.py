@@ -34,7 +34,10 @@ class ActiveSetOptions:
     penetration_tol: float = 1e-6  # allowed initial penetration relative to the element size
     tolerance: float = 1e-6  # complementarity residual (relative) required at the end
     predictor: bool = True  # probe candidate sets with multi-RHS solves (direct solvers)
-    max_probes: int = 2000  # largest candidate set probed
+    # Largest candidate set probed (its dense block: 8 c^2 bytes, 128 MB at 4000). Above it
+    # the loop runs unprobed: on the default-graded structured Hertz mesh at 1.23M DOFs
+    # (3,298 candidates) that took 16 steps and 89 s; probing them all, 2 steps and 33 s.
+    max_probes: int = 4000
     # With cheap probe responses (serial MUMPS: selected entries of the inverse), start from
     # every multiplier row in contact and probe them all: one factorization, the predicted
     # set by the small complementarity problem, then one solve that only releases rows.
