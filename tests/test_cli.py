@@ -1,6 +1,8 @@
 """The command line as a user runs it: the JSON schema, outputs, and one-line errors."""
 
 import json
+import subprocess
+from pathlib import Path
 
 import pytest
 from conftest import cli, run_cli
@@ -73,6 +75,15 @@ def test_mortar_patch_test_from_the_issue(tmp_path) -> None:
         assert max(abs(v / 50.0 + 1) for v in itf[key]) < 1e-8
 
 
+def assert_refused(proc: subprocess.CompletedProcess[str], needle: str, out: Path) -> None:
+    """Exit 2, one stderr line holding `needle`, no traceback, no JSON."""
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], proc.stderr
+    assert "Traceback" not in proc.stderr + proc.stdout
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
@@ -91,12 +102,7 @@ def test_bad_input_one_line_no_traceback(tmp_path, args: list[str], needle: str)
     """Bad input: exit 2, one line on stderr naming the problem, no JSON written (in this
     process: main() turns the error into its line; the fresh-process contract is below)."""
     out = tmp_path / "r.json"
-    proc = cli("solve", *args, "--json", str(out))
-    assert proc.returncode == 2
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and needle in lines[0], proc.stderr
-    assert "Traceback" not in proc.stderr + proc.stdout
-    assert not out.exists()
+    assert_refused(cli("solve", *args, "--json", str(out)), needle, out)
 
 
 def test_hertz_structured_mesh_from_the_cli(tmp_path) -> None:
@@ -136,9 +142,4 @@ def test_mesh_option_is_hertz_only(tmp_path) -> None:
 def test_bad_input_in_a_fresh_process_exits_2(tmp_path, args: list[str], needle: str) -> None:
     """`python -m contactfx` itself: exit status 2, one stderr line, no traceback, no JSON."""
     out = tmp_path / "r.json"
-    proc = run_cli("solve", *args, "--json", str(out))
-    assert proc.returncode == 2
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and needle in lines[0], proc.stderr
-    assert "Traceback" not in proc.stderr + proc.stdout
-    assert not out.exists()
+    assert_refused(run_cli("solve", *args, "--json", str(out)), needle, out)

@@ -18,7 +18,7 @@ from ..results.sizing import SizingRule
 from ..scenes import parse_scene_file
 from ..study.adapt import AdaptOptions, AdaptResult, adapt, level_record, uniform_levels
 from ..study.adapt_charts import plot_adapt
-from .params import build_from_args, is_scene_file, spec_from_args
+from .params import build_from_args, is_scene_file, reject_structured_adapt, spec_from_args
 
 
 def check_remeshable(args: argparse.Namespace) -> None:
@@ -30,11 +30,7 @@ def check_remeshable(args: argparse.Namespace) -> None:
                 f"scene {Path(args.scene).name}: its mesh {mesh.name} is a {mesh.suffix} "
                 "file: there is no geometry to remesh (give the mesh as a .geo)"
             )
-    elif args.mesh == "structured":
-        raise InputError(
-            "the structured Hertz mesh cannot be adapted: use --mesh gmsh (gmsh remeshes "
-            "the geometry from a size field)"
-        )
+    reject_structured_adapt(args)
 
 
 def adapt_json(args: argparse.Namespace, result: AdaptResult, opts: AdaptOptions) -> dict[str, Any]:

@@ -72,6 +72,15 @@ PARAM_HELP = {
 }
 
 
+def reject_structured_adapt(args: argparse.Namespace) -> None:
+    """InputError before anything runs: the structured Hertz mesh has no gmsh geometry."""
+    if not is_scene_file(args.scene) and getattr(args, "mesh", None) == "structured":
+        raise InputError(
+            "the structured Hertz mesh cannot be adapted: use --mesh gmsh (gmsh remeshes "
+            "the geometry from a size field)"
+        )
+
+
 def is_scene_file(scene: str) -> bool:
     """Whether the SCENE argument names a scene file rather than a built-in scene."""
     return scene.endswith(".toml")

@@ -14,7 +14,13 @@ from ..study import builtin_levels, run_study, scene_file_levels, size_factors, 
 from ..study.adaptive import adaptive_methods, adaptive_runs
 from ..study.levels import Level
 from ..study.report import adaptive_lines, level_lines, table_lines
-from .params import is_scene_file, reject_builtin_options, scene_params, spec_from_args
+from .params import (
+    is_scene_file,
+    reject_builtin_options,
+    reject_structured_adapt,
+    scene_params,
+    spec_from_args,
+)
 
 
 def parse_methods(text: str) -> list[str]:
@@ -50,10 +56,7 @@ def check_adaptive(args: argparse.Namespace, methods: list[str], comm: MPI.Comm)
         )
     if not adaptive_methods(methods):
         raise InputError("study --adaptive needs a method with an estimate (not only schwarz)")
-    if not is_scene_file(args.scene) and args.mesh == "structured":
-        raise InputError(
-            "study --adaptive: the structured Hertz mesh cannot be adapted: use --mesh gmsh"
-        )
+    reject_structured_adapt(args)
 
 
 def run_command(args: argparse.Namespace) -> int:

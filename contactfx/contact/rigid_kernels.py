@@ -28,7 +28,7 @@ from .geometry import Surface, nodal_normals, segment_lengths
 from .mortar import SLIVER, _check_basis, _dual_values
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
 from .rigid import Circle, Closest, Plane, Polyline, RigidShape
-from .sts import GAUSS_POINTS as STS_POINTS
+from .sts import gauss_points
 
 GAUSS_FLAT = 2
 GAUSS_ROUND = 6
@@ -171,13 +171,7 @@ def nts_operator(active: Surface, shape: RigidShape, ndofs: int) -> RigidOperato
 
 def sts_operator(active: Surface, shape: RigidShape, ndofs: int) -> RigidOperator:
     """STS: row j = sum_gp w N_j (g + n . (u_active - u_obstacle)), 4 points per segment."""
-    gx, gw = gauss_unit(STS_POINTS)
-    ma = active.n_segments
-    e = np.repeat(np.arange(ma), STS_POINTS)
-    xi = np.tile(gx, ma)
-    w = np.tile(gw, ma) * segment_lengths(active)[e]
-    na = linear_shape(xi)
-    nodes = active.segments[e]
+    w, na, nodes = gauss_points(active)
     near = shape.closest(_points(active, nodes, na))
     f = np.flatnonzero(near.found)
     return _assemble(

@@ -13,15 +13,18 @@ GAUSS_POINTS = 4
 TOL = 1e-8
 
 
-def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOperator:
-    """STS operator: row j = sum_gp w N_j n . (e_active(gp) - sum_A N_A(xi_gp) e_A)."""
+def gauss_points(active: Surface) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """STS's points on every active segment: weights w, shape values na, the segments' nodes."""
     gx, gw = gauss_unit(GAUSS_POINTS)
     ma = active.n_segments
     e = np.repeat(np.arange(ma), GAUSS_POINTS)
-    xi = np.tile(gx, ma)
     w = np.tile(gw, ma) * segment_lengths(active)[e]
-    na = linear_shape(xi)
-    nodes = active.segments[e]
+    return w, linear_shape(np.tile(gx, ma)), active.segments[e]
+
+
+def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOperator:
+    """STS operator: row j = sum_gp w N_j n . (e_active(gp) - sum_A N_A(xi_gp) e_A)."""
+    w, na, nodes = gauss_points(active)
     points = np.einsum("pk,pkd->pd", na, active.x[nodes])
     seg, eta, found = project(points, passive, TOL, group=GAUSS_POINTS)
     # No cutting at passive nodes: a segment straddling a passive node or kink is integrated

@@ -314,21 +314,20 @@ class Scene:
 
     def remeshed(self, factor: float) -> Scene:
         """The same scene with every mesh size times `factor` (InputError if it cannot be)."""
-        if self.recipe is None:
-            raise InputError(
-                f"scene '{self.name}' cannot be remeshed: only built-in scenes and .geo "
-                "meshes can (a .msh or an in-memory gmsh model has no geometry to remesh)"
-            )
-        return self.recipe.resized(factor).build(self.comm)
+        return self._recipe().resized(factor).build(self.comm)
 
     def remeshed_to(self, field: SizeField) -> Scene:
         """The same scene's geometry meshed by gmsh with the sizes of `field` (collective)."""
+        return self._recipe().adapted(field).build(self.comm)
+
+    def _recipe(self) -> Recipe:
+        """The scene's recipe; InputError if it has none (nothing to remesh)."""
         if self.recipe is None:
             raise InputError(
                 f"scene '{self.name}' cannot be remeshed: there is no geometry to remesh "
-                "(a .msh or an in-memory gmsh model; give the scene's mesh as a .geo)"
+                "(a .msh or an in-memory gmsh model; only built-in scenes and .geo meshes can)"
             )
-        return self.recipe.adapted(field).build(self.comm)
+        return self.recipe
 
     def body_of_curve(self, name: str) -> Body:
         """The body that the contact curve group `name` lies on."""
