@@ -91,8 +91,10 @@ def inverse_entries(
     for i, v in saved.items():
         lib.MatMumpsGetIcntl(F.handle, i, ctypes.byref(v))
     # Right-hand sides per block of the selected inverse: 64 (MUMPS' default -32 picks about
-    # 32). Probe step at 44k DOFs with 871 candidates: 0.97-0.99 s -> 0.81-0.87 s; 128 gave
-    # 0.85-0.91 s, 256 and 512 no gain (graded gmsh Hertz, `--refine 0.0025`).
+    # 32). First step (factorization + probes), mortar, default -32 against 64 alternating in
+    # one process, two repeats: gmsh default grading 86k DOFs / 1683 candidates 2.88-2.90 s
+    # -> 2.51-2.58 s; 28k/73, 44k/871, structured 319k/130 and 584k/1681: the same within
+    # the repeats' spread (about 10 %).
     lib.MatMumpsSetIcntl(F.handle, 27, INVERSE_BLOCK)
     err = lib.MatMumpsGetInverse(F.handle, sp.handle)
     for i, v in saved.items():  # back to ordinary solves
