@@ -94,7 +94,7 @@ def inverse_entries(
     # 32). First step (factorization + probes), mortar, default -32 against 64 alternating in
     # one process, two repeats: gmsh default grading 86k DOFs / 1683 candidates 2.88-2.90 s
     # -> 2.51-2.58 s; 28k/73, 44k/871, structured 319k/130 and 584k/1681: the same within
-    # the repeats' spread (about 10 %).
+    # the repeats' spread (about 10 %) (benchmarks/inverse_block.py).
     lib.MatMumpsSetIcntl(F.handle, 27, INVERSE_BLOCK)
     err = lib.MatMumpsGetInverse(F.handle, sp.handle)
     for i, v in saved.items():  # back to ordinary solves
