@@ -314,13 +314,13 @@ class Scene:
 
     def remeshed(self, factor: float) -> Scene:
         """The same scene with every mesh size times `factor` (InputError if it cannot be)."""
-        return self._recipe().resized(factor).build(self.comm)
+        return self.require_recipe().resized(factor).build(self.comm)
 
     def remeshed_to(self, field: SizeField) -> Scene:
         """The same scene's geometry meshed by gmsh with the sizes of `field` (collective)."""
-        return self._recipe().adapted(field).build(self.comm)
+        return self.require_recipe().adapted(field).build(self.comm)
 
-    def _recipe(self) -> Recipe:
+    def require_recipe(self) -> Recipe:
         """The scene's recipe; InputError if it has none (nothing to remesh)."""
         if self.recipe is None:
             raise InputError(

@@ -119,11 +119,7 @@ def adapt(
 ) -> AdaptResult:
     """Run the adaptive loop from `scene` (collective); `say` prints progress (rank 0)."""
     opts.check()
-    if scene.recipe is None:
-        raise InputError(
-            f"scene '{scene.name}' cannot be adapted: there is no geometry to remesh "
-            "(give the scene's mesh as a .geo)"
-        )
+    scene.require_recipe()
     comm = scene.comm
     say = say or (lambda line: print(line, flush=True) if comm.rank == 0 else None)
     levels: list[AdaptLevel] = []
