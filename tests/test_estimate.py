@@ -11,6 +11,7 @@ from conftest import cli
 
 import contactfx
 from contactfx.results.estimate import BULK_TERMS, CONTACT_TERMS, estimate
+from contactfx.results.facet_jumps import FacetTraction, jump_term
 from contactfx.results.true_error import energy_error
 from contactfx.scenes import BlockParams, HertzParams, blocks, hertz
 
@@ -59,6 +60,32 @@ def test_effectivity_against_overkill() -> None:
         ests.append(est.relative)
     assert all(1.0 < e < 10.0 for e in effs), effs
     assert max(effs) / min(effs) < 3.0, effs
+
+
+def test_hand_jumps_equal_the_ds_form() -> None:
+    """The process-boundary path, run here on every interior facet from both of its cells,
+    gives the dS form's jump term: same Gauss points, normals and pairing of the points."""
+    sol = contactfx.solve(_hertz(0.1), "mortar")
+    est = estimate(sol)
+    msh = sol.scene.mesh
+    msh.topology.create_connectivity(1, 2)
+    msh.topology.create_connectivity(2, 1)
+    f2c = msh.topology.connectivity(1, 2)
+    c2f = msh.topology.connectivity(2, 1).array.reshape(-1, 4)
+    facets = np.flatnonzero(np.diff(f2c.offsets) == 2)
+    cells = f2c.array.reshape(-1)[f2c.offsets[facets][:, None] + np.arange(2)]
+    traction = FacetTraction(sol)
+    sides = [traction(cells[:, k], np.argmax(c2f[cells[:, k]] == facets[:, None], axis=1))
+             for k in range(2)]  # fmt: skip
+    (t0, e0, len0), (t1, e1, len1) = sides
+    assert np.allclose(len0, len1, rtol=1e-14)
+    # The two cells' points are the same physical points: t0 + t1 is small where sigma
+    # is smooth; pairing point q with point nq - 1 - q instead changes the total.
+    per_facet = jump_term(t0 + t1, 0.5 * (e0 + e1), len0, traction.weights)
+    # Each facet's term goes to both of its cells.
+    assert np.isclose(2 * per_facet.sum(), est.terms["jump"] ** 2, rtol=1e-12, atol=0)
+    flipped = jump_term(t0 + t1[:, ::-1], 0.5 * (e0 + e1), len0, traction.weights)
+    assert not np.isclose(2 * flipped.sum(), est.terms["jump"] ** 2, rtol=1e-3)
 
 
 def test_true_error_of_itself_is_zero() -> None:
