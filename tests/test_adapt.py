@@ -93,12 +93,26 @@ def test_msh_refused(tmp_path: Path) -> None:
 
 
 @pytest.mark.mpi
-def test_two_ranks_refused(tmp_path: Path) -> None:
-    """mpirun -n 2: not supported yet (the jumps need a facet-ghosted mesh): one line, exit 2."""
-    proc = run_cli("adapt", *COARSE_HERTZ, "--out", str(tmp_path / "o"), ranks=2)
-    assert proc.returncode == 2, proc.stderr
-    assert "one rank only" in proc.stderr and "Traceback" not in proc.stderr
-    assert not (tmp_path / "o" / "adapt.json").exists()
+def test_two_ranks_print_once_and_match_serial(tmp_path: Path) -> None:
+    """mpirun -n 2: each progress line once (rank 0), one set of files, serial's levels.
+
+    tests/rank_cases.py (cli-adapt-hertz) compares a Hertz run number by number.
+    """
+    args = ("blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2")
+    serial = _adapt(tmp_path / "one", *args)
+    cmd = ("adapt", *args, "--out", str(tmp_path / "two"))
+    proc = run_cli(*cmd, ranks=2)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    for line in ("level 0:", "level 1:", "remeshed:", "stopped:", "wrote ", "2 ranks"):
+        assert proc.stdout.count(line) == 1, (line, proc.stdout)
+    two = json.loads((tmp_path / "two" / "adapt.json").read_text())
+    assert [lv["dofs"] for lv in two["levels"]] == [lv["dofs"] for lv in serial["levels"]]
+    for a, b in zip(serial["levels"], two["levels"], strict=True):
+        assert b["estimate"] == pytest.approx(a["estimate"], rel=1e-9)
+    assert sorted(p.name for p in (tmp_path / "two").glob("fields_p*.vtu")) == [
+        "fields_p0.vtu",
+        "fields_p1.vtu",
+    ]
 
 
 def test_weight_below_one_refused(tmp_path: Path) -> None:

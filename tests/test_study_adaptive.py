@@ -47,8 +47,15 @@ def test_structured_mesh_refused(tmp_path: Path) -> None:
 
 
 @pytest.mark.mpi
-def test_two_ranks_refused(tmp_path: Path) -> None:
+def test_two_ranks_match_serial(adaptive_study: tuple[dict, str, Path], tmp_path: Path) -> None:
+    """mpirun -n 2: the adaptive levels of the serial study (same DOFs, estimates, errors)."""
+    serial = adaptive_study[0]["adaptive"]["runs"]
     proc = run_cli(*HERTZ, "--adaptive", "--out", str(tmp_path / "o"), ranks=2)
-    assert proc.returncode == 2, proc.stderr
-    assert "one rank only" in proc.stderr and "Traceback" not in proc.stderr
-    assert not (tmp_path / "o").exists()
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert proc.stdout.count("adaptive levels") == 1
+    runs = json.loads((tmp_path / "o" / "study.json").read_text())["adaptive"]["runs"]
+    assert [r["dofs"] for r in runs] == [r["dofs"] for r in serial]
+    for a, b in zip(serial, runs, strict=True):
+        assert b["estimate"] == pytest.approx(a["estimate"], rel=1e-9)
+        for name in ("l2", "a", "p0"):
+            assert b["errors"][name] == pytest.approx(a["errors"][name], rel=1e-8)

@@ -49,11 +49,6 @@ def levels_from_args(args: argparse.Namespace, comm: MPI.Comm) -> list[Level]:
 
 def check_adaptive(args: argparse.Namespace, methods: list[str], comm: MPI.Comm) -> None:
     """InputError before anything runs if --adaptive cannot be done."""
-    if comm.size > 1:
-        raise InputError(
-            "study --adaptive runs on one rank only for now (the error estimate needs a "
-            "mesh ghosted across shared facets): run it without mpirun"
-        )
     if not adaptive_methods(methods):
         raise InputError("study --adaptive needs a method with an estimate (not only schwarz)")
     reject_structured_adapt(args)

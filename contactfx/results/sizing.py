@@ -45,17 +45,39 @@ class Plan:
     predicted: float  # predicted relative estimate on it
 
 
-def _local_cells(sol: Solution, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(vertices (n, 4, 2) in gmsh order, local vertex ids (n, 4), eta) of the local cells."""
+def _owned_cells(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices (n, 4, 2) in gmsh order, global vertex ids (n, 4)) of the owned cells."""
     msh = sol.scene.mesh
     tdim = msh.topology.dim
-    n = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
+    n = msh.topology.index_map(tdim).size_local
     msh.topology.create_connectivity(tdim, 0)
     c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)[:n]
     geo = msh.geometry.dofmaps[0][:n]
     # DOLFINx orders a quad's vertices (0,0),(1,0),(0,1),(1,1); gmsh goes round the cell.
     order = [0, 1, 3, 2]
-    return msh.geometry.x[geo][:, order, :2], c2v[:, order], eta[:n]
+    gv = msh.topology.index_map(0).local_to_global(c2v[:, order].ravel().astype(np.int32))
+    return msh.geometry.x[geo][:, order, :2], gv.reshape(-1, 4)
+
+
+def _vertex_sizes(comm: MPI.Comm, quads: np.ndarray, verts: np.ndarray, h: np.ndarray) -> SizeField:
+    """The size field on rank 0: at each vertex the smallest new size of the cells around it.
+
+    Gathered first, so that a vertex on a process boundary sees the cells of both ranks;
+    the cells sorted by midpoint, so that the field does not depend on the partition.
+    """
+    parts = comm.gather((quads, verts, h), root=0)
+    if parts is None:
+        return SizeField(np.zeros((0, 4, 2)), np.zeros((0, 4)))
+    quads = np.concatenate([p[0] for p in parts])
+    verts = np.concatenate([p[1] for p in parts])
+    h = np.concatenate([p[2] for p in parts])
+    mid = quads.mean(axis=1)
+    order = np.lexsort((mid[:, 1], mid[:, 0]))
+    quads, verts, h = quads[order], verts[order], h[order]
+    ids, inverse = np.unique(verts, return_inverse=True)
+    node = np.full(len(ids), np.inf)
+    np.minimum.at(node, inverse.ravel(), np.repeat(h, 4))
+    return SizeField(quads, node[inverse.reshape(verts.shape)])
 
 
 def _budget_target(
@@ -89,41 +111,25 @@ def plan_mesh(
 ) -> Plan:
     """The size field of the next level (collective; the field's arrays on rank 0)."""
     comm = sol.scene.comm
-    Q = est.eta.function_space
     msh = sol.scene.mesh
-    ntot = msh.topology.index_map(2).size_local + msh.topology.index_map(2).num_ghosts
-    eta_cell = est.eta.x.array[Q.dofmap.list[:ntot, 0]]
-    quads, verts, eta_true = _local_cells(sol, eta_cell)
+    Q = est.eta.function_space
     nloc = msh.topology.index_map(2).size_local
-    # One rank (the estimate refuses more): the owned cells are all the cells.
-    eta = eta_true.copy()
-    eta[:nloc] = est.marking(rule.contact_weight)
+    eta_true = est.eta.x.array[Q.dofmap.list[:nloc, 0]]
+    quads, verts = _owned_cells(sol)
+    eta = est.marking(rule.contact_weight)
     d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
     h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
     q = rule.rate + 1.0
     eta = np.maximum(eta, 1e-300)
-    S = comm.allreduce(float(np.sum(eta[:nloc] ** (2 / q))))
+    S = comm.allreduce(float(np.sum(eta ** (2 / q))))
     ncells = msh.topology.index_map(2).size_global
     budget = min(rule.growth * ncells, max_cells)
     target = tol * est.energy
     eta_tol = (target**2 / S) ** (1 / (2 - 2 / q))
-    eta_t = max(_budget_target(comm, eta[:nloc], budget, q, rule), eta_tol)
+    eta_t = max(_budget_target(comm, eta, budget, q, rule), eta_tol)
     factor = np.clip((eta_t / eta) ** (1 / q), rule.finest, rule.coarsest)
-    new_h = h * factor
-    cells = comm.allreduce(float(np.sum(factor[:nloc] ** -2.0)))
+    cells = comm.allreduce(float(np.sum(factor**-2.0)))
     eta_true = np.maximum(eta_true, 1e-300)
-    predicted = float(
-        np.sqrt(comm.allreduce(float(np.sum((eta_true[:nloc] * factor[:nloc] ** (q - 1)) ** 2))))
-    )
-    # Sizes at the vertices: the smallest of the cells around each (continuous, safe).
-    node = np.full(verts.max() + 1, np.inf)
-    np.minimum.at(node, verts.ravel(), np.repeat(new_h, 4))
-    sizes = node[verts]
-    parts = comm.gather((quads[:nloc], sizes[:nloc]), root=0)
-    if parts is None:
-        field = SizeField(np.zeros((0, 4, 2)), np.zeros((0, 4)))
-    else:
-        field = SizeField(
-            np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
-        )
+    predicted = float(np.sqrt(comm.allreduce(float(np.sum((eta_true * factor ** (q - 1)) ** 2)))))
+    field = _vertex_sizes(comm, quads, verts, h * factor)
     return Plan(field, cells, predicted / est.energy)
