@@ -17,7 +17,8 @@ traction-free); sigma_nn, sigma_nt are each body's own traction on the contact f
 passive normal nu the multipliers act along, as results/interface.py resolves it), p_h the
 piecewise-linear interpolant of the multipliers on the active surface and, on the passive
 surface, at the projection of each passive node. docs/adapt.md has the references and the
-measured effectivity.
+measured effectivity. The jumps across process boundaries, which DOLFINx's dS does not
+reach on the scenes' unghosted meshes, come from results/facet_jumps.py.
 """
 
 from __future__ import annotations
