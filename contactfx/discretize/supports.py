@@ -134,6 +134,17 @@ def _free_modes(rows: np.ndarray, ncols: int) -> np.ndarray:
     return v[:, w <= 1e-10 * max(float(w.max()), 1e-300)].T
 
 
+def _free_motions(part: np.ndarray) -> str:
+    """The rigid motions of one body that its part (k, 3) of the free modes spans."""
+    _, sv, vt = np.linalg.svd(part, full_matrices=False)
+    span = vt[sv > 1e-6 * max(float(sv.max(initial=0.0)), 1e-300)]
+    axes = ("translation along x", "translation along y", "rotation")
+    names = [
+        name for name, e in zip(axes, np.eye(3), strict=True) if np.linalg.norm(span @ e) > 0.999
+    ]
+    return ", ".join(names) if names else _describe(span[0])
+
+
 def _describe(mode: np.ndarray) -> str:
     if abs(mode[2]) >= np.hypot(mode[0], mode[1]):
         return "rotation"
@@ -234,12 +245,12 @@ def check_held(
         rows.append(hold.contact_rows(surf.x, nodal_normals(surf), a, q))
     free = hold.free_modes(np.vstack(rows))
     if free.shape[0]:
-        mode = free[0]
-        nb = len(scene.bodies)
-        k = int(np.argmax([np.linalg.norm(mode[3 * i : 3 * i + 3]) for i in range(nb)]))
+        # The free space, not one basis vector of it: eigh's basis of a degenerate null
+        # space is arbitrary (it changed with the LAPACK build), and so was the body named.
+        k = hold.loose(free)[0]
         raise SingularSystemError(
             f"body '{scene.bodies[k].name}' can still move freely after its supports and "
-            f"contacts ({_describe(mode[3 * k : 3 * k + 3])}): add a [[dirichlet]] support or a "
-            "contact pair that holds it"
+            f"contacts ({_free_motions(free[:, 3 * k : 3 * k + 3])}): add a [[dirichlet]] "
+            "support or a contact pair that holds it"
         )
     return hold.needs_contact()
