@@ -179,9 +179,13 @@ _MUMPS_LU: dict[str, object] = {
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
-    # PORD ordering: MUMPS' sequential METIS analysis cost half of a 1M-DOF solve
-    # (benchmarks/README.md).
-    "mat_mumps_icntl_7": 4,
+    # The ordering (ICNTL(7)) is chosen by size where the solver is made
+    # (methods/solvers.py, with_ordering) unless an option names one.
+    # CNTL(1) = 0.1, MUMPS' relative pivot threshold (default 0.01): with AMD the looser one
+    # left the LDL^T of the Hertz saddle point (6,856 DOFs) 2.0e-11 from the LU solution,
+    # against 3.5e-13 (PORD 1.1e-13), at the same cost for LDL^T and LU (44k DOFs: 0.16 and
+    # 0.19-0.20 s either way; docs/scale.md, "The ordering rule").
+    "mat_mumps_cntl_1": 0.1,
 }
 # The saddle point is symmetric (indefinite): MUMPS' LDL^T (SYM=2, PETSc's Cholesky on a
 # matrix not flagged SPD) takes about 0.75-0.8 of LU's time (docs/scale.md, "Symmetric").
@@ -266,7 +270,6 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "ksp_max_it": 500,
                 "pc_type": "cholesky",
                 "pc_factor_mat_solver_type": "mumps",
-                "mat_mumps_icntl_7": 4,
             },
             rtol=1e-9,
             loose_rtol=1e-4,

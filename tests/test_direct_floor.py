@@ -74,3 +74,48 @@ def test_reference_timing_reports_both_factorizations(tmp_path: Path) -> None:
     times = json.loads(out.read_text())["times"]
     for key in ("reference_solve", "reference_lu", "reference_ldlt"):
         assert times[key] > 0.0
+
+
+def test_ordering_rule() -> None:
+    """AMD below PORD_FROM_DOFS, PORD from there; an option naming one wins; MUMPS only."""
+    from contactfx.methods.solvers import AMD, ORDERING_KEY, PORD, PORD_FROM_DOFS, with_ordering
+
+    mumps = SOLVERS["mumps"].petsc
+    assert with_ordering(mumps, PORD_FROM_DOFS - 1)[ORDERING_KEY] == AMD
+    assert with_ordering(mumps, PORD_FROM_DOFS)[ORDERING_KEY] == PORD
+    assert with_ordering({**mumps, ORDERING_KEY: 5}, 10)[ORDERING_KEY] == 5
+    assert ORDERING_KEY not in with_ordering(SOLVERS["condensed"].petsc, 10)
+
+
+@pytest.mark.parametrize("name", ["mumps", "mumps-lu"])
+def test_ordering_reaches_mumps(cylinders, name) -> None:
+    """The factorization MUMPS ran used the rule's ordering (ICNTL(7)) on this 8k-DOF scene."""
+    from contactfx.discretize.setup import prepare_contact
+    from contactfx.methods.active_set import ActiveSetOptions
+    from contactfx.methods.solvers import AMD, PORD_FROM_DOFS, make_solver
+    from contactfx.options import Method
+    from contactfx.timers import Timers
+
+    setup = prepare_contact(
+        cylinders, Method.MORTAR.kernel, ActiveSetOptions().penetration_tol, Timers()
+    )
+    el = setup.elasticity
+    solver = make_solver(
+        SOLVERS[name],
+        el.K,
+        setup.B,
+        el.f,
+        e_max=setup.e_max,
+        h=setup.h,
+        modes=lambda: [],
+        node_dofs=setup.node_dofs(),
+    )
+    try:
+        # Every row in contact, as the loop's first step: a nonsingular saddle point.
+        solver.solve(setup.g, np.ones(len(setup.layout.mine), dtype=bool), fresh=True)
+        factor = solver._ksp.getPC().getFactorMatrix()  # type: ignore[attr-defined]
+        assert el.K.getSize()[0] < PORD_FROM_DOFS
+        assert factor.getMumpsIcntl(7) == AMD
+    finally:
+        solver.destroy()
+        setup.destroy()

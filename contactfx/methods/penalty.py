@@ -28,6 +28,7 @@ from ..scenes import Scene
 from ..timers import Timers
 from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
 from .solution import PenaltyResult, Solution, finish
+from .solvers import with_ordering
 
 DEFAULT_FACTOR = 1e3
 """Default eps = DEFAULT_FACTOR * max E / h, h the median active-surface element size."""
@@ -78,7 +79,7 @@ def _solve(
     ksp.setOperators(A)
     info: dict[str, float] = {}
     try:
-        with petsc_options(options) as prefix:
+        with petsc_options(with_ordering(options, K.getSize()[0])) as prefix:
             ksp.setOptionsPrefix(prefix)
             ksp.setFromOptions()
             if condition:

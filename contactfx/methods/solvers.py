@@ -17,8 +17,8 @@ from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
 from ..options import SolverKind, SolverSpec
 
-# MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the preset's PORD
-# ordering on the host. Parallel analysis with PT-Scotch (ICNTL(28) = 2, ICNTL(29) = 1) orders
+# MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the ordering below on
+# the host. Parallel analysis with PT-Scotch (ICNTL(28) = 2, ICNTL(29) = 1) orders
 # worse here: 2 ranks, 1.2M DOFs (structured Hertz, h_far 10h), warm LDL^T 21.9 s against
 # 14.6 s sequential (serial: 20.9 s), and at 2M 53.8 s against a serial 37.5 s.
 SEQUENTIAL_ANALYSIS: dict[str, object] = {"mat_mumps_icntl_28": 1}
@@ -29,6 +29,34 @@ def with_sequential_analysis(petsc: Mapping[str, object], ranks: int) -> Mapping
     if ranks == 1 or any(k in petsc for k in SEQUENTIAL_ANALYSIS):
         return petsc
     return {**petsc, **SEQUENTIAL_ANALYSIS}
+
+
+# MUMPS' fill-reducing ordering (ICNTL(7)) by the number of DOFs. benchmarks/orderings.py on
+# the final Hertz saddle point (mortar, fresh LDL^T, medians of 3, both meshers' 10H family):
+# AMD 0.054 / 0.334 / 1.970 s against PORD 0.093 / 0.442 / 2.132 s (gmsh 28k / 102k / 396k),
+# 0.057 / 0.296 / 1.778 s against 0.097 / 0.354 / 1.587 s (structured 29k / 89k / 319k);
+# at 1.2M (structured, one run each) AMD takes 26.1 s, PORD 9.8 s. METIS and SCOTCH lose
+# everywhere (their analysis is slower), QAMD ties with AMD.
+AMD, PORD = 0, 4
+PORD_FROM_DOFS = 300_000
+ORDERING_KEY = "mat_mumps_icntl_7"
+
+
+def with_ordering(petsc: Mapping[str, object], ndofs: int) -> Mapping[str, object]:
+    """A MUMPS factorization's options with the ordering for `ndofs` DOFs.
+
+    AMD below PORD_FROM_DOFS, then PORD, unless the options name one; others unchanged.
+    """
+    if ORDERING_KEY in petsc or petsc.get("pc_factor_mat_solver_type") != "mumps":
+        return petsc
+    return {**petsc, ORDERING_KEY: AMD if ndofs < PORD_FROM_DOFS else PORD}
+
+
+def direct_options(petsc: Mapping[str, object], K: PETSc.Mat) -> Mapping[str, object]:
+    """A direct saddle-point solver's options: its ordering and, on several ranks, analysis."""
+    return with_sequential_analysis(
+        with_ordering(petsc, K.getSize()[0]), K.getComm().tompi4py().size
+    )
 
 
 def augmentation(spec: SolverSpec, e_max: float, h: float) -> float:
@@ -60,7 +88,7 @@ def make_solver(
             K,
             B,
             f,
-            spec.petsc,
+            with_ordering(spec.petsc, K.getSize()[0]),
             node_dofs,
             [] if factorized else modes(),
             rtol=spec.rtol,
@@ -81,7 +109,7 @@ def make_solver(
         K,
         B,
         f,
-        with_sequential_analysis(spec.petsc, K.getComm().tompi4py().size) if direct else spec.petsc,
+        direct_options(spec.petsc, K) if direct else spec.petsc,
         direct=direct,
         gamma=augmentation(spec, e_max, h),
         nullspace=nullspace,
