@@ -185,3 +185,14 @@ def test_basis_and_solver_errors() -> None:
         solve(scene, "schwarz", solver="fieldsplit")
     with pytest.raises(InputError, match="unknown solver"):
         solve(scene, "mortar", solver="cholmod")
+
+
+def test_condensed_predictor_is_solved_directly(small_hertz) -> None:
+    """The condensed kinds' coarse solve runs on the direct default (one probed factorization)."""
+    from contactfx.methods.predictor import DIRECT_PREDICTOR_DOFS, predictor_solver, scene_dofs
+    from contactfx.options import SOLVERS
+
+    assert scene_dofs(small_hertz) <= DIRECT_PREDICTOR_DOFS
+    for name in ("condensed", "condensed-direct"):
+        assert predictor_solver(SOLVERS[name], small_hertz) is SOLVERS["mumps"]
+    assert predictor_solver(SOLVERS["fieldsplit"], small_hertz) is SOLVERS["fieldsplit"]
