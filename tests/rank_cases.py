@@ -392,9 +392,9 @@ def adapt_hertz() -> tuple[Solution, Arrays]:
     }
 
 
-# Level 1's mesh comes from the gathered size field, equal to serial's up to round-off:
-# gmsh gives the same mesh, its nodes moved at round-off (gmsh takes discrete decisions
-# that a perturbation can flip: seen at level 2 of `adapt blocks`, not here).
+# Level 1's mesh comes from the gathered size field, rounded to results/sizing.py's
+# SIZE_DIGITS so that round-off between rank counts does not reach gmsh's discrete decisions:
+# the same mesh, its nodes at round-off of serial's.
 CASES["cli-adapt-hertz"] = Case(
     adapt_hertz,
     {

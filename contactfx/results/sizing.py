@@ -77,7 +77,20 @@ def _vertex_sizes(comm: MPI.Comm, quads: np.ndarray, verts: np.ndarray, h: np.nd
     ids, inverse = np.unique(verts, return_inverse=True)
     node = np.full(len(ids), np.inf)
     np.minimum.at(node, inverse.ravel(), np.repeat(h, 4))
-    return SizeField(quads, node[inverse.reshape(verts.shape)])
+    return SizeField(quads, significant(node[inverse.reshape(verts.shape)], SIZE_DIGITS))
+
+
+# Sizes handed to gmsh keep this many significant digits. gmsh's discrete decisions flip on
+# round-off (a size perturbed by 1e-13 moved a node in one of three trials), and the sizes
+# of 1 and 2 ranks differ at round-off: rounded, they are equal unless a value sits within
+# round-off of a rounding boundary (about 1e-9 of the values at this precision).
+SIZE_DIGITS = 6
+
+
+def significant(a: np.ndarray, digits: int) -> np.ndarray:
+    """Positive `a` rounded to `digits` significant digits."""
+    scale = 10.0 ** np.floor(np.log10(np.maximum(a, 1e-300)))
+    return np.round(a / scale, digits - 1) * scale
 
 
 def _budget_target(
