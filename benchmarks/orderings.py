@@ -5,7 +5,7 @@ meshes each case once, then for each ordering in turn solves it with mortar and 
 solver (MUMPS LDL^T) with `--reference-timing`: a fresh LDL^T and a fresh LU of the final
 system with that ordering, after the contact solve in the same process (warm). The orderings
 take turns (R rounds), so none is always the first. Prints one line per solve and a median
-table; the comment at `contactfx.options._MUMPS_LU` cites it.
+table; the comment at `contactfx.methods.solvers.PORD_FROM_DOFS` and docs/scale.md cite it.
 """
 
 from __future__ import annotations
