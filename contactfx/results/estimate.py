@@ -118,7 +118,7 @@ class _ContactFields:
         msh = sol.scene.mesh
         self.S = fem.functionspace(msh, ("Lagrange", 1))
         self.p = fem.Function(self.S)
-        self.comp = fem.Function(self.S)  # p g^+ at the active nodes
+        self.g = fem.Function(self.S)  # the multiplier rows' gaps at the active nodes
         self.pen = fem.Function(self.S)  # (g^-)^2 at the active nodes
         self.N = [fem.Function(self.S), fem.Function(self.S)]
         for k in range(len(sol.pairs)):
@@ -141,7 +141,7 @@ class _ContactFields:
         for c in range(2):
             self._set(self.N[c], dofs, normal[:, c])
         rows = dofs[pv.nodes]
-        self._set(self.comp, rows, sol.pressure[pv.rows] * np.maximum(gap, 0.0))
+        self._set(self.g, rows, gap)
         self._set(self.pen, rows, np.minimum(gap, 0.0) ** 2)
         if pv.passive is None:
             return
@@ -259,7 +259,10 @@ def estimate(sol: Solution) -> Estimate:
     tt = tn - tnn * N
     forms["normal"] = he * (tnn + cf.p) ** 2 / E * w * dsc
     forms["tangential"] = he * ufl.dot(tt, tt) / E * w * dsc
-    forms["complementarity"] = cf.comp * w * dsc
+    # The interpolants' product, not the nodal one: p_h g_h^+ vanishes at every node of a
+    # converged set but not in the cell across the zone's edge, where p_h falls from its
+    # last active node and g_h rises to its first inactive one.
+    forms["complementarity"] = cf.p * ufl.max_value(cf.g, 0.0) * w * dsc
     forms["gap"] = E * cf.pen / he * w * dsc
     nloc = msh.topology.index_map(msh.topology.dim).size_local
     cell_dof = Q.dofmap.list[:nloc, 0]
