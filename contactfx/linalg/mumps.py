@@ -122,12 +122,18 @@ def _unpack(
     The half of the pairs within `cols` that was not asked for is filled by symmetry.
     """
     out = np.full((len(cols), len(rows)), np.nan)
-    lo = 0
-    for k, a in enumerate(asked):
-        out[k, np.searchsorted(rows, a)] = values[lo : lo + len(a)]
-        lo += len(a)
+    if asked:
+        flat = np.concatenate(asked)
+        ks = np.repeat(np.arange(len(asked)), [len(a) for a in asked])
+        out[ks, np.searchsorted(rows, flat)] = values[: len(flat)]
     missing = np.isnan(out)
-    if missing.any():
+    idx = np.searchsorted(rows, cols)
+    if missing.any() and np.array_equal(rows[np.minimum(idx, len(rows) - 1)], cols):
+        # Every column is a row too: the unasked half is the transpose of the asked one in
+        # the (cols x cols) block, entry (cols[j], cols[k]) = (cols[k], cols[j]).
+        block = out[:, idx]
+        out[:, idx] = np.where(np.isnan(block), block.T, block)
+    elif missing.any():
         ks, ii = np.nonzero(missing)
         # Entry (rows[i], cols[k]) = entry (cols[k], rows[i]) = column rows[i], row cols[k].
         out[ks, ii] = out[np.searchsorted(cols, rows[ii]), np.searchsorted(rows, cols[ks])]
