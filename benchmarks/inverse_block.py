@@ -1,9 +1,9 @@
 """A/B of the selected inverse's block size (MUMPS ICNTL(27)) on the probe step.
 
 `python benchmarks/inverse_block.py CASE [BLOCK ...]` solves the Hertz case CASE with mortar,
-the blocks alternating in one process (default: MUMPS' -32 and contactfx's 64), twice, and
+the blocks alternating in one process (default: contactfx's two, 64 and 256), twice, and
 prints the first active-set step (factorization + probes) per block. The comment at
-`contactfx.linalg.mumps.INVERSE_BLOCK` quotes its numbers.
+`contactfx.linalg.mumps.LARGE_BLOCK` quotes its numbers.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ CASES = {
 def main() -> None:
     """Run one case with each block size in turn, twice."""
     name = sys.argv[1]
-    blocks = [int(b) for b in sys.argv[2:]] or [-32, 64]
+    blocks = [int(b) for b in sys.argv[2:]] or [64, 256]
     for _ in range(2):
         for block in blocks:
             mumps.INVERSE_BLOCK = block

@@ -47,8 +47,25 @@ def _pattern(rows: np.ndarray, cols: np.ndarray, symmetric: bool) -> list[np.nda
     return [rows[~in_cols | (rows >= c)] for c in cols]
 
 
-INVERSE_BLOCK = 64
-"""MUMPS ICNTL(27) while computing selected-inverse entries (restored afterwards)."""
+INVERSE_BLOCK: int | None = None
+"""MUMPS ICNTL(27) while computing selected-inverse entries (restored afterwards); None:
+`inverse_block`'s rule (benchmarks/inverse_block.py sets it for its A/B)."""
+
+# Right-hand sides per block of the selected inverse, by the system's size. First step
+# (factorization + probes), mortar, alternating in one process: MUMPS' default -32 against
+# 64 on the 86k default-graded gmsh mesh (1,683 candidates) 2.88-2.90 -> 2.51-2.58 s; 64
+# against 256: 45k 0.464-0.472 vs 0.490-0.505 s, 86k 1.62-1.67 vs 1.63-1.66 s, structured
+# default 280k 1.93-2.00 vs 1.87-1.99 s, 584k 4.33-4.49 vs 4.00-4.25 s, 1.23M 12.27-12.55
+# vs 11.48-11.72 s, and on 2 ranks 2.41M (6,075 rows) 41.8-42.1 vs 36.7 s (512-2048:
+# 36.9-38.0 s). So 64 below the size where the ordering turns to PORD, 256 from it.
+SMALL_BLOCK, LARGE_BLOCK, LARGE_FROM = 64, 256, 300_000
+
+
+def inverse_block(n: int) -> int:
+    """ICNTL(27) for the selected inverse of an n x n system (INVERSE_BLOCK if set)."""
+    if INVERSE_BLOCK is not None:
+        return INVERSE_BLOCK
+    return LARGE_BLOCK if n >= LARGE_FROM else SMALL_BLOCK
 
 
 def inverse_entries(
@@ -90,12 +107,7 @@ def inverse_entries(
     saved = {i: ctypes.c_int() for i in (20, 21, 27, 30)}
     for i, v in saved.items():
         lib.MatMumpsGetIcntl(F.handle, i, ctypes.byref(v))
-    # Right-hand sides per block of the selected inverse: 64 (MUMPS' default -32 picks about
-    # 32). First step (factorization + probes), mortar, default -32 against 64 alternating in
-    # one process, two repeats: gmsh default grading 86k DOFs / 1683 candidates 2.88-2.90 s
-    # -> 2.51-2.58 s; 28k/73, 44k/871, structured 319k/130 and 584k/1681: the same within
-    # the repeats' spread (about 10 %) (benchmarks/inverse_block.py).
-    lib.MatMumpsSetIcntl(F.handle, 27, INVERSE_BLOCK)
+    lib.MatMumpsSetIcntl(F.handle, 27, inverse_block(n))
     err = lib.MatMumpsGetInverse(F.handle, sp.handle)
     for i, v in saved.items():  # back to ordinary solves
         lib.MatMumpsSetIcntl(F.handle, i, v.value)
