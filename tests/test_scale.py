@@ -331,3 +331,19 @@ def test_run_case_coarse_predictor() -> None:
     assert not use_coarse(Predictor.AUTO, sol.scene, SOLVERS["fieldsplit"])
     with pytest.raises(InputError):
         Predictor.parse("sometimes")
+
+
+def test_auto_predictor_by_candidate_rows() -> None:
+    """auto, direct: every row probed up to PROBE_ALL_ROWS rows, the coarse solve above."""
+    from contactfx.api import run_scene
+    from contactfx.methods.predictor import PROBE_ALL_ROWS, contact_facets, use_coarse
+
+    few = hertz(HertzParams(refine=0.05))
+    many = hertz(HertzParams(refine=0.0025))  # the default grading: 871 rows
+    assert contact_facets(few) <= PROBE_ALL_ROWS < contact_facets(many)
+    assert not use_coarse(Predictor.AUTO, few, SOLVERS["mumps"])
+    assert use_coarse(Predictor.AUTO, many, SOLVERS["mumps"])
+    sol, data = run_scene(many, "mortar")
+    assert abs(contact_facets(many) - data["multipliers"]) <= 1  # facets + 1 nodes per curve
+    assert "predictor" in data["times"]
+    assert max(h["probes"] for h in sol.history) < 0.1 * data["multipliers"]  # a band only

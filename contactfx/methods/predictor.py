@@ -39,16 +39,42 @@ def scene_dofs(scene: Scene) -> int:
     return 2 * scene.mesh.topology.index_map(0).size_global
 
 
+# A direct solver's probes are selected entries of the inverse, whose cost grows with the
+# candidates: up to this many rows the loop starts from every row and probes them all, above
+# it from the coarse solve, probing only its uncertain band (about 20 rows). Contact solve,
+# mortar, serial, auto (all rows) against coarse, two runs each: 10H family, 45-187 rows,
+# the coarse solve costs 0.02-0.17 s more than it saves (gmsh 20k 0.055-0.066 vs 0.13 s,
+# 303k 1.92-1.94 vs 2.04-2.07 s; structured 319k 1.85-1.93 vs 1.91-1.92 s); default
+# grading: gmsh 44k / 871 rows 0.41-0.45 vs 0.35-0.36 s, 84k / 1,683 1.37-1.48 vs 0.65-0.67 s;
+# structured 280k / 869 1.92-2.00 vs 1.64-1.65 s, 584k / 1,681 3.99-4.07 vs 3.56-3.74 s,
+# 1.23M / 3,298 11.6-12.0 vs 8.6-8.8 s; on 2 ranks 2.41M / 6,075 37.8 vs 15.2 s.
+PROBE_ALL_ROWS = 500
+
+
+def contact_facets(scene: Scene) -> int:
+    """Facets on the pairs' active surfaces: about the multiplier rows (collective)."""
+    tags = scene.facet_tags
+    count = 0
+    if tags is not None:
+        owned = scene.mesh.topology.index_map(scene.mesh.topology.dim - 1).size_local
+        groups = [p.active for p in scene.contacts] + [o.surface for o in scene.obstacles]
+        for group in groups:
+            dim, tag = scene.groups.by_name.get(group, (-1, -1))
+            if dim == scene.mesh.topology.dim - 1:
+                count += int(np.count_nonzero(tags.find(tag) < owned))
+    return int(scene.comm.allreduce(count))
+
+
 def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
     """Whether `predictor` asks for a coarse solve of `scene` with this solver.
 
-    auto: never for serial direct solves (their probes are selected entries of the inverse,
-    so the loop starts from every row), always for the condensed solver (no probes at all),
-    above COARSE_PREDICTOR_DOFS otherwise.
+    auto: for direct solves when the active surfaces hold more than PROBE_ALL_ROWS rows and
+    the scene can be remeshed (else every row is probed), always for the condensed solver
+    (no probes at all), above COARSE_PREDICTOR_DOFS otherwise.
     """
     if predictor is Predictor.AUTO:
         if spec.kind is SolverKind.DIRECT:
-            return False
+            return scene.can_remesh and contact_facets(scene) > PROBE_ALL_ROWS
         if spec.kind.condensed:
             return True
         return scene_dofs(scene) >= COARSE_PREDICTOR_DOFS
