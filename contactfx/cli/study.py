@@ -47,7 +47,7 @@ def levels_from_args(args: argparse.Namespace, comm: MPI.Comm) -> list[Level]:
     return builtin_levels(args.scene, scene_params(args), factors, args.active or 2, comm)
 
 
-def check_adaptive(args: argparse.Namespace, methods: list[str], comm: MPI.Comm) -> None:
+def check_adaptive(args: argparse.Namespace, methods: list[str]) -> None:
     """InputError before anything runs if --adaptive cannot be done."""
     if not adaptive_methods(methods):
         raise InputError("study --adaptive needs a method with an estimate (not only schwarz)")
@@ -68,7 +68,7 @@ def run_command(args: argparse.Namespace) -> int:
             "do not apply to it"
         )
     if args.adaptive:
-        check_adaptive(args, methods, comm)
+        check_adaptive(args, methods)
     levels = levels_from_args(args, comm)
     say = print if comm.rank == 0 else (lambda *a, **k: None)
     say(

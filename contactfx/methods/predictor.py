@@ -12,6 +12,7 @@ import logging
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..discretize.mesh_utils import owned_facets
 from ..errors import InputError
 from ..logs import stage
 from ..options import SOLVERS, Basis, Method, Predictor, SolverKind, SolverSpec
@@ -53,16 +54,8 @@ PROBE_ALL_ROWS = 500
 
 def contact_facets(scene: Scene) -> int:
     """Facets on the pairs' active surfaces: about the multiplier rows (collective)."""
-    tags = scene.facet_tags
-    count = 0
-    if tags is not None:
-        owned = scene.mesh.topology.index_map(scene.mesh.topology.dim - 1).size_local
-        groups = [p.active for p in scene.contacts] + [o.surface for o in scene.obstacles]
-        for group in groups:
-            dim, tag = scene.groups.by_name.get(group, (-1, -1))
-            if dim == scene.mesh.topology.dim - 1:
-                count += int(np.count_nonzero(tags.find(tag) < owned))
-    return int(scene.comm.allreduce(count))
+    groups = [p.active for p in scene.contacts] + [o.surface for o in scene.obstacles]
+    return int(scene.comm.allreduce(sum(len(owned_facets(scene, g)) for g in groups)))
 
 
 def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
