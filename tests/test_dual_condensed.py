@@ -187,12 +187,15 @@ def test_basis_and_solver_errors() -> None:
         solve(scene, "mortar", solver="cholmod")
 
 
-def test_condensed_predictor_is_solved_directly(small_hertz) -> None:
-    """The condensed kinds' coarse solve runs on the direct default (one probed factorization)."""
-    from contactfx.methods.predictor import DIRECT_PREDICTOR_DOFS, predictor_solver, scene_dofs
-    from contactfx.options import SOLVERS
+def test_condensed_predictor_is_solved_directly(small_hertz, caplog) -> None:
+    """The condensed solver's coarse solve is a direct, probed one; the fine loop is CG."""
+    import logging
 
-    assert scene_dofs(small_hertz) <= DIRECT_PREDICTOR_DOFS
-    for name in ("condensed", "condensed-direct"):
-        assert predictor_solver(SOLVERS[name], small_hertz) is SOLVERS["mumps"]
-    assert predictor_solver(SOLVERS["fieldsplit"], small_hertz) is SOLVERS["fieldsplit"]
+    from contactfx import solve
+
+    with caplog.at_level(logging.INFO, logger="contactfx"):
+        sol = solve(small_hertz, "nts", solver="condensed")
+    coarse = [r.getMessage() for r in caplog.records if r.getMessage().startswith("predictor")]
+    assert coarse and "probes" in coarse[0]  # only a direct solver probes
+    assert all(h["probes"] == 0 for h in sol.history)  # the fine loop has no probes
+    assert any(h["linear_iterations"] > 1 for h in sol.history)  # CG ran on the fine mesh
