@@ -16,7 +16,7 @@ from .errors import InputError
 from .methods.active_set import ActiveSetOptions
 from .methods.multipliers import solve_contact
 from .methods.penalty import solve_penalty
-from .methods.predictor import predict
+from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.schwarz import SchwarzOptions, solve_schwarz
 from .methods.solution import Solution
 from .options import SOLVERS, Basis, Method, Predictor, SolverSpec, solver_spec
@@ -39,6 +39,7 @@ def solve(
     predictor: Predictor | str = Predictor.AUTO,
     timers: Timers | None = None,
     basis: Basis | str = Basis.STANDARD,
+    initial: Solution | None = None,
 ) -> Solution:
     """Solve the frictionless contact problem of `scene` with `method`.
 
@@ -54,6 +55,8 @@ def solve(
             or none; the converged solution does not depend on it.
         timers: Where the labelled times go (a new Timers if None).
         basis: Mortar's multiplier basis: standard or dual (biorthogonal, D diagonal).
+        initial: A solution of the same scene on another mesh (an adaptive loop's previous
+            level): its active set is the first guess, in place of the predictor's.
 
     Returns:
         The Solution: displacement, multipliers per pair, history and costs.
@@ -76,7 +79,11 @@ def solve(
         return solve_schwarz(
             scene, schwarz or SchwarzOptions(max_iterations=max_iterations), timers
         )
-    init = predict(scene, method, spec, predictor, aso, basis, timers)
+    init = (
+        coarse_initial_set(initial, margin=coarse_margin(spec))
+        if initial is not None
+        else predict(scene, method, spec, predictor, aso, basis, timers)
+    )
     return solve_contact(
         scene,
         method,

@@ -13,6 +13,7 @@ runs the named cases in one process pair; rank 0 writes OUTDIR/<case>.npz with t
 
 from __future__ import annotations
 
+import functools
 import sys
 import tempfile
 import time
@@ -344,7 +345,7 @@ CASES["estimate-hertz-cli"] = Case(
 CASES["estimate-blocks-S2-mortar"] = Case(estimate_blocks, ESTIMATE_CHECKS)
 
 
-def adapt_hertz() -> tuple[Solution, Arrays]:
+def adapt_hertz(extra: tuple[str, ...] = ()) -> tuple[Solution, Arrays]:
     """`contactfx adapt hertz`, 2 levels: per level DOFs, estimates, Hertz error; mesh.msh."""
     import json
 
@@ -359,7 +360,7 @@ def adapt_hertz() -> tuple[Solution, Arrays]:
         return seen[-1]
 
     argv = ["adapt", "hertz", "--refine", "2", "--h-far", "2", "--refine-edge", "0"]
-    argv += ["--slope", "0.3", "--max-dofs", "12000", "--max-levels", "2", "-q"]
+    argv += ["--slope", "0.3", "--max-dofs", "12000", "--max-levels", "2", "-q", *extra]
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(comm.bcast(tmp))
         with mock.patch.object(cli_adapt, "adapt", recording):
@@ -383,6 +384,7 @@ def adapt_hertz() -> tuple[Solution, Arrays]:
         "dofs": np.array([lv["dofs"] for lv in levels]),
         "estimate": np.array([lv["estimate"] for lv in levels]),
         "parts": np.array([[p["contact"], p["bulk"]] for p in parts]),
+        "pressure": np.array([p["pressure"] for p in parts]),
         "l2": np.array([lv["hertz"]["l2_error"] for lv in levels]),
         "force": np.array([lv["contact_force"] for lv in levels]),
         "msh_nodes": np.array([counts[0]]),
@@ -395,19 +397,23 @@ def adapt_hertz() -> tuple[Solution, Arrays]:
 # Level 1's mesh comes from the gathered size field, rounded to results/sizing.py's
 # SIZE_DIGITS so that round-off between rank counts does not reach gmsh's discrete decisions:
 # the same mesh, its nodes at round-off of serial's.
-CASES["cli-adapt-hertz"] = Case(
-    adapt_hertz,
-    {
-        "dofs": Exact(positive=True),
-        "estimate": Approx(1e-9),
-        "parts": Approx(1e-9),
-        "l2": Approx(1e-8),
-        "force": Approx(1e-9),
-        "msh_nodes": Exact(positive=True),
-        "msh_xy_sum": Approx(1e-9),
-        "msh_kinds": Exact(),
-        "msh_kind_counts": Exact(positive=True),
-    },
+ADAPT_CHECKS = {
+    "dofs": Exact(positive=True),
+    "estimate": Approx(1e-9),
+    "parts": Approx(1e-9),
+    "pressure": Approx(1e-9),
+    "l2": Approx(1e-8),
+    "force": Approx(1e-9),
+    "msh_nodes": Exact(positive=True),
+    "msh_xy_sum": Approx(1e-9),
+    "msh_kinds": Exact(),
+    "msh_kind_counts": Exact(positive=True),
+}
+CASES["cli-adapt-hertz"] = Case(adapt_hertz, ADAPT_CHECKS)
+# The pressure sizing maps the (gathered) surfaces onto each rank's own cells.
+CASES["cli-adapt-hertz-pressure"] = Case(
+    functools.partial(adapt_hertz, ("--max-levels", "3", "--pressure-tol", "0.001")),
+    ADAPT_CHECKS,
 )
 
 

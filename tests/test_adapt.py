@@ -130,9 +130,9 @@ def test_overshooting_mesh_is_replanned_not_dropped(monkeypatch: pytest.MonkeyPa
     budgets: list[float] = []
     plan, count = loop.plan_mesh, loop._mesh_dofs
 
-    def recording(sol, est, tol, budget, rule):  # type: ignore[no-untyped-def]
+    def recording(sol, est, tol, budget, rule, pressure_tol):  # type: ignore[no-untyped-def]
         budgets.append(budget)
-        return plan(sol, est, tol, budget, rule)
+        return plan(sol, est, tol, budget, rule, pressure_tol)
 
     def overshoot_once(scene):  # type: ignore[no-untyped-def]
         # gmsh's first mesh of level 1 counted as twice --max-dofs, as if it overshot.

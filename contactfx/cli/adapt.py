@@ -14,7 +14,7 @@ from ..errors import InputError
 from ..options import Method
 from ..results.files import write_fields, write_json
 from ..results.mesh_file import write_msh
-from ..results.sizing import SizingRule
+from ..results.sizing import SizingRule, default_contact_weight
 from ..scenes import parse_scene_file
 from ..study.adapt import AdaptOptions, AdaptResult, adapt, level_record, uniform_levels
 from ..study.adapt_charts import plot_adapt
@@ -45,12 +45,20 @@ def adapt_json(args: argparse.Namespace, result: AdaptResult, opts: AdaptOptions
             "rate": opts.rule.rate,
             "growth": opts.rule.growth,
             "weight_contact": opts.rule.contact_weight,
+            "pressure_tol": opts.pressure_tol,
             "solver": args.solver,
         },
         "stop": result.stop,
         "levels": [level_record(lv) for lv in result.levels],
         **({"uniform": [level_record(lv) for lv in result.uniform]} if result.uniform else {}),
     }
+
+
+def contact_weight(args: argparse.Namespace) -> float:
+    """--weight-contact, or its default (10, or 1 with --pressure-tol)."""
+    if args.weight_contact is not None:
+        return float(args.weight_contact)
+    return default_contact_weight(args.pressure_tol)
 
 
 def run_adapt(args: argparse.Namespace) -> int:
@@ -64,7 +72,8 @@ def run_adapt(args: argparse.Namespace) -> int:
         args.tol,
         args.max_dofs,
         args.max_levels,
-        SizingRule(growth=args.growth, contact_weight=args.weight_contact),
+        SizingRule(growth=args.growth, contact_weight=contact_weight(args)),
+        args.pressure_tol,
     )
     opts.check()
     check_remeshable(args)

@@ -81,6 +81,14 @@ def _study_parser(sub: Any) -> None:
         "to its finest level's DOFs: the adaptive levels on the time chart, in study.json "
         "(`adaptive`) and on accuracy_vs_dofs.png (one rank; not schwarz)",
     )
+    s.add_argument(
+        "--pressure-tol",
+        type=float,
+        default=None,
+        metavar="P",
+        help="with --adaptive: also size the contact cells for a relative L2 pressure "
+        "estimate of P (as adapt's --pressure-tol)",
+    )
     _solver_options(s)
     o = s.add_argument_group("output")
     o.add_argument(
@@ -223,11 +231,20 @@ def _adapt_parser(sub: Any) -> None:
     a.add_argument(
         "--weight-contact",
         type=float,
-        default=10.0,
+        default=None,
         metavar="W",
         help="size the next mesh with each cell's contact terms times W (the estimate "
         "itself is unweighted; docs/adapt.md: W > 1 resolves the contact zone for the "
-        "pressure; default 10, 1 sizes by the energy estimate alone)",
+        "pressure; default 10, or 1 with --pressure-tol, whose sizing does that better)",
+    )
+    a.add_argument(
+        "--pressure-tol",
+        type=float,
+        default=None,
+        metavar="P",
+        help="also size the cells along the contact surfaces for a relative L2 pressure "
+        "estimate of P, and stop only when it is met too (docs/adapt.md; default: "
+        "the energy estimate alone)",
     )
     a.add_argument(
         "--compare-uniform",

@@ -51,6 +51,8 @@ def check_adaptive(args: argparse.Namespace, methods: list[str]) -> None:
     """InputError before anything runs if --adaptive cannot be done."""
     if not adaptive_methods(methods):
         raise InputError("study --adaptive needs a method with an estimate (not only schwarz)")
+    if args.pressure_tol is not None and not args.pressure_tol > 0:
+        raise InputError(f"--pressure-tol must be > 0 (got {args.pressure_tol})")
     reject_structured_adapt(args)
 
 
@@ -100,6 +102,7 @@ def run_command(args: argparse.Namespace) -> int:
             options={"max_iterations": args.max_iterations},
             paper_interface=levels[0].paper_interface,
             max_levels=3 * len(levels),
+            pressure_tol=args.pressure_tol,
             say=lambda line: say(line, flush=True),
         )
     if comm.rank == 0:

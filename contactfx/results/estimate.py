@@ -37,6 +37,7 @@ from ..discretize.mesh_utils import vertex_to_block
 from ..methods.solution import Solution
 from ..scenes import Pressure
 from .facet_jumps import JUMP_DEGREE, FacetTraction, process_boundary_jumps, two_cell_facets
+from .pressure_estimate import PressureEstimate, pressure_estimate
 
 BULK_TERMS = ("element", "jump", "neumann")
 CONTACT_TERMS = ("normal", "tangential", "complementarity", "gap")
@@ -52,6 +53,7 @@ class Estimate:
     energy: float  # ||u_h||_E = sqrt(a(u_h, u_h))
     # Per owned cell: the sum of its contact terms (squared units, as eta_K^2).
     contact_cells: np.ndarray | None = None
+    pressure: PressureEstimate | None = None  # the contact pressure's L2 error estimate
 
     def marking(self, contact_weight: float = 1.0) -> np.ndarray:
         """Per owned cell: eta_K with the contact terms times `contact_weight` (for sizing)."""
@@ -92,8 +94,10 @@ class Estimate:
             "terms": {k: v / e for k, v in self.terms.items()},
             "absolute": self.total,
             "energy_norm": e,
+            "pressure": self.pressure.relative if self.pressure is not None else None,
             "norm": "energy: sqrt(int sigma(u_h) : eps(u_h)); every value above but "
-            "absolute relative to it",
+            "absolute relative to it; pressure: the contact pressure's L2 error estimate "
+            "relative to ||p_h||_L2 (results/pressure_estimate.py)",
         }
 
 
@@ -284,4 +288,4 @@ def estimate(sol: Solution) -> Estimate:
     eta.x.scatter_forward()
     energy_form = fem.form(ufl.inner(sig, ufl.sym(ufl.grad(u))) * ufl.dx)
     energy = float(np.sqrt(msh.comm.allreduce(fem.assemble_scalar(energy_form), op=MPI.SUM)))
-    return Estimate(eta, terms, energy, contact)
+    return Estimate(eta, terms, energy, contact, pressure_estimate(sol))

@@ -16,7 +16,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..options import Method, SolverSpec
-from ..results.sizing import SizingRule
+from ..results.sizing import SizingRule, default_contact_weight
 from ..scenes import Scene
 from .adapt import AdaptLevel, AdaptOptions, adapt
 from .core import Study, exact_errors, self_reference
@@ -70,9 +70,15 @@ def adaptive_runs(
     paper_interface: bool = False,
     max_levels: int = 12,
     growth: float = GROWTH,
+    pressure_tol: float | None = None,
     say: Callable[[str], None] | None = None,
 ) -> list[AdaptiveRun]:
-    """Run the adaptive loop of every method from `scene` (level 0) and measure its levels."""
+    """Run the adaptive loop of every method from `scene` (level 0) and measure its levels.
+
+    With `pressure_tol` the contact cells are sized for the pressure too, and the contact
+    terms are not weighted (as adapt's defaults).
+    """
+    rule = SizingRule(growth=growth, contact_weight=default_contact_weight(pressure_tol))
     ref = self_reference(study.runs, study.methods) if study.reference["kind"] == "self" else None
     out: list[AdaptiveRun] = []
     for m in adaptive_methods(study.methods):
@@ -82,7 +88,7 @@ def adaptive_runs(
         result = adapt(
             scene,
             m,
-            AdaptOptions(NO_TOL, cap, max_levels, SizingRule(growth=growth)),
+            AdaptOptions(NO_TOL, cap, max_levels, rule, pressure_tol),
             solver=solver,
             options=options,
             paper_interface=paper_interface,
