@@ -122,6 +122,7 @@ def test_solve_estimate_cli(tmp_path: Path) -> None:
     e = data["estimate"]
     assert 0 < e["contact"] < e["total"] and 0 < e["bulk"] <= e["total"]
     assert "estimate (relative to the energy norm)" in proc.stdout
+    assert 0 < e["pressure"] < 1 and "pressure estimate (relative L2)" in proc.stdout
     pyvista = pytest.importorskip("pyvista")
     grid = pyvista.read(str(tmp_path / "out" / "fields.pvtu"))
     eta = np.asarray(grid.cell_data["eta"])

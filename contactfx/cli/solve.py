@@ -52,6 +52,8 @@ def terminal_summary(data: dict[str, Any]) -> list[str]:
             f"estimate (relative to the energy norm): {100 * e['total']:.3g} % (contact "
             f"{100 * e['contact']:.3g} %, bulk {100 * e['bulk']:.3g} %)"
         )
+        if e.get("pressure"):
+            lines.append(f"pressure estimate (relative L2): {100 * e['pressure']:.3g} %")
     return lines
 
 
