@@ -56,7 +56,8 @@ def solve(
         timers: Where the labelled times go (a new Timers if None).
         basis: Mortar's multiplier basis: standard or dual (biorthogonal, D diagonal).
         initial: A solution of the same scene on another mesh (an adaptive loop's previous
-            level): its active set is the first guess, in place of the predictor's.
+            level): its active set is the first guess of a multiplier method, in place of
+            the predictor's (penalty and schwarz have no active-set guess to take).
 
     Returns:
         The Solution: displacement, multipliers per pair, history and costs.

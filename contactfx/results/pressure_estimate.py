@@ -57,28 +57,26 @@ class PressureEstimate:
         return self.total / n if n > 0 else 0.0
 
 
-def curvatures(x: np.ndarray, segments: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """F'' at each node from the slopes of the (at most two) segments around it.
+def _lengths(x: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """Length of every segment (as contact.geometry.segment_lengths, from arrays)."""
+    d = x[segments[:, 1], :2] - x[segments[:, 0], :2]
+    return np.hypot(d[:, 0], d[:, 1])
+
+
+def curvatures(segments: np.ndarray, h: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The second derivative f'' at each node, from the slopes of the segments around it.
 
     With s_k = (p_other - p_node) / h_k the slope away from the node along segment k, a
     linear p gives s_1 + s_2 = 0 and a quadratic one s_1 + s_2 = f'' (h_1 + h_2) / 2. Nodes
-    with one segment (chain ends) get 0.
+    with one segment (chain ends) get 0. h: the segments' lengths.
     """
     a, b = segments[:, 0], segments[:, 1]
-    h = np.linalg.norm(x[b, :2] - x[a, :2], axis=1)
+    n = len(p)
     slope = (p[b] - p[a]) / np.maximum(h, 1e-300)
-    n = len(x)
-    total = np.zeros(n)
-    length = np.zeros(n)
-    count = np.zeros(n, dtype=np.int64)
-    np.add.at(total, a, slope)
-    np.add.at(total, b, -slope)
-    np.add.at(length, a, h)
-    np.add.at(length, b, h)
-    np.add.at(count, a, 1)
-    np.add.at(count, b, 1)
+    total = np.bincount(a, slope, n) - np.bincount(b, slope, n)
+    length = np.bincount(a, h, n) + np.bincount(b, h, n)
+    two = np.bincount(segments.ravel(), minlength=n) == 2
     out = np.zeros(n)
-    two = count == 2
     out[two] = 2.0 * total[two] / length[two]
     return out
 
@@ -92,8 +90,8 @@ def segment_indicators(
     quadratic; on the two segments at each edge of the zone the error of p_h against the
     square-root law through the last two active nodes (edge_errors).
     """
-    c = curvatures(x, segments, p)
-    h = np.linalg.norm(x[segments[:, 1], :2] - x[segments[:, 0], :2], axis=1)
+    h = _lengths(x, segments)
+    c = curvatures(segments, h, p)
     eta = np.sqrt(h**5 * (c[segments[:, 0]] ** 2 + c[segments[:, 1]] ** 2) / 240.0)
     edge = np.zeros(len(segments), dtype=bool)
     for (inner, outer), err in edge_errors(segments, h, p).items():
@@ -126,28 +124,31 @@ def edge_errors(
     (A clipped to [0, h_kj]: the edge lies before the open node j). Returns
     {(segment ik, segment kj): (error on ik, error on kj)}.
     """
-    nbr: dict[int, list[tuple[int, int]]] = {}
-    for e, (a, b) in enumerate(segments):
-        nbr.setdefault(int(a), []).append((e, int(b)))
-        nbr.setdefault(int(b), []).append((e, int(a)))
-    out: dict[tuple[int, int], tuple[float, float]] = {}
-    for k, around in nbr.items():
-        if len(around) != 2 or not p[k] > 0:
-            continue
-        (e1, n1), (e2, n2) = around
-        if p[n1] == 0 and p[n2] > p[k]:
-            (ej, _), (ei, i) = (e1, n1), (e2, n2)
-        elif p[n2] == 0 and p[n1] > p[k]:
-            (ej, _), (ei, i) = (e2, n2), (e1, n1)
-        else:
-            continue
-        out[(ei, ej)] = edge_pair_errors(float(p[i]), float(p[k]), float(h[ei]), float(h[ej]))
-    return out
+    n, m = len(p), len(segments)
+    ends = segments.T.ravel()  # each segment once from either end
+    other = segments[:, ::-1].T.ravel()
+    seg = np.tile(np.arange(m), 2)
+    order = np.argsort(ends, kind="stable")
+    degree = np.bincount(ends, minlength=n)
+    first = np.concatenate([[0], np.cumsum(degree)[:-1]])
+    k = np.flatnonzero((degree == 2) & (p > 0))
+    s1, s2 = order[first[k]], order[first[k] + 1]
+    n1, n2 = other[s1], other[s2]
+    open1 = (p[n1] == 0) & (p[n2] > p[k])  # j = n1, i = n2
+    open2 = (p[n2] == 0) & (p[n1] > p[k])  # j = n2, i = n1
+    at = open1 | open2
+    ei = np.where(open1, seg[s2], seg[s1])[at]
+    ej = np.where(open1, seg[s1], seg[s2])[at]
+    i = np.where(open1, n2, n1)[at]
+    return {
+        (int(a), int(b)): edge_pair_errors(float(p[c]), float(p[d]), float(h[a]), float(h[b]))
+        for a, b, c, d in zip(ei, ej, i, k[at], strict=True)
+    }
 
 
 def l2_norm(x: np.ndarray, segments: np.ndarray, p: np.ndarray) -> float:
     """||p_h||_L2 of the piecewise-linear nodal function p on the segments."""
-    h = np.linalg.norm(x[segments[:, 1], :2] - x[segments[:, 0], :2], axis=1)
+    h = _lengths(x, segments)
     pa, pb = p[segments[:, 0]], p[segments[:, 1]]
     return float(np.sqrt(np.sum(h * (pa**2 + pa * pb + pb**2) / 3.0)))
 

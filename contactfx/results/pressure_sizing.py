@@ -71,8 +71,10 @@ def pressure_cell_sizes(
     parts = [_node_sizes(q, s) for q, s in zip(pe.pairs, seg_sizes, strict=True)]
     pts = np.concatenate([p for p, _ in parts])
     size = np.concatenate([s for _, s in parts])
-    scale = float(np.ptp(quads.reshape(-1, 2), axis=0).max())
+    # A vertex on a surface is one of its nodes (the same coordinates); the tolerance is
+    # relative to the surfaces' extent, the same on every rank.
+    tol = 1e-9 * float(np.ptp(pts, axis=0).max())
     dist, idx = cKDTree(pts).query(quads.reshape(-1, 2))
-    at = np.where(dist <= 1e-9 * scale, size[np.minimum(idx, len(size) - 1)], np.inf)
+    at = np.where(dist <= tol, size[idx], np.inf)
     out = at.reshape(-1, 4).min(axis=1)
     return np.maximum(out, finest * h)

@@ -63,15 +63,12 @@ class AdaptOptions:
         """Why the loop may stop at this estimate, or None."""
         if est.relative > self.tol:
             return None
-        if self.pressure_tol is None:
-            return f"estimate {est.relative:.3g} <= tol {self.tol:g}"
-        pressure = est.pressure.relative if est.pressure is not None else 0.0
-        if pressure > self.pressure_tol:
+        if not self.pressure_met(est):
             return None
-        return (
-            f"estimate {est.relative:.3g} <= tol {self.tol:g}, pressure estimate "
-            f"{pressure:.3g} <= {self.pressure_tol:g}"
-        )
+        reached = f"estimate {est.relative:.3g} <= tol {self.tol:g}"
+        if self.pressure_tol is None or est.pressure is None:
+            return reached
+        return f"{reached}, pressure estimate {est.pressure.relative:.3g} <= {self.pressure_tol:g}"
 
     def check(self) -> None:
         """InputError for a value out of range."""
