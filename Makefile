@@ -15,7 +15,7 @@ export OMP_NUM_THREADS := 1
 
 venv: $(STAMP)
 
-$(STAMP): pyproject.toml setup.py
+$(STAMP): pyproject.toml
 	@test -n "$(PYTHON312)" || { echo "python3.12 not found" >&2; exit 1; }
 	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
@@ -27,10 +27,11 @@ demo: $(STAMP)
 
 # In-process tests on both cores (pytest-xdist); then the mpirun -n 2 tests, one at a time.
 test: $(STAMP)
-	$(PY) -m ruff check contactfx meshes tests demos benchmarks
-	$(PY) -m ruff format --check contactfx meshes tests demos benchmarks
+	$(PY) -m ruff check contactfx tests demos benchmarks
+	$(PY) -m ruff format --check contactfx tests demos benchmarks
 	$(PY) -m mypy
 	$(VENV)/bin/lint-imports
+	$(PY) tools/layout_check.py 400 250 120
 	$(PY) -m pytest -q -n 2 -m serial tests
 	$(PY) -m pytest -q -m mpi tests
 

@@ -26,8 +26,8 @@ import dolfinx_solver  # noqa: F401
 import numpy as np
 
 from contactfx import load_scene_file, run_scene
-from contactfx.results.sizing import SizingRule
-from contactfx.study.adapt import AdaptOptions, adapt, uniform_levels
+from contactfx.adapt.loop import AdaptOptions, adapt, uniform_levels
+from contactfx.adapt.sizing import SizingRule
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "demos" / "scenes"

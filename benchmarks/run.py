@@ -26,9 +26,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-from contactfx.meshes.hertz_structured import hertz_grid
 from sweep_report import charts as sweep_charts
 from sweep_report import contact_solve, group_key, summarize, t, table, write_readme
+
+from contactfx.meshes.hertz_structured import hertz_grid
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

@@ -295,7 +295,7 @@ CASES["cli-hertz-penalty"] = Case(
 
 def estimate_arrays(sol: Solution) -> Arrays:
     """The estimate: relative total and squared terms, the cell indicators by midpoint."""
-    from contactfx.results.estimate import BULK_TERMS, CONTACT_TERMS, estimate
+    from contactfx.adapt.estimate import BULK_TERMS, CONTACT_TERMS, estimate
 
     est = estimate(sol)
     comm = sol.scene.comm
@@ -394,7 +394,7 @@ def adapt_hertz(extra: tuple[str, ...] = ()) -> tuple[Solution, Arrays]:
     }
 
 
-# Level 1's mesh comes from the gathered size field, rounded to results/sizing.py's
+# Level 1's mesh comes from the gathered size field, rounded to adapt/sizing.py's
 # SIZE_DIGITS so that round-off between rank counts does not reach gmsh's discrete decisions:
 # the same mesh, its nodes at round-off of serial's.
 ADAPT_CHECKS = {

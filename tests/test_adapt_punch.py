@@ -16,8 +16,8 @@ import numpy as np
 from conftest import ROOT
 
 from contactfx import load_scene_file, run_scene
-from contactfx.results.sizing import SizingRule
-from contactfx.study.adapt import AdaptOptions, adapt
+from contactfx.adapt.loop import AdaptOptions, adapt
+from contactfx.adapt.sizing import SizingRule
 
 SCENES = ROOT / "demos" / "scenes"
 

@@ -10,9 +10,9 @@ import pytest
 from conftest import cli
 
 import contactfx
-from contactfx.results.estimate import BULK_TERMS, CONTACT_TERMS, estimate
-from contactfx.results.facet_jumps import FacetTraction, jump_term
-from contactfx.results.true_error import energy_error
+from contactfx.adapt.estimate import BULK_TERMS, CONTACT_TERMS, estimate
+from contactfx.adapt.facet_jumps import FacetTraction, jump_term
+from contactfx.adapt.true_error import energy_error
 from contactfx.scenes import BlockParams, HertzParams, blocks, hertz
 
 

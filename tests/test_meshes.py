@@ -7,11 +7,11 @@ from pathlib import Path
 import dolfinx_solver  # noqa: F401 - orders MPI ahead of the dolfinx bindings
 import numpy as np
 import pytest
-from contactfx.meshes import build_blocks, build_hertz
 from dolfinx.io.gmsh import MeshData
 from dolfinx.mesh import CellType, entities_to_geometry
 from mpi4py import MPI
 
+from contactfx.meshes import build_blocks, build_hertz
 from contactfx.scenes.gmsh_io import balanced_partitioner, to_dolfinx
 
 NAMES = {"body1", "body2", "contact1", "contact2", "symmetry", "support", "load"}

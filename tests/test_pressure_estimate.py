@@ -11,10 +11,10 @@ from conftest import cli
 from test_adapt import COARSE_HERTZ
 
 import contactfx
-from contactfx.results.estimate import estimate
-from contactfx.results.pressure_estimate import l2_norm, segment_indicators
+from contactfx.adapt.estimate import estimate
+from contactfx.adapt.pressure_estimate import l2_norm, segment_indicators
+from contactfx.adapt.sizing import SizingRule, plan_mesh
 from contactfx.results.references import exact_pressure
-from contactfx.results.sizing import SizingRule, plan_mesh
 from contactfx.scenes import HertzParams, hertz
 
 A, P0 = 1.4378, 44.28  # the built-in Hertz scene's half-width and peak

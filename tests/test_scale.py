@@ -9,7 +9,6 @@ import math
 import numpy as np
 import pytest
 from conftest import cli
-from contactfx.meshes.hertz_structured import graded_points, hertz_grid
 from mpi4py import MPI
 
 from contactfx.contact import Kernel
@@ -19,6 +18,7 @@ from contactfx.discretize.supports import rigid_body_modes
 from contactfx.errors import InputError
 from contactfx.linalg.policy import FactorizationPolicy, ReuseMode
 from contactfx.linalg.saddle import SaddleSolver
+from contactfx.meshes.hertz_structured import graded_points, hertz_grid
 from contactfx.methods.active_set import ActiveSetOptions
 from contactfx.methods.multipliers import solve_contact
 from contactfx.options import SOLVERS, Method, Predictor

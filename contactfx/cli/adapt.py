@@ -10,14 +10,14 @@ from typing import Any
 
 from mpi4py import MPI
 
+from ..adapt.charts import plot_adapt
+from ..adapt.loop import AdaptOptions, AdaptResult, adapt, level_record, uniform_levels
+from ..adapt.mesh_file import write_msh
+from ..adapt.sizing import SizingRule, default_contact_weight
 from ..errors import InputError
 from ..options import Method
 from ..results.files import write_fields, write_json
-from ..results.mesh_file import write_msh
-from ..results.sizing import SizingRule, default_contact_weight
 from ..scenes import parse_scene_file
-from ..study.adapt import AdaptOptions, AdaptResult, adapt, level_record, uniform_levels
-from ..study.adapt_charts import plot_adapt
 from .params import build_from_args, is_scene_file, reject_structured_adapt, spec_from_args
 
 

@@ -9,10 +9,10 @@ from typing import Any
 
 from mpi4py import MPI
 
+from ..adapt.estimate import estimate
 from ..api import run_scene
 from ..errors import InputError
 from ..options import Method
-from ..results.estimate import estimate
 from ..results.figures import contact_window, deformed_fields, plot_interface, plot_pair
 from ..results.files import write_contact_surfaces, write_fields, write_json
 from ..timers import Timers

@@ -227,7 +227,7 @@ class SizeField:
     """A mesh size given at the vertices of quadrilaterals: a background mesh for gmsh.
 
     `quads` (n, 4, 2) and `sizes` (n, 4) are the whole field on rank 0 (where gmsh runs);
-    the other ranks hold empty arrays. The adaptive loop makes it (study/adapt.py).
+    the other ranks hold empty arrays. The adaptive loop makes it (adapt/loop.py).
     """
 
     quads: np.ndarray

@@ -1,7 +1,7 @@
 """`study --adaptive`: the adaptive loop beside the uniform levels, on the same charts.
 
 After the uniform study, each method (but schwarz, which has no estimate) runs the adaptive
-loop (study/adapt.py) from level 0's mesh, up to the DOFs of that method's finest uniform
+loop (adapt/loop.py) from level 0's mesh, up to the DOFs of that method's finest uniform
 level. Each adaptive level is measured like a uniform run: against the exact solution
 (Hertz, patch test) or, without one, against the study's self-convergence reference (the
 finest uniform level of the most accurate method). Its time on the charts is cumulative:
@@ -15,10 +15,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from ..adapt.loop import AdaptLevel, AdaptOptions, adapt
+from ..adapt.sizing import SizingRule, default_contact_weight
 from ..options import Method, SolverSpec
-from ..results.sizing import SizingRule, default_contact_weight
 from ..scenes import Scene
-from .adapt import AdaptLevel, AdaptOptions, adapt
 from .core import Study, exact_errors, self_reference
 from .measures import contact_size, profiles
 from .measures import self_errors as compare_profiles

@@ -2,7 +2,7 @@
 
 DOLFINx cannot refine quadrilaterals, so every level remeshes the scene's geometry (a
 built-in scene's gmsh model or a .geo) from a background size field built from the
-indicators (results/sizing.py). The loop stops when the relative estimate is at most `tol`,
+indicators (adapt/sizing.py). The loop stops when the relative estimate is at most `tol`,
 after `max_levels` levels, or when the next mesh would exceed `max_dofs`. `uniform_levels`
 refines the same starting scene uniformly, for the comparison charts.
 """
@@ -20,10 +20,10 @@ from ..api import run_scene
 from ..errors import InputError
 from ..methods.solution import Solution
 from ..options import SolverSpec
-from ..results.estimate import Estimate, estimate
-from ..results.sizing import SizingRule, plan_mesh
 from ..scenes import Scene
 from ..timers import Timers
+from .estimate import Estimate, estimate
+from .sizing import SizingRule, plan_mesh
 
 # On a full budget, the pressure sizing goes on while its estimate falls below this fraction
 # of the previous level's.
