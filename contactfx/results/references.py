@@ -3,8 +3,8 @@
 Hertz, for one pair: half-width, peak and the L2 error of the pressure. The distance r from
 the contact centre is measured along the active surface's tangent at the centre (the
 tangent-plane coordinate of Hertz's theory). For a half model (`symmetric`) the centre is the
-end of the active surface nearest the pressure peak; otherwise the pressure's centroid along
-the arc length.
+end of the active surface nearest the pressure peak; otherwise the pressure's own centre along
+the arc length: the first moment of the piecewise-linear pressure (`pressure_centre`).
 """
 
 from __future__ import annotations
@@ -31,6 +31,21 @@ def fit_half_width(x: np.ndarray, p: np.ndarray) -> float | None:
     A = np.column_stack([np.ones_like(x), x**2])
     (c0, c1), *_ = np.linalg.lstsq(A, p**2, rcond=None)
     return float(np.sqrt(-c0 / c1)) if c1 < 0 < c0 else None
+
+
+def pressure_centre(s: np.ndarray, p: np.ndarray) -> float:
+    """Centre of the piecewise-linear pressure: integral of p s ds / integral of p ds.
+
+    Integrated exactly segment by segment (s sorted; negative values count as 0). A mean of
+    the nodes' s weighted by their pressures would lean towards the side with more nodes.
+    """
+    order = np.argsort(s, kind="stable")
+    s, w = s[order], np.clip(p[order], 0.0, None)
+    h, s0, s1, w0, w1 = np.diff(s), s[:-1], s[1:], w[:-1], w[1:]
+    mass = float(np.sum(h * (w0 + w1))) / 2.0
+    if mass <= 0.0:
+        return float(s[np.argmax(w)]) if s.size else 0.0
+    return float(np.sum(h * (w0 * (2 * s0 + s1) + w1 * (s0 + 2 * s1)))) / (6.0 * mass)
 
 
 def l2_error(
@@ -76,10 +91,10 @@ def computed_load(sol: Solution, ref: HertzReference, tangent: np.ndarray) -> fl
 
 def centre_distance(
     sol: Solution, ref: HertzReference
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(r, pressure, active, tc) of the pair's multipliers, r signed along the centre's tangent.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """(r, pressure, active, tc, sc) of the pair's multipliers, r signed along the centre's tangent.
 
-    tc is that tangent (unit).
+    tc is that tangent (unit), sc the centre's arc length s along the active surface.
     """
     pv = sol.pairs[ref.pair]
     rows = pv.rows
@@ -93,24 +108,23 @@ def centre_distance(
         peak = s[int(np.argmax(p))]
         ends = np.array([np.nanmin(s_all), np.nanmax(s_all)])
         centre_node = int(np.nanargmin(np.abs(s_all - ends[np.argmin(np.abs(ends - peak))])))
-        xc, tc = surf.x[centre_node], t_all[centre_node]
+        xc, tc, sc = surf.x[centre_node], t_all[centre_node], float(s_all[centre_node])
     else:
-        w = np.clip(p, 0.0, None)
-        sc = float((w * s).sum() / max(w.sum(), 1e-300))
+        sc = pressure_centre(s, p)
         xc = np.array([np.interp(sc, s, surf.x[node, d]) for d in (0, 1)])
         tc = np.array([np.interp(sc, s, t_all[node, d]) for d in (0, 1)])
         tc /= np.linalg.norm(tc)
     r = (surf.x[node] - xc) @ tc
     if ref.symmetric and np.any(p > 0) and np.median(r[p > 0]) < 0:
         r = -r  # the centre is the end of largest s: measure into the surface
-    return r, p, act, tc
+    return r, p, act, tc, sc
 
 
 def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> dict[str, object]:
     """The `hertz` block of the JSON: fitted and bracketed half-width, p0 and the L2 error."""
     if ref is None:
         ref = next(r for r in sol.scene.references if isinstance(r, HertzReference))
-    r, p, act, tc = centre_distance(sol, ref)
+    r, p, act, tc, sc = centre_distance(sol, ref)
     load = ref.P if ref.P is not None else computed_load(sol, ref, tc)
     exact = reference_values(sol.scene, ref, load)
     order = np.argsort(r, kind="stable")
@@ -120,6 +134,7 @@ def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> dict[str,
     beyond = np.abs(r[(~act) & (np.abs(r) > last)])
     return {
         "pair": ref.pair,
+        "s_centre": sc,
         "a": fit_half_width(r[act], p[act]),
         "a_bracket": [last, float(beyond.min()) if beyond.size else None],
         "a_exact": exact["a"],

@@ -167,7 +167,7 @@ class HertzReference:
     model), which is what a displacement-controlled scene knows. `symmetric`: the model is a
     half model cut through the contact centre (which is then the end of the active surface
     nearest the symmetry line); otherwise (the default, in Python and in scene files alike)
-    the centre is the pressure's centroid.
+    the centre is the first moment of the piecewise-linear pressure along the arc length.
     """
 
     pair: int
