@@ -134,7 +134,7 @@ def main() -> None:
                 "reference_linear_iterations": sol.reference_linear_iterations,
                 "hertz": {
                     k: v
-                    for k, v in hertz_summary(sol).items()
+                    for k, v in hertz_summary(sol).to_json().items()
                     if k in ("a", "a_exact", "p0", "p0_exact", "l2_error")
                 },
                 "contact_force_error": abs(

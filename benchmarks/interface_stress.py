@@ -75,6 +75,7 @@ def level(f: float, mesher: str) -> None:
     sol, data = run_case(
         "hertz", hertz_at(HertzParams(mesh=mesher), f), "mortar", comm=MPI.COMM_SELF
     )
+    data = data.to_json()
     pv = sol.pairs[0]
     a, p0 = data["hertz"]["a_exact"], data["hertz"]["p0_exact"]
     order = np.argsort(pv.s, kind="stable")

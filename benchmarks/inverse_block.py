@@ -31,6 +31,7 @@ def main() -> None:
         for block in blocks:
             mumps.INVERSE_BLOCK = block
             _, data = run_case("hertz", CASES[name], "mortar")
+            data = data.to_json()
             first = data["active_set"][0]
             print(
                 f"{name} {data['dofs']} dofs, ICNTL(27) {block}: {first['probes']} probes, "

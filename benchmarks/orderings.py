@@ -56,6 +56,7 @@ def main() -> None:
                 spec = solver_spec("mumps").with_petsc([f"mat_mumps_icntl_7={k}"])
                 t0 = time.perf_counter()
                 _, data = run_scene(scene, "mortar", solver=spec, reference_timing=True)
+                data = data.to_json()
                 t = data["times"]
                 dofs = data["dofs"]
                 got = {

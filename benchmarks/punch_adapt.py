@@ -76,6 +76,7 @@ def reference(tmp: Path, slope: float, hmin: float) -> dict:
     """A mesh graded towards the punch edge: h = max(hmin, slope r), at most 2."""
     f = f"Min(2, Max({hmin}, {slope} * Sqrt((x - 1)^2 + y^2)))"
     _, data = run_scene(load_scene_file(scene_with(tmp, f"ref{slope}", f)), "nts")
+    data = data.to_json()
     return measures(data, None)
 
 
@@ -124,7 +125,7 @@ def main() -> None:
     for name, levels in (("adaptive", result.levels), ("uniform", uni)):
         rows[name] = []
         for lv in levels:
-            m = measures(lv.summary, r2)
+            m = measures(lv.summary.to_json(), r2)
             m["energy"] = float(np.sqrt(max(m["force"] - F, 0.0) / F))
             m["estimate"] = float(lv.est.relative)
             del m["x"], m["p"]

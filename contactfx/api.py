@@ -1,4 +1,4 @@
-"""The Python API: solve(scene, method) -> Solution, run_scene with its JSON summary, run_case.
+"""The Python API: solve(scene, method) -> Solution, run_scene with its summary, run_case.
 
 The CLI, the demos, the benchmarks and the tests are thin layers over these calls. Every
 option is validated here, once, into its typed value (options.py).
@@ -20,7 +20,8 @@ from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.schwarz import SchwarzOptions, solve_schwarz
 from .methods.solution import Solution
 from .options import SOLVERS, Basis, Method, Predictor, SolverSpec, solver_spec
-from .results.summary import summary
+from .results.records import RunSummary
+from .results.summary import solver_label, summary
 from .scenes import BlockParams, HertzParams, Scene, build_scene
 from .timers import Timers
 
@@ -106,11 +107,12 @@ def run_scene(
     timers: Timers | None = None,
     paper_interface: bool = False,
     **options: Any,
-) -> tuple[Solution, dict[str, Any]]:
-    """Solve `scene` and return the solution with its JSON summary (times from `t_start`).
+) -> tuple[Solution, RunSummary]:
+    """Solve `scene` and return the solution with its summary (times from `t_start`).
 
     `options` go to `solve`; `paper_interface` adds the x-sorted `interface` block of pair
-    0 (the paper's scenes: one horizontal contact line).
+    0 (the paper's scenes: one horizontal contact line). The summary's `to_json()` is the
+    JSON of `contactfx solve --json`.
     """
     t_start = time.perf_counter() if t_start is None else t_start
     timers = timers or Timers()
@@ -121,8 +123,13 @@ def run_scene(
         if key in timers.seconds:
             times[key] = timers.seconds[key]
     times["total"] = time.perf_counter() - t_start
-    extra = {"solver": spec.name, "memory": peak_memory(scene.comm)}
-    return sol, summary(sol, times, extra, paper_interface=paper_interface)
+    return sol, summary(
+        sol,
+        times,
+        solver=solver_label(sol.method, spec),
+        memory=peak_memory(scene.comm),
+        paper_interface=paper_interface,
+    )
 
 
 def peak_memory(comm: MPI.Comm) -> dict[str, float]:
@@ -143,8 +150,8 @@ def run_case(
     solver: SolverSpec | str = "mumps",
     comm: MPI.Comm = MPI.COMM_WORLD,
     **options: Any,
-) -> tuple[Solution, dict[str, Any]]:
-    """Mesh, assemble and solve a built-in scene; return the solution and its JSON summary.
+) -> tuple[Solution, RunSummary]:
+    """Mesh, assemble and solve a built-in scene; return the solution and its summary.
 
     `options` go to `solve`; the summary carries the paper's `interface` block.
     """

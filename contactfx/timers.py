@@ -20,7 +20,3 @@ class Timers:
             yield
         finally:
             self.seconds[label] += time.perf_counter() - t0
-
-    def as_dict(self) -> dict[str, float]:
-        """Return the totals as a plain dict."""
-        return dict(self.seconds)

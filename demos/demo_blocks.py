@@ -67,6 +67,7 @@ for name, params in BLOCK_SCENES.items():
     for active in (2,) if name == "S1" else (2, 1):
         for method in METHODS:
             sol, data = run_case("blocks", params, method, active=active, comm=comm)
+            data = data.to_json()
             corner = params.l2 / 2
             row = {
                 "scene": name,

@@ -127,9 +127,10 @@ def rows_of(study: Study, label: str, size_key: str) -> list[dict]:
     out = []
     for r in study.runs:
         assert r.ok, f"{label} {r.method} level {r.level}: {r.message}"
-        hz = r.summary["hertz"]
-        lo, hi = hz["a_bracket"]
-        a = hz["a"] if hz["a"] is not None else 0.5 * (lo + (hi if hi is not None else lo))
+        assert r.summary is not None and r.summary.hertz and r.summary.interface is not None
+        hz, itf = r.summary.hertz[0], r.summary.interface
+        lo, hi = hz.a_bracket
+        a = hz.a if hz.a is not None else 0.5 * (lo + (hi if hi is not None else lo))
         out.append(
             {
                 "series": label,
@@ -138,20 +139,20 @@ def rows_of(study: Study, label: str, size_key: str) -> list[dict]:
                 "h_measured": r.h,
                 "elements": r.elements,
                 "dofs": r.dofs,
-                "multipliers": r.summary["multipliers"],
+                "multipliers": r.summary.multipliers,
                 "a": a,
-                "a_fit": hz["a"],
-                "a_bracket": hz["a_bracket"],
-                "p0": hz["p0"],
-                "a_err": a / hz["a_exact"] - 1,
-                "p0_err": hz["p0"] / hz["p0_exact"] - 1,
-                "l2_error": hz["l2_error"],
+                "a_fit": hz.a,
+                "a_bracket": list(hz.a_bracket),
+                "p0": hz.p0,
+                "a_err": a / hz.a_exact - 1,
+                "p0_err": hz.p0 / hz.p0_exact - 1,
+                "l2_error": hz.l2_error,
                 "iterations": r.iterations,
                 "solve_time": r.times["solve"],
                 "time_after_mesh": r.after_mesh,
                 "mesh_time": r.times["mesh"],
-                "x": r.summary["interface"]["x"],
-                "pressure": r.summary["interface"]["pressure"],
+                "x": itf["x"],
+                "pressure": itf["pressure"],
             }
         )
     return out

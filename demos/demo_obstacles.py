@@ -80,9 +80,10 @@ hertz = {}
 for method, options in METHODS:
     t0 = time.perf_counter()
     sol, data = run_scene(indenter, method, **options)
+    data = data.to_json()
     c = data["contacts"][0]
     P = 2.0 * abs(c["force"][1])
-    h = hertz_summary(sol, HertzReference(0, 20.0, P, symmetric=True))
+    h = hertz_summary(sol, HertzReference(0, 20.0, P, symmetric=True)).to_json()
     hertz[label(method, options)] = (h, c)
     say(
         f"{label(method, options):12s} P = {P:.4f}: a {100 * (h['a'] / h['a_exact'] - 1):+.2f} %, "
@@ -107,6 +108,7 @@ same = scene_from_gmsh(
     comm=comm,
 )
 _, again = run_scene(same, "mortar")
+again = again.to_json()
 say(f"Python API: force {again['contacts'][0]['force']}")
 # -
 
@@ -143,6 +145,7 @@ punch = load_scene_file(SCENES / "rigid_punch.toml", comm)
 flat = {}
 for method, options in METHODS:
     _, data = run_scene(punch, method, **options)
+    data = data.to_json()
     c = data["contacts"][0]
     P, interior, l1 = sadowsky(c)
     flat[label(method, options)] = (P, interior, l1, c)

@@ -134,6 +134,7 @@ results = {}
 for method in METHODS:
     t0 = time.perf_counter()
     _, data = run_scene(scene, method)
+    data = data.to_json()
     results[method] = data
     for h, c in zip(data["hertz_pairs"], data["contacts"], strict=True):
         say(

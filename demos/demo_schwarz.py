@@ -78,10 +78,12 @@ def interface_arrays(data: dict) -> dict[str, np.ndarray]:
 runs = {}
 for name, params in BLOCK_SCENES.items():
     _, mortar = run_case("blocks", params, Method.MORTAR, comm=comm)
+    mortar = mortar.to_json()
     runs[name] = {"mortar": mortar}
     for label, opts in SETTINGS.items():
         try:
             sol, data = run_case("blocks", params, Method.SCHWARZ, comm=comm, schwarz=opts)
+            data = data.to_json()
             entry = {"data": data, "history": data["active_set"], "converged": True}
             if label.startswith("Aitken"):
                 entry["patch"] = body_stress_deviation(sol, -params.p)
@@ -142,7 +144,9 @@ sweep = []
 for k in levels:
     params = replace(BLOCK_SCENES["S2"], size1=0.08 / k, size2=0.1 / k)
     _, mortar = run_case("blocks", params, Method.MORTAR, comm=comm)
+    mortar = mortar.to_json()
     sol, schwarz = run_case("blocks", params, Method.SCHWARZ, comm=comm)
+    schwarz = schwarz.to_json()
     sweep.append(
         {
             "refine": k,

@@ -33,6 +33,7 @@ from contactfx import cli, load_scene_file, run_scene, solve
 from contactfx.api import run_case
 from contactfx.cli import solve as cli_solve
 from contactfx.methods.solution import Solution
+from contactfx.results import RunSummary
 from contactfx.results.interface import u_at_points
 from contactfx.scenes import BLOCK_SCENES, HertzParams, hertz
 
@@ -70,10 +71,10 @@ def cli_solution() -> Iterator[list[Solution]]:
     """Record the Solution that `contactfx solve` computes (its run_scene, unchanged)."""
     seen: list[Solution] = []
 
-    def recording(*args: Any, **kwargs: Any) -> tuple[Solution, dict[str, Any]]:
-        sol, data = run_scene(*args, **kwargs)
+    def recording(*args: Any, **kwargs: Any) -> tuple[Solution, RunSummary]:
+        sol, record = run_scene(*args, **kwargs)
         seen.append(sol)
-        return sol, data
+        return sol, record
 
     with mock.patch.object(cli_solve, "run_scene", recording):
         yield seen
@@ -102,6 +103,7 @@ def blocks(scene: str, method: str, active: int, solver: str) -> Callable[[], An
 
     def run() -> tuple[Solution, Arrays]:
         sol, data = run_case("blocks", BLOCK_SCENES[scene], method, active=active, solver=solver)
+        data = data.to_json()
         itf = data["interface"]
         return sol, {**u_split(sol), "x": np.asarray(itf["x"]), "p": np.asarray(itf["pressure"])}
 
@@ -123,6 +125,7 @@ for _scene, _method, _active, _solver in (
 def schwarz_s2() -> tuple[Solution, Arrays]:
     """Schwarz on S2 (active body 1): u, pressure and the iteration count."""
     sol, data = run_case("blocks", BLOCK_SCENES["S2"], "schwarz", active=1)
+    data = data.to_json()
     p = np.asarray(data["interface"]["pressure"])
     return sol, {**u_split(sol), "p": p, "its": np.asarray(data["iterations"])}
 
@@ -138,6 +141,7 @@ def user_scene(path: Path, method: str) -> Callable[[], Any]:
 
     def run() -> tuple[Solution, Arrays]:
         sol, data = run_scene(load_scene_file(path), method)
+        data = data.to_json()
         itf = [c["interface"] for c in data["contacts"]]
         snn = [v for i in itf for v in i["sigma_nn_active"]]
         return sol, {
@@ -164,6 +168,7 @@ def obstacle(path: Path, method: str, basis: str) -> Callable[[], Any]:
 
     def run() -> tuple[Solution, Arrays]:
         sol, data = run_scene(load_scene_file(path), method, basis=basis)
+        data = data.to_json()
         c = data["contacts"][0]
         return sol, {
             **u_split(sol),
@@ -201,6 +206,7 @@ def hertz_graded() -> tuple[Solution, Arrays]:
     """The graded gmsh Hertz scene, mortar: the pressure profile and the Hertz measures."""
     params = HertzParams(refine=0.08, refine_edge=0.02, slope=0.2)
     sol, d = run_case("hertz", params, "mortar")
+    d = d.to_json()
     h = d["hertz"]
     return sol, {
         "x": np.asarray(d["interface"]["x"]),

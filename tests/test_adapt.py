@@ -121,27 +121,28 @@ def test_weight_below_one_refused(tmp_path: Path) -> None:
     assert "--weight-contact" in proc.stderr and not (tmp_path / "o").exists()
 
 
-def test_overshooting_mesh_is_replanned_not_dropped(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_overshooting_mesh_is_replanned_not_dropped() -> None:
     """A remeshed level above --max-dofs is planned again with a smaller budget and kept."""
+    from contactfx.adapt import loop
+    from contactfx.adapt.sizing import plan_mesh
+    from contactfx.methods.predictor import scene_dofs
     from contactfx.scenes import HertzParams
     from contactfx.scenes.builtin import hertz
-    from contactfx.study import adapt as loop
 
     budgets: list[float] = []
-    plan, count = loop.plan_mesh, loop._mesh_dofs
 
     def recording(sol, est, tol, budget, rule, pressure_tol):  # type: ignore[no-untyped-def]
         budgets.append(budget)
-        return plan(sol, est, tol, budget, rule, pressure_tol)
+        return plan_mesh(sol, est, tol, budget, rule, pressure_tol)
 
     def overshoot_once(scene):  # type: ignore[no-untyped-def]
         # gmsh's first mesh of level 1 counted as twice --max-dofs, as if it overshot.
-        return count(scene) if len(budgets) > 1 else 2 * opts.max_dofs
+        return scene_dofs(scene) if len(budgets) > 1 else 2 * opts.max_dofs
 
     opts = loop.AdaptOptions(max_levels=2, max_dofs=20_000)
-    monkeypatch.setattr(loop, "plan_mesh", recording)
-    monkeypatch.setattr(loop, "_mesh_dofs", overshoot_once)
     scene = hertz(HertzParams(refine=2, h_far=2, refine_edge=0, slope=0.3))
-    result = loop.adapt(scene, "mortar", opts, say=lambda _: None)
+    result = loop.adapt(
+        scene, "mortar", opts, say=lambda _: None, count_dofs=overshoot_once, plan=recording
+    )
     assert len(budgets) == 2 and budgets[1] == pytest.approx(budgets[0] * 0.95 / 2)
     assert len(result.levels) == 2 and result.levels[1].dofs <= opts.max_dofs

@@ -35,7 +35,7 @@ def test_patch_test_has_no_residual() -> None:
 def test_parts_add_up_and_json() -> None:
     sol = contactfx.solve(_hertz(0.1), "mortar")
     est = estimate(sol)
-    s = est.summary()
+    s = est.summary().to_json()
     assert set(s["terms"]) == set(BULK_TERMS) | set(CONTACT_TERMS)
     assert np.isclose(s["total"] ** 2, s["bulk"] ** 2 + s["contact"] ** 2)
     assert np.isclose(sum(v**2 for v in s["terms"].values()), s["total"] ** 2)

@@ -37,6 +37,7 @@ def assert_names_the_floating_bodies(message: str) -> None:
 def test_stacked_blocks_carry_the_load_through_every_pair() -> None:
     """The correct stack: every pair carries p L = 20 along y (statics), balanced."""
     _, data = run_scene(load_scene_file(STACK), "mortar")
+    data = data.to_json()
     assert len(data["contacts"]) == 3
     for c in data["contacts"]:
         np.testing.assert_allclose(c["force"], [0.0, P * L], atol=1e-9 * P * L)

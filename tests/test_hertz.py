@@ -23,7 +23,7 @@ def mortar_finest() -> dict:
 
     The rates over the three levels are asserted per method in tests/test_study.py.
     """
-    return run_case("hertz", _graded(0.01, 0.141), "mortar", comm=MPI.COMM_SELF)[1]
+    return run_case("hertz", _graded(0.01, 0.141), "mortar", comm=MPI.COMM_SELF)[1].to_json()
 
 
 def test_exact_formulas_against_johnson() -> None:
@@ -66,6 +66,7 @@ def test_profile_matches_exact_on_coarse_graded_mesh(mortar_finest: dict) -> Non
 
 def test_active_set_iterations_bounded(multiplier_method: str) -> None:
     sol, data = run_case("hertz", _graded(0.02, 0.2), multiplier_method, comm=MPI.COMM_SELF)
+    data = data.to_json()
     assert data["iterations"] <= 4
     hist = data["active_set"]
     assert hist[-1]["entered"] == hist[-1]["left"] == 0
@@ -125,5 +126,6 @@ def test_block_scenes_still_one_iteration(preset: str) -> None:
     from contactfx.scenes import BLOCK_SCENES
 
     _, data = run_case("blocks", BLOCK_SCENES[preset], "mortar", comm=MPI.COMM_SELF)
+    data = data.to_json()
     assert data["iterations"] == 1
     assert data["active_nodes"] == data["multipliers"]

@@ -19,6 +19,7 @@ import pytest
 from conftest import ROOT
 
 from contactfx import load_scene_file, run_scene
+from contactfx.options import Method
 from contactfx.results.references import exact_pressure, hertz_summary
 from contactfx.scenes import HertzReference
 
@@ -71,10 +72,10 @@ def test_centre_of_exact_hertz_on_unsymmetric_nodes(h_left: float, h_right: floa
     s = np.sort(np.concatenate([left, right]))
     p = exact_pressure(s - c, a, p0)
     hz = hertz_summary(straight_pair(s, p, E, nu), HertzReference(0, R, P))  # type: ignore[arg-type]
-    assert hz["a_exact"] == pytest.approx(a) and hz["p0_exact"] == pytest.approx(p0)
-    assert abs(float(hz["s_centre"]) - c) < 0.01 * a, (hz["s_centre"], c, a)  # type: ignore[arg-type]
+    assert hz.a_exact == pytest.approx(a) and hz.p0_exact == pytest.approx(p0)
+    assert abs(hz.s_centre - c) < 0.01 * a, (hz.s_centre, c, a)
     expected = brute_l2(s - c, p, a, p0)
-    assert hz["l2_error"] == pytest.approx(expected, rel=0.05), (hz["l2_error"], expected)
+    assert hz.l2_error == pytest.approx(expected, rel=0.05), (hz.l2_error, expected)
 
 
 def graded_rotated_hertz(tmp: Path, h_left: float, h_right: float) -> Path:
@@ -103,19 +104,19 @@ def test_full_model_l2_error_measured_from_the_true_centre(tmp_path: Path) -> No
     Measured: 0.013754 reported, 0.013756 from the true centre (the old nodal mean of s
     reported 0.362); on 0.02 | 0.06 and 0.03 | 0.12 meshes they agree to 2e-3 and 8e-3.
     """
-    _, data = run_scene(load_scene_file(graded_rotated_hertz(tmp_path, 0.01, 0.04)), "mortar")
-    hz, itf = data["hertz"], data["contacts"][0]["interface"]
+    _, run = run_scene(load_scene_file(graded_rotated_hertz(tmp_path, 0.01, 0.04)), "mortar")
+    hz, itf = run.hertz[0], run.contacts[0].interface
     x, y, p = (np.asarray(itf[k], dtype=float) for k in ("x", "y", "pressure"))
     r = np.column_stack([x, y]) @ np.array([math.cos(math.pi / 6), math.sin(math.pi / 6)])
     left, right = r[p > 0].min(), r[p > 0].max()
     assert right / -left > 0.9 and np.sum((p > 0) & (r < 0)) > 2 * np.sum((p > 0) & (r > 0))
     # Hertz for the load along the true centre's normal (rotated y): R = 10, E* = E/(2(1-nu^2)).
-    load = float(np.dot(data["contacts"][0]["force"], [-0.5, math.cos(math.pi / 6)]))
+    load = float(np.dot(run.contacts[0].force, [-0.5, math.cos(math.pi / 6)]))
     a = math.sqrt(4 * abs(load) * 10.0 / (math.pi * 7000.0 / (2 * (1 - 0.3**2))))
     order = np.argsort(r)
     expected = brute_l2(r[order], p[order], a, 2 * abs(load) / (math.pi * a))
-    assert hz["l2_error"] == pytest.approx(expected, rel=1e-3), (hz["l2_error"], expected)
-    assert abs(hz["a"] / hz["a_exact"] - 1) < 0.01
+    assert hz.l2_error == pytest.approx(expected, rel=1e-3), (hz.l2_error, expected)
+    assert hz.a is not None and abs(hz.a / hz.a_exact - 1) < 0.01
 
 
 def test_pair_chart_places_exact_hertz_at_the_centre(
@@ -133,16 +134,16 @@ def test_pair_chart_places_exact_hertz_at_the_centre(
     cols = {k: list(p if k == "pressure" else 0 * s) for k in ("pressure", "gap")}
     cols |= {f"sigma_{k}_{side}": list(-p) for k in ("nn", "nt") for side in ("active", "passive")}
     itf = {"s": list(s), "active": list(p > 0), **cols}
-    contact = {"interface": itf, "active_body": "b1", "passive_body": "b2"}
-    data = {
-        "scene": "synthetic",
-        "method": "mortar",
-        "contacts": [{**contact, "active": "c1", "passive": "c2"}],
-        "hertz": {"pair": 0, "a_exact": 1.0, "p0_exact": 10.0, "s_centre": 0.05},
-    }
+    contact = SimpleNamespace(
+        interface=itf, active_body="b1", passive_body="b2", active="c1", passive="c2", obstacle=None
+    )
+    hertz = SimpleNamespace(pair=0, a_exact=1.0, p0_exact=10.0, s_centre=0.05)
+    run = SimpleNamespace(
+        scene="synthetic", method=Method.MORTAR, contacts=[contact], hertz=[hertz]
+    )
     figures: list[Figure] = []
     monkeypatch.setattr(Figure, "savefig", lambda fig, *_, **__: figures.append(fig))
-    plot_pair(data, 0, tmp_path / "pair.png")
+    plot_pair(run, 0, tmp_path / "pair.png")  # type: ignore[arg-type]
     (line,) = [ln for ln in figures[0].axes[0].lines if "exact Hertz" in str(ln.get_label())]
     xs = np.asarray(line.get_xdata(), dtype=float)
     assert 0.5 * (xs.min() + xs.max()) == pytest.approx(0.05, abs=1e-12)

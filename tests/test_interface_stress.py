@@ -17,12 +17,15 @@ measured within 5 % of the nodal average: the frame, not the averaging, was the 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
 from mpi4py import MPI
 
 from contactfx import run_case
+from contactfx.results import RunSummary
 from contactfx.results.figures import plot_interface, plot_pair
 from contactfx.scenes import HertzParams
 from contactfx.study.levels import hertz_at
@@ -41,7 +44,7 @@ def l2_over_zone(x: np.ndarray, v: np.ndarray, a: float, p0: float) -> float:
 
 
 @pytest.fixture(scope="module")
-def hertz_levels() -> list[dict]:
+def hertz_levels() -> list[RunSummary]:
     """The Hertz summaries at study levels f = 2 and f = 1 (the default mesh)."""
     return [
         run_case("hertz", hertz_at(HertzParams(), f), "mortar", comm=MPI.COMM_SELF)[1]
@@ -62,12 +65,12 @@ def measures(data: dict) -> dict[str, float]:
 
 
 @pytest.mark.serial
-def test_sigma_nt_tends_to_zero_and_sigma_nn_to_minus_p(hertz_levels: list[dict]) -> None:
+def test_sigma_nt_tends_to_zero_and_sigma_nn_to_minus_p(hertz_levels: list[RunSummary]) -> None:
     """Both sides, both components: smaller on the finer level at a rate of at least 0.7
     (measured 0.79 to 0.90; the Q1 stress rate is 1; before: 0.52 for the active sigma_nt),
     and the active sigma_nt below 1 % of p0 on the default mesh (before: 1.38 %)."""
-    coarse, fine = (measures(d) for d in hertz_levels)
-    ratio = hertz_levels[0]["elements"] / hertz_levels[1]["elements"]
+    coarse, fine = (measures(d.to_json()) for d in hertz_levels)
+    ratio = hertz_levels[0].elements / hertz_levels[1].elements
     h_ratio = 2.0  # h halves between the levels (tests/test_study.py)
     assert 0.3 < ratio < 0.5
     for key in coarse:
@@ -82,6 +85,7 @@ def test_uniform_stress_is_resolved_exactly_in_the_contact_frame() -> None:
     from contactfx.scenes import BLOCK_SCENES
 
     _, data = run_case("blocks", BLOCK_SCENES["S4"], "mortar", comm=MPI.COMM_SELF)
+    data = data.to_json()
     for key, value in data["patch"]["pairs"][0].items():
         assert value < 1e-8, (key, value)
 
@@ -101,15 +105,17 @@ def saved_axes(monkeypatch: pytest.MonkeyPatch) -> list:
 
 @pytest.mark.serial
 def test_pair_chart_zooms_on_the_contact_zone_without_a_reference(
-    hertz_levels: list[dict], tmp_path, monkeypatch: pytest.MonkeyPatch
+    hertz_levels: list[RunSummary], tmp_path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """With no Hertz block the pair chart (and the paper chart) still show the contact zone:
     the active zone and half its length on each side, not the whole contact curve (15 cm
     of arc, 1.44 of it in contact)."""
-    data = {k: v for k, v in hertz_levels[1].items() if k not in ("hertz", "hertz_pairs")}
+    record = replace(hertz_levels[1], hertz=())
     axes = saved_axes(monkeypatch)
-    plot_pair(data, 0, tmp_path / "pair.png")
-    plot_interface(data, tmp_path / "interface.png")
+    plot_pair(record, 0, tmp_path / "pair.png")
+    plot_interface(record, tmp_path / "interface.png")
+    data = record.to_json()
+    assert "hertz" not in data
     itf = data["contacts"][0]["interface"]
     s, x, act = column(itf, "s"), column(itf, "x"), np.asarray(itf["active"])
     for ax, coord in zip(axes, (s, x), strict=True):

@@ -46,6 +46,7 @@ def test_rigid_floor_patch_test_is_exact(floor: Scene, method: str, options: dic
     2e-11 to 4e-11 with every multiplier method: the floor is straight, so all of them are
     exact); the force on the floor is the load, along the floor's normal."""
     _, data = run_scene(floor, method, **options)
+    data = data.to_json()
     assert data["patch"]["max"] < 1e-8, data["patch"]
     c = data["contacts"][0]
     assert (c["passive"], c["passive_body"], c["active_body"]) == ("floor", "floor", "block")
@@ -59,6 +60,7 @@ def test_rigid_floor_penalty_error_is_its_penetration(floor: Scene) -> None:
     """Penalty leaves the uniform penetration p / eps, which the pinned corner (held at the
     exact, unpenetrated displacement) resists: errors of 2.9e-4 measured, band +-50 %."""
     _, data = run_scene(floor, "penalty")
+    data = data.to_json()
     assert 1.4e-4 < data["patch"]["max"] < 4.4e-4
     assert data["penetration"] == pytest.approx(10.0 / data["penalty"], rel=1e-6)
 
@@ -72,6 +74,7 @@ def test_pinned_contact_node_is_not_singular(floor: Scene) -> None:
     )
     for method, exact_pressure in (("nts", True), ("mortar", False)):
         _, data = run_scene(pinned, method)
+        data = data.to_json()
         patch = data["patch"]
         assert patch["bodies"]["block"] < 1e-8, (method, patch)
         if exact_pressure:
@@ -83,10 +86,11 @@ def test_pinned_contact_node_is_not_singular(floor: Scene) -> None:
 def indenter_hertz(scene: Scene, method: str, options: dict) -> dict:
     """Solve the rigid indenter; Hertz's a, p0, L2 with the line load P that it carries."""
     sol, data = run_scene(scene, method, **options)
+    data = data.to_json()
     c = data["contacts"][0]
     assert c["passive"] == "indenter" and c["obstacle"]["shape"] == "circle"
     P = 2.0 * abs(c["force"][1])  # the half model carries half the line load
-    return hertz_summary(sol, HertzReference(0, 20.0, P, symmetric=True))
+    return hertz_summary(sol, HertzReference(0, 20.0, P, symmetric=True)).to_json()
 
 
 @pytest.fixture(scope="module")
@@ -147,6 +151,7 @@ def test_flat_punch_matches_sadowsky(
     node takes 338 against NTS's 229); NTS and dual mortar keep the whole face closed. The
     punch carries no horizontal force (a flat face), and nothing beyond its edge."""
     _, data = run_scene(load_scene_file(DEMO_SCENES / "rigid_punch.toml"), method, **options)
+    data = data.to_json()
     interior, l1 = sadowsky_errors(data)
     assert interior < 0.01 and l1 < l1_high, (interior, l1)
     assert abs(data["contacts"][0]["force"][0]) < 1e-10 * abs(data["contacts"][0]["force"][1])
@@ -159,8 +164,8 @@ def test_flat_punch_matches_sadowsky(
 def test_flat_punch_converges_to_sadowsky() -> None:
     """Halving every mesh size: the interior error halves, L1 drops (sqrt(h) at the edge)."""
     path = DEMO_SCENES / "rigid_punch.toml"
-    coarse = sadowsky_errors(run_scene(load_scene_file(path, size_factor=2.0), "nts")[1])
-    fine = sadowsky_errors(run_scene(load_scene_file(path), "nts")[1])
+    coarse = sadowsky_errors(run_scene(load_scene_file(path, size_factor=2.0), "nts")[1].to_json())
+    fine = sadowsky_errors(run_scene(load_scene_file(path), "nts")[1].to_json())
     assert fine[0] < 0.6 * coarse[0] and fine[1] < 0.85 * coarse[1], (coarse, fine)
 
 
@@ -178,6 +183,7 @@ def test_block_resting_on_a_rigid_floor_is_held() -> None:
     scene = scene_from_gmsh(path, obstacles=[floor], **kwargs)
     for method in ("nts", "mortar"):
         _, data = run_scene(scene, method)
+        data = data.to_json()
         assert data["patch"]["max"] < 1e-8, data["patch"]
         assert data["contacts"][0]["force_passive"][1] == pytest.approx(-40.0, rel=1e-10)
     with pytest.raises(SingularSystemError, match="translation along y"):
@@ -196,7 +202,9 @@ def test_obstacle_and_body_pair_together_equal_a_roller() -> None:
     )
     for method in ("nts", "mortar"):
         sol_r, data_r = run_scene(roller, method)
+        data_r = data_r.to_json()
         sol_f, data_f = run_scene(scene, method)
+        data_f = data_f.to_json()
         ur, uf = u_at_points(sol_r), u_at_points(sol_f)
         assert np.abs(uf[:, 2:] - ur[:, 2:]).max() < 1e-10 * np.abs(ur[:, 2:]).max()
         pair, on_floor = data_f["contacts"]
@@ -220,6 +228,7 @@ def test_two_obstacles_on_one_body_balance(indenter: Scene) -> None:
     )
     sol_r, _ = run_scene(indenter, "mortar")
     sol, data = run_scene(scene, "mortar")
+    data = data.to_json()
     top, bottom = data["contacts"]
     assert (top["passive"], bottom["passive"]) == ("indenter", "floor")
     assert bottom["force"][1] == pytest.approx(-top["force"][1], rel=1e-10)
@@ -231,6 +240,7 @@ def test_coarse_predictor_carries_the_obstacles(indenter: Scene) -> None:
     """The coarse predictor remeshes the .geo with the obstacle: same converged answer."""
     sol_a, _ = run_scene(indenter, "mortar", predictor="none")
     sol_b, data_b = run_scene(indenter, "mortar", predictor="coarse")
+    data_b = data_b.to_json()
     assert "predictor" in data_b["times"]
     ua, ub = u_at_points(sol_a), u_at_points(sol_b)
     assert np.abs(ub[:, 2:] - ua[:, 2:]).max() < 1e-8 * np.abs(ua[:, 2:]).max()

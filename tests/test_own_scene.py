@@ -33,6 +33,7 @@ def test_inclined_patch_test_mortar_exact(inclined: Scene) -> None:
     """Mortar: pressure, sigma_nn = -p and sigma_nt = 0 on both sides, sigma = -p I in both
     bodies, to 1e-8 of p (measured 1.2e-9 to 1.5e-9, set by the point supports' values)."""
     _, data = run_scene(inclined, "mortar")
+    data = data.to_json()
     patch = data["patch"]
     assert patch["max"] < 1e-8, patch
     assert set(patch["bodies"]) == {"lower", "upper"}
@@ -66,6 +67,7 @@ def test_inclined_patch_test_nts_sts_fail_by_their_known_size(
     """NTS and STS do not pass the patch test on non-matching meshes: errors of 14-43 % of p,
     each of a known size (to rel 1e-3) with body 2 or body 1 active."""
     _, data = run_scene(inclined, method)
+    data = data.to_json()
     scene_file = request.node.callspec.params["inclined"]
     assert data["patch"]["max"] == pytest.approx(KNOWN_INCLINED[scene_file, method], rel=1e-3)
 
@@ -74,6 +76,7 @@ def test_two_cylinders_match_hertz() -> None:
     """R1 = 40, R2 = 60, dissimilar materials: a and p0 within 1 % of Hertz (R = 24)."""
     scene = load_scene_file(SCENES / "two_cylinders.toml")
     _, data = run_scene(scene, "mortar")
+    data = data.to_json()
     hz = data["hertz"]
     assert hz["a_exact"] == pytest.approx(1.1026159230931443, rel=1e-12)
     assert abs(hz["a"] / hz["a_exact"] - 1) < 0.01
@@ -85,6 +88,7 @@ def test_three_bodies_two_pairs_balance_and_hertz() -> None:
     """A cylinder between two blocks: each pair balances to 1e-8, carries P/2, and matches
     Hertz (a, p0 within 1 %)."""
     _, data = run_scene(load_scene_file(THREE_BODIES), "mortar")
+    data = data.to_json()
     assert len(data["contacts"]) == 2
     for c in data["contacts"]:
         assert c["balance"] < 1e-8
@@ -99,6 +103,7 @@ def test_three_bodies_two_pairs_balance_and_hertz() -> None:
 def test_every_method_on_the_three_body_scene(method: str) -> None:
     """All methods run on several pairs at once and carry the load through both pairs."""
     _, data = run_scene(load_scene_file(THREE_BODIES), method)
+    data = data.to_json()
     assert len(data["contacts"]) == 2
     for c in data["contacts"]:
         assert abs(c["force"][1]) == pytest.approx(50.0, rel=1e-7)
@@ -117,6 +122,7 @@ def test_schwarz_refuses_curved_pairs_clearly() -> None:
 def test_interface_along_the_normal_has_every_key() -> None:
     """contacts[k].interface holds x, y, s, pressure, gap and both sigma_nn, sigma_nt."""
     _, data = run_scene(load_scene_file(SCENES / "two_cylinders.toml"), "mortar")
+    data = data.to_json()
     itf = data["contacts"][0]["interface"]
     keys = {
         "x",
@@ -261,6 +267,7 @@ def test_from_gmsh_model_in_python() -> None:
     finally:
         gmsh.finalize()
     _, data = run_scene(scene, "mortar")
+    data = data.to_json()
     assert data["contacts"][0]["force"][1] == pytest.approx(3.0, rel=1e-10)
 
 

@@ -29,6 +29,7 @@ def test_patch_test_uniform_penetration(active: int) -> None:
     # Exact solution: sigma_yy = -p everywhere, pressure p, and a uniform penetration p / eps.
     eps = 1e7
     sol, data = run_case("blocks", S4, "penalty", active=active, penalty=eps, comm=MPI.COMM_SELF)
+    data = data.to_json()
     p = S4.p
     err = patch_errors(data["interface"], p)
     dev = body_stress_deviation(sol, -p)
@@ -46,6 +47,7 @@ def test_hertz_converges_to_mortar_like_one_over_eps() -> None:
     diffs = []
     for eps in (1e7, 1e8, 1e9):  # about 70, 700, 7000 E / h on this mesh
         sol, data = run_case("hertz", HERTZ, "penalty", penalty=eps, comm=MPI.COMM_SELF)
+        data = data.to_json()
         assert data["contact_force"] == pytest.approx(HERTZ.P / 2, rel=1e-9)
         assert np.array_equal(sol.layout.x, ref.layout.x)
         assert np.array_equal(sol.active, ref.active)
@@ -58,7 +60,9 @@ def test_hertz_converges_to_mortar_like_one_over_eps() -> None:
 def test_small_penalty_spreads_the_contact() -> None:
     # A soft penalty lets the cylinder sink in: more nodes carry load, the peak drops.
     stiff, d_stiff = run_case("hertz", HERTZ, "penalty", penalty=1e8, comm=MPI.COMM_SELF)
+    d_stiff = d_stiff.to_json()
     soft, d_soft = run_case("hertz", HERTZ, "penalty", penalty=1e3, comm=MPI.COMM_SELF)
+    d_soft = d_soft.to_json()
     assert soft.active.sum() > stiff.active.sum()
     assert d_soft["hertz"]["p0"] < 0.8 * d_stiff["hertz"]["p0"]
     assert d_soft["penetration"] > 100 * d_stiff["penetration"]
@@ -83,6 +87,7 @@ def test_default_penalty_penetration_is_load_over_stiffness() -> None:
     """The default eps (1e3 E_max / h) carries the uniform S4 pressure with the uniform
     penetration p / eps, measured on the displacement field itself (not on the gap)."""
     sol, data = run_case("blocks", S4, "penalty", comm=MPI.COMM_SELF)
+    data = data.to_json()
     eps = data["penalty"]
     # Jump of u_y across the interface at the multiplier nodes (x sorted, both bodies).
     u = u_at_points(sol)

@@ -43,3 +43,16 @@ def test_readme_says_what_a_solution_holds() -> None:
     pair_view = {f.name for f in dataclasses.fields(PairView)} | set(dir(PairView))
     for name in ("rows", "s", "n", "t", "frame"):
         assert f"`{name}`" in text and name in pair_view, name
+
+
+def test_readme_says_what_a_run_summary_holds() -> None:
+    """Every field of RunSummary is named, and the README's examples read real attributes."""
+    from contactfx.results import RunSummary
+
+    start = README.index("What a `RunSummary` holds")
+    text = README[start : README.index("\n\n", start)]
+    for f in dataclasses.fields(RunSummary):
+        assert f"`{f.name}`" in text, f.name
+    names = {f.name for f in dataclasses.fields(RunSummary)} | set(dir(RunSummary))
+    for name in ("hertz", "patch", "to_json", "with_estimate"):
+        assert name in names, name

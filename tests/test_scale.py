@@ -322,7 +322,9 @@ def test_run_case_coarse_predictor() -> None:
 
     params = HertzParams(refine=0.025, mesh="structured")
     base, s_base = run_case("hertz", params, "mortar", predictor="none")
+    s_base = s_base.to_json()
     sol, s = run_case("hertz", params, "mortar", predictor="coarse")
+    s = s.to_json()
     assert "predictor" in s["times"] and "predictor" not in s_base["times"]
     assert np.array_equal(sol.active, base.active)
     assert np.abs(sol.pressure - base.pressure).max() <= 1e-8 * np.abs(base.pressure).max()
@@ -344,6 +346,7 @@ def test_auto_predictor_by_candidate_rows() -> None:
     assert not use_coarse(Predictor.AUTO, few, SOLVERS["mumps"])
     assert use_coarse(Predictor.AUTO, many, SOLVERS["mumps"])
     sol, data = run_scene(many, "mortar")
+    data = data.to_json()
     assert abs(contact_facets(many) - data["multipliers"]) <= 1  # facets + 1 nodes per curve
     assert "predictor" in data["times"]
     assert max(h["probes"] for h in sol.history) < 0.1 * data["multipliers"]  # a band only

@@ -35,6 +35,7 @@ from ..contact.geometry import nodal_normals, project
 from ..discretize.elasticity import sigma
 from ..discretize.mesh_utils import vertex_to_block
 from ..methods.solution import Solution
+from ..results.records import EstimateSummary
 from ..scenes import Pressure
 from .facet_jumps import JUMP_DEGREE, FacetTraction, process_boundary_jumps, two_cell_facets
 from .pressure_estimate import PressureEstimate, pressure_estimate
@@ -84,21 +85,18 @@ class Estimate:
         """Total / ||u_h||_E."""
         return self.total / self.energy
 
-    def summary(self) -> dict[str, Any]:
-        """The JSON block `estimate`: relative total, contact and bulk parts, each term."""
+    def summary(self) -> EstimateSummary:
+        """The record of the JSON block `estimate`: relative total, parts and each term."""
         e = self.energy
-        return {
-            "total": self.relative,
-            "contact": self.contact / e,
-            "bulk": self.bulk / e,
-            "terms": {k: v / e for k, v in self.terms.items()},
-            "absolute": self.total,
-            "energy_norm": e,
-            "pressure": self.pressure.relative if self.pressure is not None else None,
-            "norm": "energy: sqrt(int sigma(u_h) : eps(u_h)); every value above but "
-            "absolute relative to it; pressure: the contact pressure's L2 error estimate "
-            "relative to ||p_h||_L2 (results/pressure_estimate.py)",
-        }
+        return EstimateSummary(
+            total=self.relative,
+            contact=self.contact / e,
+            bulk=self.bulk / e,
+            terms={k: v / e for k, v in self.terms.items()},
+            absolute=self.total,
+            energy_norm=e,
+            pressure=self.pressure.relative if self.pressure is not None else None,
+        )
 
 
 def _surface_nodes(sol: Solution, gblock: np.ndarray, S: fem.FunctionSpace) -> np.ndarray:

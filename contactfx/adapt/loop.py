@@ -14,16 +14,16 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from mpi4py import MPI
-
 from ..api import run_scene
 from ..errors import InputError
+from ..methods.predictor import scene_dofs
 from ..methods.solution import Solution
 from ..options import SolverSpec
+from ..results.records import RunSummary
 from ..scenes import Scene
 from ..timers import Timers
 from .estimate import Estimate, estimate
-from .sizing import SizingRule, plan_mesh
+from .sizing import Plan, SizingRule, plan_mesh
 
 # On a full budget, the pressure sizing goes on while its estimate falls below this fraction
 # of the previous level's.
@@ -84,12 +84,12 @@ class AdaptOptions:
             raise InputError(f"--pressure-tol must be > 0 (got {self.pressure_tol})")
 
 
-@dataclass
+@dataclass(frozen=True)
 class AdaptLevel:
-    """One solved level: its summary (with `estimate`), the solution and the estimate."""
+    """One solved level: its summary (with the estimate), the solution and the estimate."""
 
     index: int
-    summary: dict[str, Any]
+    summary: RunSummary
     solution: Solution
     est: Estimate
     time: float  # seconds: meshing (remesh) + solve + estimate
@@ -97,7 +97,16 @@ class AdaptLevel:
     @property
     def dofs(self) -> int:
         """Displacement DOFs of the level."""
-        return int(self.summary["dofs"])
+        return self.summary.dofs
+
+    def to_json(self) -> dict[str, Any]:
+        """The level's entry of adapt.json: the run's JSON, `estimate` the relative total."""
+        out = self.summary.to_json()
+        out["estimate"] = self.est.relative
+        out["estimate_parts"] = self.est.summary().to_json()
+        out["level"] = self.index
+        out["time"] = self.time
+        return out
 
 
 @dataclass
@@ -107,6 +116,29 @@ class AdaptResult:
     levels: list[AdaptLevel]
     stop: str
     uniform: list[AdaptLevel] = field(default_factory=list)
+
+    def to_json(self, scene: str, method: str, opts: AdaptOptions, solver: str) -> dict[str, Any]:
+        """adapt.json: the settings, every level (estimate a number), why the loop stopped.
+
+        `scene`, `method` and `solver` as the user named them.
+        """
+        return {
+            "scene": scene,
+            "method": method,
+            "settings": {
+                "tol": opts.tol,
+                "max_dofs": opts.max_dofs,
+                "max_levels": opts.max_levels,
+                "rate": opts.rule.rate,
+                "growth": opts.rule.growth,
+                "weight_contact": opts.rule.contact_weight,
+                "pressure_tol": opts.pressure_tol,
+                "solver": solver,
+            },
+            "stop": self.stop,
+            "levels": [lv.to_json() for lv in self.levels],
+            **({"uniform": [lv.to_json() for lv in self.uniform]} if self.uniform else {}),
+        }
 
 
 def solve_level(
@@ -119,7 +151,7 @@ def solve_level(
     paper_interface: bool,
     previous: Solution | None = None,
 ) -> AdaptLevel:
-    """Solve one mesh and estimate its error; the summary gets `estimate` (a number).
+    """Solve one mesh and estimate its error; the summary carries the estimate.
 
     `previous` (the level before) gives the first active set: remeshing a coarser copy of
     an adapted mesh for the predictor costs more than it saves, and gmsh may fail to
@@ -128,7 +160,7 @@ def solve_level(
     t0 = time.perf_counter()
     if previous is not None:
         options = {**options, "initial": previous}
-    sol, data = run_scene(
+    sol, run = run_scene(
         scene,
         method,
         solver=solver,
@@ -137,22 +169,13 @@ def solve_level(
         **options,
     )
     est = estimate(sol)
-    data["estimate"] = est.relative
-    data["estimate_parts"] = est.summary()
-    data["times"]["mesh"] = mesh_time
-    data["level"] = index
+    run = run.with_estimate(est.summary()).with_times(mesh=mesh_time)
     elapsed = mesh_time + time.perf_counter() - t0
-    data["time"] = elapsed
-    return AdaptLevel(index, data, sol, est, elapsed)
+    return AdaptLevel(index, run, sol, est, elapsed)
 
 
 # Remeshings with a smaller budget when gmsh's mesh exceeds --max-dofs.
 REPLANS = 2
-
-
-def _mesh_dofs(scene: Scene) -> int:
-    """Displacement DOFs a scene's mesh will have (Q1: two per vertex)."""
-    return 2 * scene.mesh.topology.index_map(0).size_global
 
 
 def adapt(
@@ -165,8 +188,14 @@ def adapt(
     paper_interface: bool = False,
     say: Callable[[str], None] | None = None,
     mesh_time: float = 0.0,
+    count_dofs: Callable[[Scene], int] = scene_dofs,
+    plan: Callable[..., Plan] = plan_mesh,
 ) -> AdaptResult:
-    """Run the adaptive loop from `scene` (collective); `say` prints progress (rank 0)."""
+    """Run the adaptive loop from `scene` (collective); `say` prints progress (rank 0).
+
+    `count_dofs` counts a remeshed scene's DOFs against the budget and `plan` sizes the next
+    mesh (`plan_mesh`'s arguments); tests pass their own to steer the loop.
+    """
     opts.check()
     scene.require_recipe()
     comm = scene.comm
@@ -186,38 +215,36 @@ def adapt(
             break
         if k + 1 == opts.max_levels:
             break
-        ratio = level.dofs / max(level.summary["elements"], 1)
+        ratio = level.dofs / max(level.summary.elements, 1)
         # 10 % margin: gmsh meets a size field only approximately.
         budget = 0.9 * opts.max_dofs / ratio
-        plan = plan_mesh(level.solution, level.est, opts.tol, budget, opts.rule, opts.pressure_tol)
+        sizes = plan(level.solution, level.est, opts.tol, budget, opts.rule, opts.pressure_tol)
         if (
-            plan.predicted > opts.tol
-            and plan.cells < 1.1 * level.summary["elements"]
+            sizes.predicted > opts.tol
+            and sizes.cells < 1.1 * level.summary.elements
             and opts.pressure_settled(level.est, levels[-2].est if k else None)
         ):
             stop = f"the next mesh would exceed --max-dofs {opts.max_dofs}"
             break
         t0 = time.perf_counter()
-        nxt = scene.remeshed_to(plan.field)
-        dofs = _mesh_dofs(nxt)
+        nxt = scene.remeshed_to(sizes.field)
+        dofs = count_dofs(nxt)
         for _ in range(REPLANS):
             if dofs <= opts.max_dofs:
                 break
             # gmsh overshot the budget: plan again for what fits, rather than stop a level
             # early (on Hertz the last level is the one the pressure target needs).
             budget *= 0.95 * opts.max_dofs / dofs
-            plan = plan_mesh(
-                level.solution, level.est, opts.tol, budget, opts.rule, opts.pressure_tol
-            )
-            nxt = scene.remeshed_to(plan.field)
-            dofs = _mesh_dofs(nxt)
+            sizes = plan(level.solution, level.est, opts.tol, budget, opts.rule, opts.pressure_tol)
+            nxt = scene.remeshed_to(sizes.field)
+            dofs = count_dofs(nxt)
         mesh_time = time.perf_counter() - t0
         if dofs > opts.max_dofs:
             stop = f"the next mesh would have {dofs} DOFs > --max-dofs {opts.max_dofs}"
             break
         say(
             f"  remeshed: {dofs} DOFs planned for a relative estimate of "
-            f"{plan.predicted:.3g} ({mesh_time:.2f} s)"
+            f"{sizes.predicted:.3g} ({mesh_time:.2f} s)"
         )
         scene = nxt
     say(f"stopped: {stop}")
@@ -246,7 +273,7 @@ def uniform_levels(
     out: list[AdaptLevel] = []
     current, mesh_time = scene, 0.0
     for k in range(max_levels):
-        if _mesh_dofs(current) > ratio**2 * max_dofs:
+        if scene_dofs(current) > ratio**2 * max_dofs:
             break
         level = solve_level(current, k, mesh_time, method, solver, options or {}, paper_interface)
         out.append(level)
@@ -261,26 +288,16 @@ def uniform_levels(
 
 def level_line(level: AdaptLevel) -> str:
     """One progress line: DOFs, estimate (contact and bulk), the reference error, time."""
-    d = level.summary
-    e = d["estimate_parts"]
+    run = level.summary
+    e = level.est.summary()
     ref = ""
-    if "hertz" in d:
-        ref = f", Hertz L2 {100 * d['hertz']['l2_error']:.3f} %"
-    elif "patch" in d:
-        ref = f", patch max {d['patch']['max']:.2e}"
-    pressure = f", pressure {100 * e['pressure']:.3g} %" if e.get("pressure") else ""
+    if run.hertz:
+        ref = f", Hertz L2 {100 * run.hertz[0].l2_error:.3f} %"
+    elif run.patch is not None:
+        ref = f", patch max {run.patch.max:.2e}"
+    pressure = f", pressure {100 * e.pressure:.3g} %" if e.pressure else ""
     return (
-        f"level {level.index}: {d['dofs']} DOFs, estimate {100 * e['total']:.3g} % "
-        f"(contact {100 * e['contact']:.3g} %, bulk {100 * e['bulk']:.3g} %{pressure}){ref}, "
+        f"level {level.index}: {run.dofs} DOFs, estimate {100 * e.total:.3g} % "
+        f"(contact {100 * e.contact:.3g} %, bulk {100 * e.bulk:.3g} %{pressure}){ref}, "
         f"{level.time:.2f} s"
     )
-
-
-def level_record(level: AdaptLevel) -> dict[str, Any]:
-    """The JSON of one level (the summary, with `estimate` the relative total)."""
-    return dict(level.summary)
-
-
-def rank_zero(comm: MPI.Comm) -> bool:
-    """Whether this is the rank that writes files."""
-    return comm.rank == 0

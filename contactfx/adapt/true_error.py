@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from mpi4py import MPI
 from scipy.spatial import cKDTree
 
 from ..methods.solution import Solution
@@ -170,9 +169,3 @@ def energy_error(sol: Solution, ref: Solution) -> dict[str, float] | None:
     err = float(np.sqrt(np.sum(weight * _energy_density(gref - gh, E, nu))))
     norm = float(np.sqrt(np.sum(weight * _energy_density(gref, E, nu))))
     return {"error": err, "norm": norm, "relative": err / norm}
-
-
-def energy_error_all(sol: Solution, ref: Solution, comm: MPI.Comm) -> dict[str, float]:
-    """energy_error, broadcast to every rank."""
-    out = energy_error(sol, ref)
-    return comm.bcast(out, root=0)

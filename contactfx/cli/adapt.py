@@ -6,16 +6,14 @@ import argparse
 import logging
 import time
 from pathlib import Path
-from typing import Any
 
 from mpi4py import MPI
 
 from ..adapt.charts import plot_adapt
-from ..adapt.loop import AdaptOptions, AdaptResult, adapt, level_record, uniform_levels
+from ..adapt.loop import AdaptOptions, adapt, uniform_levels
 from ..adapt.mesh_file import write_msh
 from ..adapt.sizing import SizingRule, default_contact_weight
 from ..errors import InputError
-from ..options import Method
 from ..results.files import write_fields, write_json
 from ..scenes import parse_scene_file
 from .params import build_from_args, is_scene_file, reject_structured_adapt, spec_from_args
@@ -33,27 +31,6 @@ def check_remeshable(args: argparse.Namespace) -> None:
     reject_structured_adapt(args)
 
 
-def adapt_json(args: argparse.Namespace, result: AdaptResult, opts: AdaptOptions) -> dict[str, Any]:
-    """adapt.json: the settings, every level's summary (estimate a number), why it stopped."""
-    return {
-        "scene": args.scene,
-        "method": args.method,
-        "settings": {
-            "tol": opts.tol,
-            "max_dofs": opts.max_dofs,
-            "max_levels": opts.max_levels,
-            "rate": opts.rule.rate,
-            "growth": opts.rule.growth,
-            "weight_contact": opts.rule.contact_weight,
-            "pressure_tol": opts.pressure_tol,
-            "solver": args.solver,
-        },
-        "stop": result.stop,
-        "levels": [level_record(lv) for lv in result.levels],
-        **({"uniform": [level_record(lv) for lv in result.uniform]} if result.uniform else {}),
-    }
-
-
 def contact_weight(args: argparse.Namespace) -> float:
     """--weight-contact, or its default (10, or 1 with --pressure-tol)."""
     if args.weight_contact is not None:
@@ -66,8 +43,6 @@ def run_adapt(args: argparse.Namespace) -> int:
     comm = MPI.COMM_WORLD
     if not args.verbose:
         logging.getLogger("contactfx").setLevel(logging.WARNING)
-    if args.method in (Method.SCHWARZ.value,):
-        raise InputError("adapt needs a multiplier or penalty method (nts, sts, mortar, penalty)")
     opts = AdaptOptions(
         args.tol,
         args.max_dofs,
@@ -115,15 +90,14 @@ def run_adapt(args: argparse.Namespace) -> int:
     msh = write_msh(final.solution, out / "mesh.msh")
     if comm.rank == 0:
         assert msh is not None
-        data = adapt_json(args, result, opts)
-        write_json(out / "adapt.json", data)
-        uni = data.get("uniform", [])
+        write_json(out / "adapt.json", result.to_json(args.scene, args.method, opts, args.solver))
+        levels, uni = result.levels, result.uniform
         title = f"{args.scene}, {args.method}: adaptive against uniform refinement"
         written += [
             out / "adapt.json",
             msh,
-            plot_adapt(data["levels"], uni, out / "adapt_dofs.png", "dofs", title),
-            plot_adapt(data["levels"], uni, out / "adapt_time.png", "time", title),
+            plot_adapt(levels, uni, out / "adapt_dofs.png", "dofs", title),
+            plot_adapt(levels, uni, out / "adapt_time.png", "time", title),
         ]
         print("wrote " + ", ".join(str(p) for p in written))
     return 0

@@ -15,45 +15,46 @@ from ..errors import InputError
 from ..options import Method
 from ..results.figures import contact_window, deformed_fields, plot_interface, plot_pair
 from ..results.files import write_contact_surfaces, write_fields, write_json
+from ..results.records import RunSummary
 from ..timers import Timers
 from .params import build_from_args, is_scene_file, spec_from_args
 
 
-def terminal_summary(data: dict[str, Any]) -> list[str]:
+def terminal_summary(run: RunSummary) -> list[str]:
     """What a user came for, last: each pair's force, and the errors against references."""
     lines = [
-        f"{data['scene']} / {data['method']}: {data['dofs']} dofs, "
-        f"{data['multipliers']} multipliers, {data['iterations']} iterations, "
-        f"total {data['times']['total']:.2f} s"
+        f"{run.scene} / {run.method.value}: {run.dofs} dofs, "
+        f"{run.multipliers} multipliers, {run.iterations} iterations, "
+        f"total {run.times['total']:.2f} s"
     ]
-    for k, c in enumerate(data["contacts"]):
-        f = c["force"]
+    for k, c in enumerate(run.contacts):
+        f = c.force
         lines.append(
-            f"pair {k} ({c['active']} on {c['passive']}): force ({f[0]:.6g}, "
-            f"{f[1]:.6g}), balance {c['balance']:.1e}, {c['active_nodes']} active nodes"
+            f"pair {k} ({c.active} on {c.passive}): force ({f[0]:.6g}, "
+            f"{f[1]:.6g}), balance {c.balance:.1e}, {c.active_nodes} active nodes"
         )
-    if "patch" in data:
+    if run.patch is not None:
         lines.append(
-            f"patch test: max stress/pressure error {data['patch']['max']:.2e} "
+            f"patch test: max stress/pressure error {run.patch.max:.2e} "
             "(relative to the exact uniform stress)"
         )
-    for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else []):
-        a = h["a"]
-        a_err = f"{100 * (a / h['a_exact'] - 1):+.2f} %" if a else "n/a"
+    for h in run.hertz:
+        a = h.a
+        a_err = f"{100 * (a / h.a_exact - 1):+.2f} %" if a else "n/a"
         lines.append(
-            f"Hertz, pair {h['pair']}: a = {a or float('nan'):.4g} (exact "
-            f"{h['a_exact']:.4g}, {a_err}), p0 = {h['p0']:.4g} (exact "
-            f"{h['p0_exact']:.4g}, {100 * (h['p0'] / h['p0_exact'] - 1):+.2f} %), "
-            f"L2 error {100 * h['l2_error']:.2f} %"
+            f"Hertz, pair {h.pair}: a = {a or float('nan'):.4g} (exact "
+            f"{h.a_exact:.4g}, {a_err}), p0 = {h.p0:.4g} (exact "
+            f"{h.p0_exact:.4g}, {100 * (h.p0 / h.p0_exact - 1):+.2f} %), "
+            f"L2 error {100 * h.l2_error:.2f} %"
         )
-    if "estimate" in data:
-        e = data["estimate"]
+    e = run.estimate
+    if e is not None:
         lines.append(
-            f"estimate (relative to the energy norm): {100 * e['total']:.3g} % (contact "
-            f"{100 * e['contact']:.3g} %, bulk {100 * e['bulk']:.3g} %)"
+            f"estimate (relative to the energy norm): {100 * e.total:.3g} % (contact "
+            f"{100 * e.contact:.3g} %, bulk {100 * e.bulk:.3g} %)"
         )
-        if e.get("pressure"):
-            lines.append(f"pressure estimate (relative L2): {100 * e['pressure']:.3g} %")
+        if e.pressure:
+            lines.append(f"pressure estimate (relative L2): {100 * e.pressure:.3g} %")
     return lines
 
 
@@ -70,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     timers = Timers()
     with timers("mesh"):
         scene = build_from_args(args)
-    sol, data = run_scene(
+    sol, record = run_scene(
         scene,
         method,
         solver=spec,
@@ -83,35 +84,34 @@ def run(args: argparse.Namespace) -> int:
         predictor=args.predictor,
         basis=args.basis,
     )
-    data["solver"] = "mumps (each body)" if method is Method.SCHWARZ else args.solver
     cells: tuple[Any, ...] = ()
     if args.estimate:
         est = estimate(sol)
-        data["estimate"] = est.summary()
+        record = record.with_estimate(est.summary())
         cells = (est.eta,)
     if args.out is not None:
         write_fields(sol, args.out, cells)
     log = logging.getLogger("contactfx")
     if comm.rank == 0:
         if args.json is not None:
-            write_json(args.json, data)
+            write_json(args.json, record.to_json())
             log.info("wrote %s", args.json)
         if args.out is not None:
-            written = write_contact_surfaces(data, args.out)
+            written = write_contact_surfaces(record, args.out)
             written += [
-                plot_pair(data, k, args.out / f"interface_pair{k}.png")
-                for k in range(len(data["contacts"]))
+                plot_pair(record, k, args.out / f"interface_pair{k}.png")
+                for k in range(len(record.contacts))
             ]
-            if "interface" in data:
-                written.append(plot_interface(data, args.out / "interface.png"))
+            if record.interface is not None:
+                written.append(plot_interface(record, args.out / "interface.png"))
             if sol.scene.obstacles:
                 # The body against the obstacles' outlines, true scale, on the contact zone
                 # (a magnified deformation would not magnify the gaps with it); serial only.
                 picture = deformed_fields(
-                    sol, args.out / "fields.png", scale=1.0, window=contact_window(data)
+                    sol, args.out / "fields.png", scale=1.0, window=contact_window(record)
                 )
                 written += [picture] if picture is not None else []
             log.info("wrote fields.pvtu, %s to %s", ", ".join(p.name for p in written), args.out)
-        for line in terminal_summary(data):
+        for line in terminal_summary(record):
             print(line)
     return 0

@@ -172,10 +172,6 @@ class Solution:
         imap = self.fields.V.dofmap.index_map
         return imap.size_global * self.fields.V.dofmap.index_map_bs
 
-    def rows_of(self, pair: int) -> np.ndarray:
-        """Layout rows of contact pair `pair`."""
-        return self.pairs[pair].rows
-
 
 def gather_all(comm: MPI.Comm, local: np.ndarray) -> np.ndarray:
     """Concatenate every rank's rows (in rank order), on every rank."""

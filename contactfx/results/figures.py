@@ -1,6 +1,6 @@
 """Figures of a run: the contact line charts (matplotlib) and the deformed fields (pyvista).
 
-The deformed-field picture is like the paper's Fig. 3; the charts read the JSON summary.
+The deformed-field picture is like the paper's Fig. 3; the charts read the run's summary record.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import numpy as np
 
 from ..methods.solution import Solution
 from .obstacles import outline
+from .records import RunSummary
 from .stress import sigma_field
 
 
@@ -94,12 +95,12 @@ def _zoom(plotter: Any, window: tuple[float, float, float, float]) -> None:
     cam.parallel_scale = 0.5 * max(y1 - y0, 0.75 * (x1 - x0))
 
 
-def contact_window(data: dict[str, Any]) -> tuple[float, float, float, float] | None:
+def contact_window(run: RunSummary) -> tuple[float, float, float, float] | None:
     """A window on the active nodes of the obstacle pairs (three times their extent)."""
     pts = []
-    for c in data["contacts"]:
-        itf = c["interface"]
-        if "obstacle" in c:
+    for c in run.contacts:
+        itf = c.interface
+        if c.obstacle is not None:
             pts += [(x, y) for x, y, a in zip(itf["x"], itf["y"], itf["active"], strict=True) if a]
     if not pts:
         return None
@@ -124,14 +125,15 @@ def contact_zoom(s: np.ndarray, active: np.ndarray) -> tuple[float, float] | Non
     return max(float(np.nanmin(s)), lo - margin), min(float(np.nanmax(s)), hi + margin)
 
 
-def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
+def plot_interface(run: RunSummary, path: Path, title: str = "") -> Path:
     """Chart sigma_yy of both bodies and the contact pressure along the contact line."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    itf = data["interface"]
+    itf = run.interface
+    assert itf is not None, "the run has no paper_interface block"
     x = np.asarray(itf["x"])
     fig, ax = plt.subplots(figsize=(7, 4), layout="constrained")
     for key, style, label in (
@@ -141,9 +143,9 @@ def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
         vals = np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
         ax.plot(x, vals, style, label=label)
     ax.plot(x, -np.asarray(itf["pressure"]), ":", label="-pressure (multipliers)")
-    if "hertz" in data:
+    if run.hertz:
         # Zoom on the contact zone and show the exact plane-strain Hertz profile.
-        a, p0 = data["hertz"]["a_exact"], data["hertz"]["p0_exact"]
+        a, p0 = run.hertz[0].a_exact, run.hertz[0].p0_exact
         xs = np.linspace(0.0, 2.0 * a, 400)
         ax.plot(
             xs,
@@ -160,7 +162,7 @@ def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
             ax.set_xlim(*zoom)
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("MPa")
-    ax.set_title(title or f"{data['scene']} / {data['method']}: contact line")
+    ax.set_title(title or f"{run.scene} / {run.method.value}: contact line")
     ax.grid(alpha=0.3)
     ax.legend()
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -169,15 +171,15 @@ def plot_interface(data: dict[str, Any], path: Path, title: str = "") -> Path:
     return path
 
 
-def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
+def plot_pair(run: RunSummary, k: int, path: Path) -> Path:
     """Chart pair k along s: pressure, -sigma_nn and sigma_nt of both bodies (and Hertz)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    c = data["contacts"][k]
-    itf = c["interface"]
+    c = run.contacts[k]
+    itf = c.interface
 
     def arr(key: str) -> np.ndarray:
         return np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
@@ -187,23 +189,16 @@ def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
         2, 1, figsize=(7, 5.5), sharex=True, layout="constrained", height_ratios=(3, 1.3)
     )
     ax.plot(s, arr("pressure"), "k.-", ms=3, lw=1, label="pressure (multipliers)")
-    ax.plot(s, -arr("sigma_nn_active"), "-", label=f"-sigma_nn {c['active_body']} (active)")
+    ax.plot(s, -arr("sigma_nn_active"), "-", label=f"-sigma_nn {c.active_body} (active)")
     bx.plot(s, arr("sigma_nt_active"), "-", label="active")
-    if "obstacle" not in c:  # a rigid obstacle has no stress to show
-        ax.plot(s, -arr("sigma_nn_passive"), "--", label=f"-sigma_nn {c['passive_body']} (passive)")
+    if c.obstacle is None:  # a rigid obstacle has no stress to show
+        ax.plot(s, -arr("sigma_nn_passive"), "--", label=f"-sigma_nn {c.passive_body} (passive)")
         bx.plot(s, arr("sigma_nt_passive"), "--", label="passive")
-    hertz = [
-        h
-        for h in data.get("hertz_pairs", [data["hertz"]] if "hertz" in data else [])
-        if h.get("pair") == k
-    ]
+    hertz = [h for h in run.hertz if h.pair == k]
     if hertz:
         # The exact profile placed at the centre the L2 error is measured from (the peak node
-        # is off it by up to a node spacing); a summary from before s_centre: at the peak.
-        h = hertz[0]
-        a, p0 = h["a_exact"], h["p0_exact"]
-        sc = h.get("s_centre")
-        sc = float(s[int(np.nanargmax(arr("pressure")))]) if sc is None else float(sc)
+        # is off it by up to a node spacing).
+        a, p0, sc = hertz[0].a_exact, hertz[0].p0_exact, hertz[0].s_centre
         xs = np.linspace(-a, a, 400)
         ax.plot(
             sc + xs,
@@ -224,8 +219,8 @@ def plot_pair(data: dict[str, Any], k: int, path: Path) -> Path:
     ax.set_ylabel("normal traction (compression > 0)")
     bx.set_ylabel("sigma_nt")
     bx.set_xlabel("s, arc length along the active surface")
-    on = f"obstacle '{c['passive']}'" if "obstacle" in c else c["passive"]
-    ax.set_title(f"{data['scene']} / {data['method']}: pair {k}, {c['active']} on {on}")
+    on = f"obstacle '{c.passive}'" if c.obstacle is not None else c.passive
+    ax.set_title(f"{run.scene} / {run.method.value}: pair {k}, {c.active} on {on}")
     for a_ in (ax, bx):
         a_.grid(alpha=0.3)
     ax.legend(fontsize=8)

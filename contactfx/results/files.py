@@ -12,8 +12,10 @@ import numpy as np
 from dolfinx import fem
 
 from ..methods.solution import Solution
+from ..scenes import Obstacle
 from .interface import INTERFACE_FIELDS
-from .obstacles import from_summary, outline
+from .obstacles import outline
+from .records import RunSummary
 from .stress import sigma_field
 
 
@@ -116,7 +118,7 @@ def _vtk_type(a: np.ndarray) -> str:
     ]
 
 
-def write_contact_surfaces(data: dict[str, Any], outdir: Path) -> list[Path]:
+def write_contact_surfaces(run: RunSummary, outdir: Path) -> list[Path]:
     """One VTK polyline per pair (open in ParaView): pressure, gap and the active flag.
 
     Each rigid obstacle also gets its outline, `obstacle_NAME.vtp`, at its reference
@@ -125,26 +127,25 @@ def write_contact_surfaces(data: dict[str, Any], outdir: Path) -> list[Path]:
     import pyvista
 
     written = []
-    for k, c in enumerate(data["contacts"]):
-        itf = c["interface"]
+    for k, c in enumerate(run.contacts):
+        itf = c.interface
         pts = np.column_stack([itf["x"], itf["y"], np.zeros(len(itf["x"]))])
         line = pyvista.lines_from_points(pts) if len(pts) > 1 else pyvista.PolyData(pts)
         for key in INTERFACE_FIELDS[2:]:  # all but the coordinates
             line.point_data[key] = np.array([np.nan if v is None else v for v in itf[key]])
         line.point_data["active"] = np.asarray(itf["active"], dtype=np.int8)
-        path = outdir / f"contact{k}_{c['active']}.vtp"
+        path = outdir / f"contact{k}_{c.active}.vtp"
         line.save(str(path))
         written.append(path)
-        if "obstacle" in c:
-            written.append(_write_outline(c, pts[:, :2], outdir))
+        if c.obstacle is not None:
+            written.append(_write_outline(c.obstacle, pts[:, :2], outdir))
     return written
 
 
-def _write_outline(entry: dict[str, Any], near: np.ndarray, outdir: Path) -> Path:
-    """The outline of the obstacle of a `contacts` entry as a VTK polyline."""
+def _write_outline(ob: Obstacle, near: np.ndarray, outdir: Path) -> Path:
+    """The outline of an obstacle as a VTK polyline."""
     import pyvista
 
-    ob = from_summary(entry)
     xy = outline(ob, near)
     line = pyvista.lines_from_points(np.column_stack([xy, np.zeros(len(xy))]))
     line.point_data["displacement"] = np.tile([*ob.displacement, 0.0], (len(xy), 1))

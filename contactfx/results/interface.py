@@ -7,7 +7,7 @@ the multipliers act along (the passive surface's), and tau perpendicular to it (
 direction of increasing arc length s along the active surface). On a frictionless contact
 sigma_nt then tends to 0 and sigma_nn to -p at the discretization's order also on curved
 pairs, where the active surface's own normal differs from nu by the slope (docs/hertz.md).
-The JSON assembly is in results/summary.py.
+The records are assembled in results/summary.py.
 """
 
 from __future__ import annotations
@@ -18,8 +18,7 @@ import numpy as np
 
 from ..contact.geometry import project
 from ..methods.solution import Solution
-from ..scenes import Obstacle
-from ..scenes.model import OBSTACLE_SHAPES
+from .records import ContactSummary
 from .stress import nodal_stress, surface_stress
 
 # The numeric columns of every pair's `interface` (plus the boolean `active`), in order.
@@ -96,42 +95,28 @@ def pair_forces(sol: Solution, k: int) -> tuple[np.ndarray, np.ndarray]:
     return fa, fp
 
 
-def contacts_summary(sol: Solution) -> list[dict[str, Any]]:
-    """The `contacts` list of the JSON: one entry per pair, in the scene's order."""
+def contacts_summary(sol: Solution) -> tuple[ContactSummary, ...]:
+    """One ContactSummary per pair, in the scene's order."""
     out = []
     for k, pv in enumerate(sol.pairs):
         fa, fp = pair_forces(sol, k)
         out.append(
-            {
-                "active": pv.pair.active,
-                "passive": pv.pair.passive,
-                "active_body": pv.active_body.name,
+            ContactSummary(
+                active=pv.pair.active,
+                passive=pv.pair.passive,
+                active_body=pv.active_body.name,
                 # An obstacle pair names the obstacle on both passive keys.
-                "passive_body": pv.pair.passive
-                if pv.passive_body is None
-                else pv.passive_body.name,
-                "force": fa.tolist(),
-                "force_passive": fp.tolist(),
-                "balance": float(np.linalg.norm(fa + fp) / max(np.linalg.norm(fa), 1e-300)),
-                "multipliers": len(pv.rows),
-                "active_nodes": int(sol.active[pv.rows].sum()),
-                "interface": pair_interface(sol, k),
-                **({} if pv.obstacle is None else {"obstacle": obstacle_summary(pv.obstacle)}),
-            }
+                passive_body=pv.pair.passive if pv.passive_body is None else pv.passive_body.name,
+                force=(float(fa[0]), float(fa[1])),
+                force_passive=(float(fp[0]), float(fp[1])),
+                balance=float(np.linalg.norm(fa + fp) / max(np.linalg.norm(fa), 1e-300)),
+                multipliers=len(pv.rows),
+                active_nodes=int(sol.active[pv.rows].sum()),
+                interface=pair_interface(sol, k),
+                obstacle=pv.obstacle,
+            )
         )
-    return out
-
-
-def obstacle_summary(ob: Obstacle) -> dict[str, Any]:
-    """An obstacle as the JSON gives it: its shape, parameters and prescribed displacement."""
-    params = {key: getattr(ob, key) for key in OBSTACLE_SHAPES[ob.shape]}
-    if ob.points is not None:
-        params["points"] = [list(p) for p in ob.points]
-    return {
-        "shape": ob.shape,
-        **{k: list(v) if isinstance(v, tuple) else v for k, v in params.items()},
-        "displacement": list(ob.displacement),
-    }
+    return tuple(out)
 
 
 def cartesian_interface(sol: Solution) -> dict[str, list[float | None]]:

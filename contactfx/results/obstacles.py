@@ -1,4 +1,4 @@
-"""Rigid obstacles in the output: their outlines, from the scene or from the JSON summary."""
+"""Rigid obstacles in the output: their outlines, from the scene, and their JSON block."""
 
 from __future__ import annotations
 
@@ -23,11 +23,13 @@ def outline(ob: Obstacle, near: np.ndarray) -> np.ndarray:
     return shape.outline()
 
 
-def from_summary(entry: dict[str, Any]) -> Obstacle:
-    """The Obstacle of a JSON `contacts` entry (its `obstacle` block, results.interface)."""
-    block = entry["obstacle"]
-    shape = block["shape"]
-    params: dict[str, Any] = {key: block[key] for key in OBSTACLE_SHAPES[shape]}
-    return Obstacle(
-        entry["passive"], shape, entry["active"], displacement=block["displacement"], **params
-    )
+def obstacle_json(ob: Obstacle) -> dict[str, Any]:
+    """An obstacle as the JSON gives it: its shape, parameters and prescribed displacement."""
+    params = {key: getattr(ob, key) for key in OBSTACLE_SHAPES[ob.shape]}
+    if ob.points is not None:
+        params["points"] = [list(p) for p in ob.points]
+    return {
+        "shape": ob.shape,
+        **{k: list(v) if isinstance(v, tuple) else v for k, v in params.items()},
+        "displacement": list(ob.displacement),
+    }

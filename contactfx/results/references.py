@@ -10,14 +10,14 @@ the arc length: the first moment of the piecewise-linear pressure (`pressure_cen
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from mpi4py import MPI
 
 from ..methods.solution import Solution
-from ..scenes import HertzReference, Scene
+from ..scenes import HertzReference, Scene, UniformStress
 from .interface import pair_forces, pair_interface, resolve
+from .records import HertzErrors, PatchErrors
 from .stress import body_vertex_stress
 
 
@@ -120,8 +120,8 @@ def centre_distance(
     return r, p, act, tc, sc
 
 
-def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> dict[str, object]:
-    """The `hertz` block of the JSON: fitted and bracketed half-width, p0 and the L2 error."""
+def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> HertzErrors:
+    """The pair's errors against Hertz: fitted and bracketed half-width, p0 and the L2 error."""
     if ref is None:
         ref = next(r for r in sol.scene.references if isinstance(r, HertzReference))
     r, p, act, tc, sc = centre_distance(sol, ref)
@@ -132,19 +132,19 @@ def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> dict[str,
     ra = np.abs(r[act])
     last = float(ra.max()) if ra.size else 0.0
     beyond = np.abs(r[(~act) & (np.abs(r) > last)])
-    return {
-        "pair": ref.pair,
-        "s_centre": sc,
-        "a": fit_half_width(r[act], p[act]),
-        "a_bracket": [last, float(beyond.min()) if beyond.size else None],
-        "a_exact": exact["a"],
-        "p0": float(p.max()),
-        "p0_exact": exact["p0"],
-        "E_star": exact["E_star"],
-        "P": load,
-        "P_source": "given" if ref.P is not None else "computed (the pair's contact force)",
-        "l2_error": l2_error(r, p, exact["a"], exact["p0"], both_sides=not ref.symmetric),
-    }
+    return HertzErrors(
+        pair=ref.pair,
+        s_centre=sc,
+        a=fit_half_width(r[act], p[act]),
+        a_bracket=(last, float(beyond.min()) if beyond.size else None),
+        a_exact=exact["a"],
+        p0=float(p.max()),
+        p0_exact=exact["p0"],
+        E_star=exact["E_star"],
+        P=load,
+        P_source="given" if ref.P is not None else "computed (the pair's contact force)",
+        l2_error=l2_error(r, p, exact["a"], exact["p0"], both_sides=not ref.symmetric),
+    )
 
 
 def _max_error(values: list[float | None], exact: np.ndarray, scale: float) -> float:
@@ -153,12 +153,13 @@ def _max_error(values: list[float | None], exact: np.ndarray, scale: float) -> f
     return float(np.nanmax(np.abs(v - exact), initial=0.0) / scale)
 
 
-def uniform_stress_errors(sol: Solution, ref: np.ndarray) -> dict[str, Any]:
+def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
     """Patch test against a uniform stress: max errors relative to the largest |ref_ij|."""
+    sigma = np.asarray(ref.sigma, dtype=float)
     comm = sol.scene.comm
-    scale = float(np.abs(ref).max())
+    scale = float(np.abs(sigma).max())
     bodies = {
-        name: comm.allreduce(float(np.max(np.abs(v - ref), initial=0.0)), op=MPI.MAX) / scale
+        name: comm.allreduce(float(np.max(np.abs(v - sigma), initial=0.0)), op=MPI.MAX) / scale
         for name, v in body_vertex_stress(sol).items()
     }
     pairs = []
@@ -166,7 +167,7 @@ def uniform_stress_errors(sol: Solution, ref: np.ndarray) -> dict[str, Any]:
         itf = pair_interface(sol, k)
         order = np.argsort(pv.s, kind="stable")
         nu, tau, _ = (v[order] for v in pv.frame)
-        sig = np.broadcast_to(ref, (len(nu), 2, 2))
+        sig = np.broadcast_to(sigma, (len(nu), 2, 2))
         # The exact values of the columns: each side's traction in the contact frame.
         nn_a, nt_a = resolve(sig, pv.n[order], nu, tau)
         nn_p, nt_p = resolve(sig, nu, nu, tau)
@@ -184,8 +185,9 @@ def uniform_stress_errors(sol: Solution, ref: np.ndarray) -> dict[str, Any]:
                 },
             }
         )
-    return {
-        "bodies": bodies,
-        "pairs": pairs,
-        "max": max([*bodies.values(), *(v for p in pairs for v in p.values())]),
-    }
+    return PatchErrors(
+        sigma=ref.sigma,
+        bodies=bodies,
+        pairs=tuple(pairs),
+        max=max([*bodies.values(), *(v for p in pairs for v in p.values())]),
+    )

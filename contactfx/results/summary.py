@@ -1,88 +1,104 @@
-"""The JSON summary of a run: sizes, costs, every pair's results and the scene's references."""
+"""The summary of a run: sizes, costs, every pair's results and the scene's references.
+
+`summary` builds the RunSummary record (results/records.py) that `run_scene` returns; its
+`to_json()` is the JSON of `contactfx solve --json`.
+"""
 
 from __future__ import annotations
 
-from typing import Any
-
-import numpy as np
-
 from ..methods.solution import Solution
+from ..options import Method, SolverSpec
 from ..scenes import HertzReference, UniformStress
 from .interface import cartesian_interface, contacts_summary
+from .records import (
+    ContactSummary,
+    EstimateSummary,
+    HertzErrors,
+    MethodExtras,
+    PatchErrors,
+    RunSummary,
+)
 from .references import hertz_summary, uniform_stress_errors
 
+__all__ = [
+    "ContactSummary",
+    "EstimateSummary",
+    "HertzErrors",
+    "MethodExtras",
+    "PatchErrors",
+    "RunSummary",
+    "method_extras",
+    "solver_label",
+    "summary",
+]
 
-def reference_results(sol: Solution) -> dict[str, Any]:
-    """Errors against each analytic reference the scene carries (keys `hertz`, `patch`)."""
-    hertz = [hertz_summary(sol, r) for r in sol.scene.references if isinstance(r, HertzReference)]
-    out: dict[str, Any] = {}
-    if hertz:
-        out["hertz"] = hertz[0]
-        if len(hertz) > 1:
-            out["hertz_pairs"] = hertz
-    for r in sol.scene.references:
-        if isinstance(r, UniformStress):
-            out["patch"] = {
-                "sigma": [list(row) for row in r.sigma],
-                **uniform_stress_errors(sol, np.asarray(r.sigma, dtype=float)),
-            }
-    return out
+# Schwarz factorizes each body with MUMPS, whatever solver the run was given.
+SCHWARZ_SOLVER = "mumps (each body)"
+SCHWARZ_SOLVES = "mumps (each body factorized once)"
 
 
-def method_results(sol: Solution) -> dict[str, Any]:
+def solver_label(method: Method, spec: SolverSpec) -> str:
+    """The label of the linear solver a run used: the spec's name, or Schwarz's own."""
+    return SCHWARZ_SOLVER if method is Method.SCHWARZ else spec.name
+
+
+def method_extras(sol: Solution) -> MethodExtras:
     """What only some methods report: mortar's basis, penalty's stiffness, Schwarz's roles."""
-    out: dict[str, Any] = {}
-    if sol.basis.value != "standard":
-        out["basis"] = sol.basis.value
-    if sol.penalty is not None:
-        out["penalty"] = sol.penalty.eps
-        out["penetration"] = sol.penalty.penetration
-        if sol.penalty.condition is not None:
-            out["condition"] = sol.penalty.condition
-    if sol.schwarz_dirichlet_body is not None:
-        out["schwarz"] = {
-            "dirichlet_body": sol.schwarz_dirichlet_body,
-            "solver": "mumps (each body factorized once)",
-        }
-    if sol.reference_linear_iterations is not None:
-        out["reference_linear_iterations"] = sol.reference_linear_iterations
-    return out
+    pen = sol.penalty
+    return MethodExtras(
+        basis=None if sol.basis.value == "standard" else sol.basis.value,
+        penalty=None if pen is None else pen.eps,
+        penetration=None if pen is None else pen.penetration,
+        condition=None if pen is None else pen.condition,
+        schwarz_dirichlet_body=sol.schwarz_dirichlet_body,
+        schwarz_solver=None if sol.schwarz_dirichlet_body is None else SCHWARZ_SOLVES,
+        reference_linear_iterations=sol.reference_linear_iterations,
+    )
 
 
 def summary(
     sol: Solution,
     times: dict[str, float],
-    extra: dict[str, Any] | None = None,
     *,
+    solver: str,
+    memory: dict[str, float],
     paper_interface: bool = False,
-) -> dict[str, Any]:
-    """The JSON-ready summary of a run (schema in README).
+) -> RunSummary:
+    """The summary record of a run (its JSON schema in README).
 
-    `paper_interface`: also the paper's x-sorted `interface` of pair 0 (sigma_yy of
-    both bodies), for scenes with one horizontal contact line (the built-in scenes).
+    Args:
+        sol: The solved scene.
+        times: Labelled wall-clock seconds of the run.
+        solver: The linear solver's label (`solver_label`).
+        memory: Peak resident memory (MB), summed over the ranks and the largest rank's.
+        paper_interface: Also the paper's x-sorted `interface` of pair 0 (sigma_yy of both
+            bodies), for scenes with one horizontal contact line (the built-in scenes).
+
+    Returns:
+        The RunSummary, with one HertzErrors per Hertz reference and the patch test's errors.
     """
     scene = sol.scene
-    contacts = contacts_summary(sol)
-    data: dict[str, Any] = {
-        "scene": scene.name,
-        "method": sol.method.value,
-        "params": dict(scene.params),
-        "ranks": scene.comm.size,
-        "dofs": sol.dofs,
-        "multipliers": int(sol.layout.size),
-        "elements": int(scene.mesh.topology.index_map(2).size_global),
-        "bodies": [b.name for b in scene.bodies],
-        "iterations": sol.iterations,
-        "active_set": sol.history,
-        "times": times,
-        # Magnitude of the first pair's force: the paper's scenes have one pair.
-        "contact_force": float(np.linalg.norm(contacts[0]["force"])),
-        "active_nodes": int(sol.active.sum()),
-        "contacts": contacts,
-        **method_results(sol),
-    }
-    if paper_interface:
-        data["interface"] = cartesian_interface(sol)
-    data.update(reference_results(sol))
-    data.update(extra or {})
-    return data
+    refs = scene.references
+    patch = [uniform_stress_errors(sol, r) for r in refs if isinstance(r, UniformStress)]
+    return RunSummary(
+        scene=scene.name,
+        method=sol.method,
+        params=dict(scene.params),
+        ranks=scene.comm.size,
+        dofs=sol.dofs,
+        multipliers=int(sol.layout.size),
+        elements=int(scene.mesh.topology.index_map(2).size_global),
+        bodies=tuple(b.name for b in scene.bodies),
+        iterations=sol.iterations,
+        active_set=sol.history,
+        times=times,
+        contacts=contacts_summary(sol),
+        solver=solver,
+        memory=memory,
+        active_nodes=int(sol.active.sum()),
+        extras=method_extras(sol),
+        interface=cartesian_interface(sol) if paper_interface else None,
+        hertz=tuple(hertz_summary(sol, r) for r in refs if isinstance(r, HertzReference)),
+        # The last uniform stress wins, as one `patch` block holds one.
+        patch=patch[-1] if patch else None,
+    )

@@ -97,16 +97,16 @@ def adaptive_runs(
         cumulative = 0.0
         for lv in result.levels:
             cumulative += lv.time
-            d = lv.summary
+            run = lv.summary
             out.append(
                 AdaptiveRun(
                     m,
                     lv.index,
                     lv.dofs,
-                    int(d["elements"]),
-                    contact_size(d),
-                    int(d["iterations"]),
-                    float(d["times"]["total"]),
+                    run.elements,
+                    contact_size(run),
+                    run.iterations,
+                    float(run.times["total"]),
                     lv.time,
                     cumulative,
                     float(lv.est.relative),

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -19,6 +18,7 @@ from mpi4py import MPI
 from ..api import run_scene
 from ..errors import ContactFxError
 from ..options import Method, SolverSpec
+from ..results.records import RunSummary
 from ..scenes import HertzReference, Reference, Scene, UniformStress
 from ..timers import Timers
 from .levels import Level
@@ -32,32 +32,11 @@ from .measures import (
 )
 from .measures import self_errors as compare_profiles
 from .progress import Progress
-from .runs import AdaptiveRun, Run
+from .runs import Run, Study
 
 # Most accurate first: the self-convergence reference is the finest level of the first of
 # these that the study ran (mortar passes the patch test on non-matching meshes).
 ACCURACY_ORDER = ("mortar", "sts", "nts", "penalty", "schwarz")
-
-
-@dataclass
-class Study:
-    """A finished study: its levels, runs, reference and fitted rates."""
-
-    scene: str
-    methods: list[str]
-    levels: list[Level]
-    runs: list[Run]
-    reference: dict[str, Any]
-    error_names: list[str]
-    rates: dict[str, dict[str, float | None]]
-    time_rates: dict[str, dict[str, float | None]]
-    wall: float
-    ranks: int
-    settings: dict[str, Any] = field(default_factory=dict)
-    # Per method and error: why its rate is not a convergence rate ("non-monotone").
-    flags: dict[str, dict[str, str]] = field(default_factory=dict)
-    # `study --adaptive`: the adaptive levels of every method (study/adaptive.py).
-    adaptive: list[AdaptiveRun] = field(default_factory=list)
 
 
 def reference_kind(scene: Scene) -> str:
@@ -69,7 +48,7 @@ def reference_kind(scene: Scene) -> str:
     return "self"
 
 
-def exact_errors(kind: str, summary: dict[str, Any]) -> dict[str, float | None]:
+def exact_errors(kind: str, summary: RunSummary) -> dict[str, float | None]:
     """Errors of one run against the scene's exact solution."""
     return hertz_errors(summary) if kind == "hertz" else patch_error(summary)
 
@@ -87,7 +66,7 @@ def solve_one(
     run = Run(method, level.index, level.factor)
     t0 = time.perf_counter()
     try:
-        sol, data = run_scene(
+        sol, record = run_scene(
             scene,
             method,
             solver=solver,
@@ -99,16 +78,16 @@ def solve_one(
     except ContactFxError as err:
         run.status, run.message = "failed", f"{type(err).__name__}: {err}"
         return run
-    times = dict(data["times"])
+    times = dict(record.times)
     times["mesh"] = mesh_time
     times["total"] += mesh_time
-    run.dofs, run.elements, run.iterations = data["dofs"], data["elements"], data["iterations"]
-    run.times, run.summary, run.h = times, data, contact_size(data)
-    run.forces = [list(c["force"]) for c in data["contacts"]]
+    run.dofs, run.elements, run.iterations = record.dofs, record.elements, record.iterations
+    run.times, run.summary, run.h = times, record, contact_size(record)
+    run.forces = [list(c.force) for c in record.contacts]
     if kind == "self":
-        run.profiles = profiles(sol, data)
+        run.profiles = profiles(sol, record)
     else:
-        run.errors = exact_errors(kind, data)
+        run.errors = exact_errors(kind, record)
     return run
 
 

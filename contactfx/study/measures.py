@@ -7,7 +7,6 @@ surfaces), identical on all ranks, so a study on 2 ranks reports what a serial o
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from mpi4py import MPI
@@ -15,6 +14,7 @@ from mpi4py import MPI
 from ..contact.geometry import arc_length
 from ..discretize.surfaces import GatheredSurface
 from ..methods.solution import Solution
+from ..results.records import HertzErrors, RunSummary
 
 # Relative errors below this are round-off (e.g. mortar on a patch test): a rate fitted
 # through them would be the slope of noise, so such points are left out of the fit.
@@ -34,15 +34,15 @@ def fit_rate(h: list[float] | np.ndarray, err: list[float | None] | np.ndarray) 
     return float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0])
 
 
-def contact_size(summary: dict[str, Any]) -> float | None:
+def contact_size(summary: RunSummary) -> float | None:
     """Median length of the active-surface elements with pressure at both ends (all pairs).
 
     Read off the summary's interface lists (nodes sorted by arc length s); if no element
     carries pressure, the median of all of the active surfaces' elements.
     """
     carrying, every = [], []
-    for c in summary["contacts"]:
-        itf = c["interface"]
+    for c in summary.contacts:
+        itf = c.interface
         s = np.asarray(itf["s"], dtype=float)
         act = np.asarray(itf["active"], dtype=bool)
         ds = np.diff(s)
@@ -61,25 +61,27 @@ def _rel(value: float | None, exact: float) -> float | None:
     return None if value is None else abs(value / exact - 1.0)
 
 
-def _half_width(h: dict[str, Any]) -> float | None:
+def _half_width(h: HertzErrors) -> float | None:
     """The fitted half-width, else the middle of the bracket (demo_hertz.py's rule)."""
-    if h["a"] is not None:
-        return float(h["a"])
-    lo, hi = h["a_bracket"]
+    if h.a is not None:
+        return float(h.a)
+    lo, hi = h.a_bracket
     return 0.5 * (lo + (hi if hi is not None else lo)) if lo else None
 
 
-def hertz_errors(summary: dict[str, Any]) -> dict[str, float | None]:
+def hertz_errors(summary: RunSummary) -> dict[str, float | None]:
     """l2 (relative L2 of the pressure), a and p0 (relative errors) against Hertz.
 
     With several Hertz pairs: the worst pair under l2, a, p0, and each pair's as l2_pair<k>...
     """
-    pairs = summary.get("hertz_pairs", [summary["hertz"]])
+    pairs = summary.hertz
+    if not pairs:
+        raise ValueError(f"run of {summary.scene} has no Hertz reference")
     per = [
         {
-            "l2": float(h["l2_error"]),
-            "a": _rel(_half_width(h), h["a_exact"]),
-            "p0": _rel(h["p0"], h["p0_exact"]),
+            "l2": float(h.l2_error),
+            "a": _rel(_half_width(h), h.a_exact),
+            "p0": _rel(h.p0, h.p0_exact),
         }
         for h in pairs
     ]
@@ -89,13 +91,15 @@ def hertz_errors(summary: dict[str, Any]) -> dict[str, float | None]:
         out[name] = None if None in vals else max(vals)  # type: ignore[type-var]
     if len(per) > 1:
         for h, p in zip(pairs, per, strict=True):
-            out.update({f"{k}_pair{h['pair']}": v for k, v in p.items()})
+            out.update({f"{k}_pair{h.pair}": v for k, v in p.items()})
     return out
 
 
-def patch_error(summary: dict[str, Any]) -> dict[str, float | None]:
+def patch_error(summary: RunSummary) -> dict[str, float | None]:
     """stress: the patch test's max stress/pressure error relative to the exact uniform stress."""
-    return {"stress": float(summary["patch"]["max"])}
+    if summary.patch is None:
+        raise ValueError(f"run of {summary.scene} has no uniform-stress reference")
+    return {"stress": float(summary.patch.max)}
 
 
 @dataclass(frozen=True)
@@ -122,11 +126,11 @@ def surface_displacement(sol: Solution, side: GatheredSurface) -> np.ndarray:
     return u
 
 
-def profiles(sol: Solution, summary: dict[str, Any]) -> Profiles:
+def profiles(sol: Solution, summary: RunSummary) -> Profiles:
     """The pressure and displacement profiles of a solved scene."""
     pressure = []
-    for c in summary["contacts"]:
-        itf = c["interface"]
+    for c in summary.contacts:
+        itf = c.interface
         pressure.append(
             (np.asarray(itf["s"], dtype=float), np.asarray(itf["pressure"], dtype=float))
         )

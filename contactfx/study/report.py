@@ -4,13 +4,11 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import asdict
 from pathlib import Path
-from typing import Any
 
-from .core import Run, Study
 from .measures import ROUND_OFF
 from .progress import format_seconds
+from .runs import Run, Study
 
 TIME_KEYS = ("mesh", "assemble", "search", "contact", "solve", "predictor", "total")
 
@@ -20,64 +18,9 @@ def main_errors(study: Study) -> list[str]:
     return [n for n in study.error_names if "_pair" not in n]
 
 
-def run_json(run: Run, study: Study) -> dict[str, Any]:
-    """One run's entry of study.json."""
-    return {
-        "method": run.method,
-        "level": run.level,
-        "factor": run.factor,
-        "sizes": study.levels[run.level].sizes,
-        "status": run.status,
-        "message": run.message,
-        "dofs": run.dofs,
-        "elements": run.elements,
-        "h": run.h,
-        "iterations": run.iterations,
-        "times": run.times,
-        "after_mesh": run.after_mesh,
-        "errors": run.errors,
-        "successive": run.successive,
-        "forces": run.forces,
-    }
-
-
-def study_json(study: Study) -> dict[str, Any]:
-    """The whole study as JSON-ready data."""
-    return {
-        "scene": study.scene,
-        "ranks": study.ranks,
-        "methods": study.methods,
-        **study.settings,
-        "wall": study.wall,
-        "levels": [
-            {"level": lv.index, "factor": lv.factor, "sizes": lv.sizes} for lv in study.levels
-        ],
-        "reference": study.reference,
-        "error_names": study.error_names,
-        "runs": [run_json(r, study) for r in study.runs],
-        "rates": study.rates,
-        "rate_flags": study.flags,
-        "time_rates": study.time_rates,
-        "h": "median length of the active-surface elements carrying pressure",
-        **({"adaptive": adaptive_json(study)} if study.adaptive else {}),
-    }
-
-
-def adaptive_json(study: Study) -> dict[str, Any]:
-    """study.json's `adaptive` block: how the levels were made and measured, and the levels."""
-    return {
-        "description": "each method's adaptive loop (contactfx adapt) from level 0's mesh up "
-        "to the DOFs of its finest uniform level; errors measured as the uniform runs' "
-        "(without an exact solution: against the reference, not the next level)",
-        "time": "cumulative: the solves, estimates and remeshing of the levels up to each "
-        "(level 0's mesh excluded); after_mesh is the level's own solve",
-        "runs": [asdict(r) for r in study.adaptive],
-    }
-
-
 def write_study_json(study: Study, path: Path) -> Path:
     """Write study.json."""
-    path.write_text(json.dumps(study_json(study), indent=1) + "\n")
+    path.write_text(json.dumps(study.to_json(), indent=1) + "\n")
     return path
 
 

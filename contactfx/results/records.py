@@ -1,0 +1,242 @@
+"""The typed records of a run that the layers above read; each writes its JSON with `to_json()`.
+
+`RunSummary` is what `run_scene` returns beside the Solution: the CLI, the writers, the
+study and the adaptive loop read its attributes. Its `to_json()` is the schema of
+`contactfx solve --json` (README), the one place that schema is written.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..options import Method
+from ..scenes import Obstacle
+from .obstacles import obstacle_json
+
+# The JSON's `estimate.norm`: what the relative values are relative to.
+ESTIMATE_NORM = (
+    "energy: sqrt(int sigma(u_h) : eps(u_h)); every value above but "
+    "absolute relative to it; pressure: the contact pressure's L2 error estimate "
+    "relative to ||p_h||_L2 (results/pressure_estimate.py)"
+)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContactSummary:
+    """One contact pair's results: its names, forces, counts and interface columns."""
+
+    active: str
+    passive: str
+    active_body: str
+    passive_body: str  # an obstacle pair names the obstacle here too
+    force: tuple[float, float]  # on the active body
+    force_passive: tuple[float, float]
+    balance: float  # |force + force_passive| / |force|
+    multipliers: int
+    active_nodes: int
+    # INTERFACE_FIELDS columns (None where not finite) and `active`, sorted by s.
+    interface: dict[str, list[Any]]
+    obstacle: Obstacle | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        """The pair's entry of the JSON's `contacts` list."""
+        out: dict[str, Any] = {
+            "active": self.active,
+            "passive": self.passive,
+            "active_body": self.active_body,
+            "passive_body": self.passive_body,
+            "force": list(self.force),
+            "force_passive": list(self.force_passive),
+            "balance": self.balance,
+            "multipliers": self.multipliers,
+            "active_nodes": self.active_nodes,
+            "interface": self.interface,
+        }
+        if self.obstacle is not None:
+            out["obstacle"] = obstacle_json(self.obstacle)
+        return out
+
+
+@dataclass(frozen=True, kw_only=True)
+class HertzErrors:
+    """One pair against plane-strain Hertz: fitted and bracketed half-width, p0, L2 error."""
+
+    pair: int
+    s_centre: float  # arc length of the contact centre r is measured from
+    a: float | None  # fitted half-width (None if the fit fails)
+    a_bracket: tuple[float, float | None]  # last active and first inactive |r|
+    a_exact: float
+    p0: float
+    p0_exact: float
+    E_star: float
+    P: float
+    P_source: str
+    l2_error: float
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON's `hertz` block."""
+        return {
+            "pair": self.pair,
+            "s_centre": self.s_centre,
+            "a": self.a,
+            "a_bracket": list(self.a_bracket),
+            "a_exact": self.a_exact,
+            "p0": self.p0,
+            "p0_exact": self.p0_exact,
+            "E_star": self.E_star,
+            "P": self.P,
+            "P_source": self.P_source,
+            "l2_error": self.l2_error,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class PatchErrors:
+    """The patch test: max errors relative to the largest exact stress component."""
+
+    sigma: tuple[tuple[float, float], tuple[float, float]]  # the exact uniform stress
+    bodies: dict[str, float]
+    pairs: tuple[dict[str, float], ...]  # pressure and sigma_* columns per pair
+    max: float
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON's `patch` block."""
+        return {
+            "sigma": [list(row) for row in self.sigma],
+            "bodies": self.bodies,
+            "pairs": list(self.pairs),
+            "max": self.max,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class EstimateSummary:
+    """The error estimate, relative to the energy norm (pressure: to ||p_h||_L2)."""
+
+    total: float
+    contact: float
+    bulk: float
+    terms: dict[str, float]
+    absolute: float
+    energy_norm: float
+    pressure: float | None
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON's `estimate` block."""
+        return {
+            "total": self.total,
+            "contact": self.contact,
+            "bulk": self.bulk,
+            "terms": self.terms,
+            "absolute": self.absolute,
+            "energy_norm": self.energy_norm,
+            "pressure": self.pressure,
+            "norm": ESTIMATE_NORM,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class MethodExtras:
+    """What only some methods report (None where the method has none)."""
+
+    basis: str | None = None  # mortar's basis, when not standard
+    penalty: float | None = None  # penalty's stiffness
+    penetration: float | None = None
+    condition: dict[str, float] | None = None  # CG + Jacobi estimate, if asked for
+    schwarz_dirichlet_body: str | None = None
+    schwarz_solver: str | None = None
+    reference_linear_iterations: int | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        """The keys these give in the JSON, in its order."""
+        out: dict[str, Any] = {}
+        if self.basis is not None:
+            out["basis"] = self.basis
+        if self.penalty is not None:
+            out["penalty"] = self.penalty
+            out["penetration"] = self.penetration
+            if self.condition is not None:
+                out["condition"] = self.condition
+        if self.schwarz_dirichlet_body is not None:
+            out["schwarz"] = {
+                "dirichlet_body": self.schwarz_dirichlet_body,
+                "solver": self.schwarz_solver,
+            }
+        if self.reference_linear_iterations is not None:
+            out["reference_linear_iterations"] = self.reference_linear_iterations
+        return out
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunSummary:
+    """One run: sizes, iterations, costs, every pair's results and the references' errors."""
+
+    scene: str
+    method: Method
+    params: dict[str, Any]
+    ranks: int
+    dofs: int
+    multipliers: int
+    elements: int
+    bodies: tuple[str, ...]
+    iterations: int
+    active_set: list[Any]  # the active-set (or Schwarz) history, step by step
+    times: dict[str, float]
+    contacts: tuple[ContactSummary, ...]
+    solver: str  # the label of the linear solver
+    memory: dict[str, float]
+    active_nodes: int
+    extras: MethodExtras = MethodExtras()
+    interface: dict[str, list[float | None]] | None = None  # the paper's view of pair 0
+    hertz: tuple[HertzErrors, ...] = ()  # one per Hertz reference
+    patch: PatchErrors | None = None
+    estimate: EstimateSummary | None = None
+
+    @property
+    def contact_force(self) -> float:
+        """Magnitude of the first pair's force: the paper's scenes have one pair."""
+        return float(np.linalg.norm(self.contacts[0].force))
+
+    def with_estimate(self, estimate: EstimateSummary) -> RunSummary:
+        """The same summary with the error estimate attached."""
+        return replace(self, estimate=estimate)
+
+    def with_times(self, **seconds: float) -> RunSummary:
+        """The same summary with these times replaced (e.g. a mesh timed elsewhere)."""
+        return replace(self, times={**self.times, **seconds})
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON summary of `contactfx solve --json` (schema in README)."""
+        out: dict[str, Any] = {
+            "scene": self.scene,
+            "method": self.method.value,
+            "params": self.params,
+            "ranks": self.ranks,
+            "dofs": self.dofs,
+            "multipliers": self.multipliers,
+            "elements": self.elements,
+            "bodies": list(self.bodies),
+            "iterations": self.iterations,
+            "active_set": self.active_set,
+            "times": self.times,
+            "contact_force": self.contact_force,
+            "active_nodes": self.active_nodes,
+            "contacts": [c.to_json() for c in self.contacts],
+            **self.extras.to_json(),
+        }
+        if self.interface is not None:
+            out["interface"] = self.interface
+        if self.hertz:
+            out["hertz"] = self.hertz[0].to_json()
+            if len(self.hertz) > 1:
+                out["hertz_pairs"] = [h.to_json() for h in self.hertz]
+        if self.patch is not None:
+            out["patch"] = self.patch.to_json()
+        out["solver"] = self.solver
+        out["memory"] = self.memory
+        if self.estimate is not None:
+            out["estimate"] = self.estimate.to_json()
+        return out
