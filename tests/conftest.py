@@ -78,7 +78,7 @@ def run_mpi_script(
     return proc
 
 
-RANK_CASES = ROOT / "tests" / "rank_cases.py"
+RANK_CASES = ROOT / "tests" / "ranks" / "rank_cases.py"
 
 
 class _NoMpirun(subprocess.Popen):
@@ -133,6 +133,9 @@ def two_rank_results(
 
     return load
 
+
+# The coarse graded Hertz scene the adaptive-loop tests start from (tests/adapt/).
+COARSE_HERTZ = ("hertz", "--refine", "2", "--h-far", "2", "--refine-edge", "0", "--slope", "0.3")
 
 # The multiplier methods (one saddle-point discretization each): most tests run all three.
 MULTIPLIER_METHODS = (Method.NTS, Method.STS, Method.MORTAR)

@@ -36,7 +36,7 @@ from contactfx.methods.solution import Solution
 from contactfx.results.interface import u_at_points
 from contactfx.scenes import BLOCK_SCENES, HertzParams, hertz
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "tests" / "scenes"
 DEMO_SCENES = ROOT / "demos" / "scenes"
 Arrays = dict[str, np.ndarray]

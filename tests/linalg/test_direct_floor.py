@@ -113,7 +113,7 @@ def test_ordering_reaches_mumps(cylinders, name) -> None:
     try:
         # Every row in contact, as the loop's first step: a nonsingular saddle point.
         solver.solve(setup.g, np.ones(len(setup.layout.mine), dtype=bool), fresh=True)
-        factor = solver._ksp.getPC().getFactorMatrix()  # type: ignore[attr-defined]
+        factor = solver._ksp.getPC().getFactorMatrix()
         assert el.K.getSize()[0] < PORD_FROM_DOFS
         assert factor.getMumpsIcntl(7) == AMD
     finally:

@@ -7,9 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import ROOT, cli, run_cli
-
-COARSE_HERTZ = ("hertz", "--refine", "2", "--h-far", "2", "--refine-edge", "0", "--slope", "0.3")
+from conftest import COARSE_HERTZ, ROOT, cli, run_cli
 
 
 def _adapt(tmp: Path, *args: str, ranks: int = 1) -> dict:
@@ -130,11 +128,11 @@ def test_overshooting_mesh_is_replanned_not_dropped(monkeypatch: pytest.MonkeyPa
     budgets: list[float] = []
     plan, count = loop.plan_mesh, loop._mesh_dofs
 
-    def recording(sol, est, tol, budget, rule, pressure_tol):  # type: ignore[no-untyped-def]
+    def recording(sol, est, tol, budget, rule, pressure_tol):
         budgets.append(budget)
         return plan(sol, est, tol, budget, rule, pressure_tol)
 
-    def overshoot_once(scene):  # type: ignore[no-untyped-def]
+    def overshoot_once(scene):
         # gmsh's first mesh of level 1 counted as twice --max-dofs, as if it overshot.
         return count(scene) if len(budgets) > 1 else 2 * opts.max_dofs
 
