@@ -94,7 +94,7 @@ def test_msh_refused(tmp_path: Path) -> None:
 def test_two_ranks_print_once_and_match_serial(tmp_path: Path) -> None:
     """mpirun -n 2: each progress line once (rank 0), one set of files, serial's levels.
 
-    tests/rank_cases.py (cli-adapt-hertz) compares a Hertz run number by number.
+    tests/ranks/rank_cases.py (cli-adapt-hertz) compares a Hertz run number by number.
     """
     args = ("blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2")
     serial = _adapt(tmp_path / "one", *args)
