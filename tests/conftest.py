@@ -1,5 +1,21 @@
-"""Shared helpers: run the CLI or a script under mpirun -n 2 as a user would, and the one
-mpirun -n 2 launch of the rank-comparison cases (tests/rank_cases.py, tests/test_ranks.py)."""
+"""Shared helpers: run the CLI or a script under mpirun -n 2 as a user would, the one
+mpirun -n 2 launch of the rank-comparison cases (tests/ranks/rank_cases.py,
+tests/ranks/test_ranks.py), and a solver on a contact setup (solver_for).
+
+The tests are laid out like the package: tests/<stage>/ holds the tests of contactfx/<stage>/
+(contact, scenes, meshes, linalg, methods, results, adapt, study, cli), tests/ranks/ the
+1-rank vs 2-rank comparisons and tests/demos/ the demos and the README's examples. Every
+test file has a unique basename (no __init__.py: pytest puts each file's folder on sys.path,
+and this folder, so `from conftest import ...` works from any of them). Constants shared by
+several test files live here, never in a test module another one imports.
+
+The rule for expected values: a deterministic number (same mesh, same solver) is pinned as a
+golden value at rel 1e-3 with its provenance (analytic, an independent computation, or a
+labelled regression lock saying how to refresh it); bands only where the number is not
+deterministic (timings, iteration counts across platforms, a bound that holds for every mesh
+of a family). A regression lock is refreshed by printing the value in the test after an
+intended change to the mesh or the method, and the commit says why it moved.
+"""
 
 from __future__ import annotations
 
@@ -17,7 +33,12 @@ import numpy as np
 import pytest
 
 from contactfx.contact import Surface
-from contactfx.options import Method
+from contactfx.discretize.setup import ContactSetup
+from contactfx.discretize.supports import rigid_body_modes
+from contactfx.linalg.protocol import LinearSolver
+from contactfx.methods.solvers import make_solver
+from contactfx.options import SOLVERS, Method, SolverSpec
+from contactfx.scenes import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
 MPIRUN = str(Path(sys.executable).parent / "mpirun")
@@ -78,7 +99,7 @@ def run_mpi_script(
     return proc
 
 
-RANK_CASES = ROOT / "tests" / "rank_cases.py"
+RANK_CASES = ROOT / "tests" / "ranks" / "rank_cases.py"
 
 
 class _NoMpirun(subprocess.Popen):
@@ -104,7 +125,7 @@ def _mpirun_only_under_the_mpi_marker(
 def two_rank_results(
     request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
 ) -> Callable[[str], dict[str, np.ndarray]]:
-    """One mpirun -n 2 of tests/rank_cases.py for every case the selected tests compare.
+    """One mpirun -n 2 of tests/ranks/rank_cases.py for every case the selected tests compare.
 
     Returns case -> its 2-rank arrays; a case the run did not write fails with the run's
     output (the run aborts at the first failing case: mpi4py -m).
@@ -133,6 +154,9 @@ def two_rank_results(
 
     return load
 
+
+# The coarse graded Hertz scene the adaptive-loop tests start from (tests/adapt/).
+COARSE_HERTZ = ("hertz", "--refine", "2", "--h-far", "2", "--refine-edge", "0", "--slope", "0.3")
 
 # The multiplier methods (one saddle-point discretization each): most tests run all three.
 MULTIPLIER_METHODS = (Method.NTS, Method.STS, Method.MORTAR)
@@ -178,3 +202,22 @@ def renumbered(s: Surface, order: np.ndarray) -> Surface:
     new = np.empty_like(order)
     new[order] = np.arange(len(order))
     return Surface(s.x[order], new[s.segments], s.normals, s.dofs[order])
+
+
+def solver_for(
+    setup: ContactSetup, spec: SolverSpec | str, scene: Scene, *, reuse: bool = True
+) -> LinearSolver:
+    """The solver the active-set loop builds on `setup` (methods/multipliers.py): `spec` is a
+    SolverSpec or a name of SOLVERS; the rigid-body modes of `scene` for GAMG."""
+    el = setup.elasticity
+    return make_solver(
+        SOLVERS[spec] if isinstance(spec, str) else spec,
+        el.K,
+        setup.B,
+        el.f,
+        e_max=setup.e_max,
+        h=setup.h,
+        modes=lambda: rigid_body_modes(el.V, scene),
+        node_dofs=setup.node_dofs(),
+        reuse=reuse,
+    )

@@ -6,7 +6,7 @@ piecewise-linear interpolant p_h on each active surface: the interpolation error
 function f on a segment of length h is |f - I f|^2 = h^5 f''^2 / 120 (f'' constant), with
 f'' at each node from the two slopes around it. Across the zone's edge, where p ~ sqrt(a - x),
 the slope changes by about p_last / h in one segment and the estimate scales like the error
-there, h^2 (checked on the exact Hertz pressure in tests/test_pressure_estimate.py). It
+there, h^2 (checked on the exact Hertz pressure in tests/adapt/test_pressure_estimate.py). It
 does not see a pressure that is smooth and wrong (a polluted bulk): the energy estimate
 sizes the bulk.
 """

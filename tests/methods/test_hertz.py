@@ -21,7 +21,7 @@ def _graded(h: float, slope: float) -> HertzParams:
 def mortar_finest() -> dict:
     """Mortar's summary on the finest of the study's cheap levels (h_e = 0.01, 1933 cells).
 
-    The rates over the three levels are asserted per method in tests/test_study.py.
+    The rates over the three levels are asserted per method in tests/study/test_study.py.
     """
     return run_case("hertz", _graded(0.01, 0.141), "mortar", comm=MPI.COMM_SELF)[1].to_json()
 

@@ -1,4 +1,4 @@
-"""The CLI under mpirun -n 2 (the 2-rank vs serial comparisons: tests/test_ranks.py)."""
+"""The CLI under mpirun -n 2 (the 2-rank vs serial comparisons: tests/ranks/test_ranks.py)."""
 
 import json
 

@@ -91,7 +91,7 @@ def test_rotate_merging_the_touching_points_is_caught(tmp_path: Path) -> None:
 def test_condensed_refusal_names_the_pair_and_why() -> None:
     """An active node with both components prescribed cannot be eliminated: the pair, where,
     and why. (The curved passive surface that was refused here is condensed since the coupled
-    elimination of linalg/pivots.py: tests/test_direct_floor.py.)"""
+    elimination of linalg/pivots.py: tests/linalg/test_direct_floor.py.)"""
     from dataclasses import replace
 
     from contactfx.scenes import BLOCK_SCENES, Dirichlet

@@ -3,11 +3,9 @@ selected inverse on several ranks."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, solver_for
 
 from contactfx import load_scene_file, solve
 from contactfx.options import SOLVERS, SolverKind
@@ -58,24 +56,6 @@ def test_curved_dual_mortar_pivot_block_is_coupled(cylinders) -> None:
     setup.destroy()
 
 
-def test_reference_timing_reports_both_factorizations(tmp_path: Path) -> None:
-    """--reference-timing times a fresh LU and a fresh LDL^T of the final saddle point."""
-    import json
-
-    from contactfx import cli
-
-    out = tmp_path / "r.json"
-    assert (
-        cli.main(
-            ["solve", "hertz", "--refine", "0.1", "--reference-timing", "--json", str(out), "-q"]
-        )
-        == 0
-    )
-    times = json.loads(out.read_text())["times"]
-    for key in ("reference_solve", "reference_lu", "reference_ldlt"):
-        assert times[key] > 0.0
-
-
 def test_ordering_rule() -> None:
     """AMD below PORD_FROM_DOFS, PORD from there; an option naming one wins; MUMPS only."""
     from contactfx.methods.solvers import AMD, ORDERING_KEY, PORD, PORD_FROM_DOFS, with_ordering
@@ -92,7 +72,7 @@ def test_ordering_reaches_mumps(cylinders, name) -> None:
     """The factorization MUMPS ran used the rule's ordering (ICNTL(7)) on this 8k-DOF scene."""
     from contactfx.discretize.setup import prepare_contact
     from contactfx.methods.active_set import ActiveSetOptions
-    from contactfx.methods.solvers import AMD, PORD_FROM_DOFS, make_solver
+    from contactfx.methods.solvers import AMD, PORD_FROM_DOFS
     from contactfx.options import Method
     from contactfx.timers import Timers
 
@@ -100,20 +80,11 @@ def test_ordering_reaches_mumps(cylinders, name) -> None:
         cylinders, Method.MORTAR.kernel, ActiveSetOptions().penetration_tol, Timers()
     )
     el = setup.elasticity
-    solver = make_solver(
-        SOLVERS[name],
-        el.K,
-        setup.B,
-        el.f,
-        e_max=setup.e_max,
-        h=setup.h,
-        modes=lambda: [],
-        node_dofs=setup.node_dofs(),
-    )
+    solver = solver_for(setup, name, cylinders)
     try:
         # Every row in contact, as the loop's first step: a nonsingular saddle point.
         solver.solve(setup.g, np.ones(len(setup.layout.mine), dtype=bool), fresh=True)
-        factor = solver._ksp.getPC().getFactorMatrix()  # type: ignore[attr-defined]
+        factor = solver._ksp.getPC().getFactorMatrix()
         assert el.K.getSize()[0] < PORD_FROM_DOFS
         assert factor.getMumpsIcntl(7) == AMD
     finally:

@@ -7,9 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import ROOT, cli, run_cli
-
-COARSE_HERTZ = ("hertz", "--refine", "2", "--h-far", "2", "--refine-edge", "0", "--slope", "0.3")
+from conftest import COARSE_HERTZ, ROOT, cli, run_cli
 
 
 def _adapt(tmp: Path, *args: str, ranks: int = 1) -> dict:
@@ -96,7 +94,7 @@ def test_msh_refused(tmp_path: Path) -> None:
 def test_two_ranks_print_once_and_match_serial(tmp_path: Path) -> None:
     """mpirun -n 2: each progress line once (rank 0), one set of files, serial's levels.
 
-    tests/rank_cases.py (cli-adapt-hertz) compares a Hertz run number by number.
+    tests/ranks/rank_cases.py (cli-adapt-hertz) compares a Hertz run number by number.
     """
     args = ("blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2")
     serial = _adapt(tmp_path / "one", *args)
@@ -131,11 +129,11 @@ def test_overshooting_mesh_is_replanned_not_dropped() -> None:
 
     budgets: list[float] = []
 
-    def recording(sol, est, tol, budget, rule, pressure_tol):  # type: ignore[no-untyped-def]
+    def recording(sol, est, tol, budget, rule, pressure_tol):
         budgets.append(budget)
         return plan_mesh(sol, est, tol, budget, rule, pressure_tol)
 
-    def overshoot_once(scene):  # type: ignore[no-untyped-def]
+    def overshoot_once(scene):
         # gmsh's first mesh of level 1 counted as twice --max-dofs, as if it overshot.
         return scene_dofs(scene) if len(budgets) > 1 else 2 * opts.max_dofs
 

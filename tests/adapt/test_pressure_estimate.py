@@ -7,8 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import cli
-from test_adapt import COARSE_HERTZ
+from conftest import COARSE_HERTZ, cli
 
 import contactfx
 from contactfx.adapt.estimate import estimate
@@ -32,7 +31,7 @@ def _true_l2(x: np.ndarray, p: np.ndarray, f: object) -> np.ndarray:
     for a, b, pa, pb in zip(x[:-1], x[1:], p[:-1], p[1:], strict=True):
         s = np.linspace(a, b, 4001)
         lin = pa + (pb - pa) * (s - a) / (b - a)
-        out.append(np.sqrt(np.trapezoid((f(s) - lin) ** 2, s)))  # type: ignore[operator]
+        out.append(np.sqrt(np.trapezoid((f(s) - lin) ** 2, s)))
     return np.array(out)
 
 

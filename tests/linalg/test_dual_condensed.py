@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, solver_for
 from mpi4py import MPI
 
 from contactfx import load_scene_file, run_scene, solve
@@ -72,26 +72,12 @@ def test_condensed_equals_mumps(small_hertz, method: str, basis: str) -> None:
 def _condensed_solver(scene, reuse: bool = True):
     """The setup of the NTS Hertz problem and a condensed solver on it."""
     from contactfx.discretize.setup import prepare_contact
-    from contactfx.discretize.supports import rigid_body_modes
     from contactfx.methods.active_set import ActiveSetOptions
-    from contactfx.methods.solvers import make_solver
-    from contactfx.options import SOLVERS, Method
+    from contactfx.options import Method
     from contactfx.timers import Timers
 
     setup = prepare_contact(scene, Method.NTS.kernel, ActiveSetOptions().penetration_tol, Timers())
-    el = setup.elasticity
-    solver = make_solver(
-        SOLVERS["condensed"],
-        el.K,
-        setup.B,
-        el.f,
-        e_max=setup.e_max,
-        h=setup.h,
-        modes=lambda: rigid_body_modes(el.V, scene),
-        node_dofs=setup.node_dofs(),
-        reuse=reuse,
-    )
-    return setup, solver
+    return setup, solver_for(setup, "condensed", scene, reuse=reuse)
 
 
 def test_condensed_matrix_equals_ptap(small_hertz) -> None:

@@ -2,10 +2,10 @@
 
 Each case solves on MPI.COMM_WORLD and returns (Solution, arrays): the arrays in an order
 that does not depend on the partition (u at the sorted nodes, the x-sorted interface, the
-layout sorted by position), all ranks holding the same values. tests/test_ranks.py runs a
+layout sorted by position), all ranks holding the same values. tests/ranks/test_ranks.py runs a
 case in the pytest process (1 rank) and compares it with this file's output on 2 ranks:
 
-    mpirun -n 2 python -m mpi4py tests/rank_cases.py OUTDIR case1 case2 ...
+    mpirun -n 2 python -m mpi4py tests/ranks/rank_cases.py OUTDIR case1 case2 ...
 
 runs the named cases in one process pair; rank 0 writes OUTDIR/<case>.npz with the arrays,
 `_ranks` and `_owned_cells` (each rank's owned cells: both must own part of the mesh).
@@ -37,7 +37,7 @@ from contactfx.results import RunSummary
 from contactfx.results.interface import u_at_points
 from contactfx.scenes import BLOCK_SCENES, HertzParams, hertz
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "tests" / "scenes"
 DEMO_SCENES = ROOT / "demos" / "scenes"
 Arrays = dict[str, np.ndarray]

@@ -233,7 +233,7 @@ def _same(a: float | None, b: float | None) -> bool:
 
 
 # The .geo user scene only: the Hertz levels' errors on 2 ranks are compared with serial to
-# 1e-8 case by case in tests/test_ranks.py (hertz-graded-mortar).
+# 1e-8 case by case in tests/ranks/test_ranks.py (hertz-graded-mortar).
 @pytest.mark.mpi
 @pytest.mark.parametrize("which", ["geo"])
 def test_two_ranks_give_the_serial_errors(

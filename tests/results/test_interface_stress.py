@@ -71,7 +71,7 @@ def test_sigma_nt_tends_to_zero_and_sigma_nn_to_minus_p(hertz_levels: list[RunSu
     and the active sigma_nt below 1 % of p0 on the default mesh (before: 1.38 %)."""
     coarse, fine = (measures(d.to_json()) for d in hertz_levels)
     ratio = hertz_levels[0].elements / hertz_levels[1].elements
-    h_ratio = 2.0  # h halves between the levels (tests/test_study.py)
+    h_ratio = 2.0  # h halves between the levels (tests/study/test_study.py)
     assert 0.3 < ratio < 0.5
     for key in coarse:
         rate = np.log(coarse[key] / fine[key]) / np.log(h_ratio)

@@ -168,12 +168,14 @@ def test_gamg_fieldsplit_agrees_with_mumps(kind, params, method) -> None:
 
 
 def test_reference_timing_in_json(tmp_path) -> None:
-    """--reference-timing adds times.reference_solve; per-iteration solver data is there."""
+    """--reference-timing times a fresh solve, a fresh LU and a fresh LDL^T of the final
+    saddle point; per-iteration solver data is there."""
     out = tmp_path / "r.json"
     proc = cli("solve", "hertz", "--method", "mortar", "--reference-timing", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
-    assert data["times"]["reference_solve"] > 0.0
+    for key in ("reference_solve", "reference_lu", "reference_ldlt"):
+        assert data["times"][key] > 0.0, key
     assert {"search", "contact", "solve"} <= data["times"].keys()
     for step in data["active_set"]:
         assert step["linear_iterations"] >= 1 and step["solve_time"] > 0.0

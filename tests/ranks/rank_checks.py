@@ -1,7 +1,7 @@
 """How a 2-rank result is compared with the serial one: one check per returned array.
 
 Each check takes (serial, two ranks) and raises AssertionError naming the array. The
-tolerances are those of the per-file tests these cases replace (tests/rank_cases.py).
+tolerances are those of the per-file tests these cases replace (tests/ranks/rank_cases.py).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Each demo asserts its own result. On 2 ranks: the blocks (several pairs, every method) and the
 user scene (gmsh .geo, a TOML scene); the other demos' parallel paths (Hertz, Schwarz, penalty,
-obstacles) are compared with serial runs case by case in tests/test_ranks.py.
+obstacles) are compared with serial runs case by case in tests/ranks/test_ranks.py.
 """
 
 import subprocess

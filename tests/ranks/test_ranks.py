@@ -1,4 +1,4 @@
-"""mpirun -n 2 gives the serial answer: every case of tests/rank_cases.py, one launch for all.
+"""mpirun -n 2 gives the serial answer: every case of tests/ranks/rank_cases.py, one launch for all.
 
 The serial side runs here, in this process, through the same case function; the 2-rank
 side comes from the one session-wide mpirun (conftest.two_rank_results).
