@@ -55,7 +55,7 @@ class Plan:
     predicted: float  # predicted relative estimate on it
 
 
-def _owned_cells(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
+def owned_cells(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
     """(vertices (n, 4, 2) in gmsh order, global vertex ids (n, 4)) of the owned cells."""
     msh = sol.scene.mesh
     tdim = msh.topology.dim
@@ -69,7 +69,7 @@ def _owned_cells(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
     return msh.geometry.x[geo][:, order, :2], gv.reshape(-1, 4)
 
 
-def _vertex_sizes(comm: MPI.Comm, quads: np.ndarray, verts: np.ndarray, h: np.ndarray) -> SizeField:
+def vertex_sizes(comm: MPI.Comm, quads: np.ndarray, verts: np.ndarray, h: np.ndarray) -> SizeField:
     """The size field on rank 0: at each vertex the smallest new size of the cells around it.
 
     Gathered first, so that a vertex on a process boundary sees the cells of both ranks;
@@ -163,7 +163,7 @@ def plan_mesh(
     Q = est.eta.function_space
     nloc = msh.topology.index_map(2).size_local
     eta_true = est.eta.x.array[Q.dofmap.list[:nloc, 0]]
-    quads, verts = _owned_cells(sol)
+    quads, verts = owned_cells(sol)
     eta = est.marking(rule.contact_weight)
     d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
     h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
@@ -188,5 +188,5 @@ def plan_mesh(
         cells = comm.allreduce(float(np.sum(factor**-2.0)))
     eta_true = np.maximum(eta_true, 1e-300)
     predicted = float(np.sqrt(comm.allreduce(float(np.sum((eta_true * factor ** (q - 1)) ** 2)))))
-    field = _vertex_sizes(comm, quads, verts, h * factor)
+    field = vertex_sizes(comm, quads, verts, h * factor)
     return Plan(field, cells, predicted / est.energy)

@@ -1,0 +1,249 @@
+"""An estimate of the error in the quantity a run stops on: a two-level comparison.
+
+The level's solution is compared with a second solve of the same scene on a mesh whose
+cells near the contact are halved (the pressure goal: the cells within a few contact cells
+of the surfaces and within half a zone length of each contact zone, where the pressure's
+error is made) or whose every cell is halved (energy, force). If the error behaves like
+C h^r, the difference d = ||q_h - q_h/2|| lies between (1 - 2^-r) and (1 + 2^-r) times
+||q - q_h||, so d / (1 - 2^-r) is between 1 and (1 + 2^-r) / (1 - 2^-r) times the error:
+for the pressure (P1 multipliers, a square-root edge: L2 rate 1.5 in h) between 1 and 2.1.
+In the energy norm the two errors are nearly orthogonal (Galerkin): d / sqrt(1 - q^2), q
+the ratio of the residual estimates of the two meshes (the observed rate; the estimator's
+constant cancels). The force is an energy-squared quantity: rate 2. docs/adapt.md has the
+measured effectivities, the cost and where it fails. A pressure singular like 1/sqrt (a
+rigid flat punch's corner) has no finite L2 norm: the estimate refuses it (GoalUnbounded)
+and names the goals that exist.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Any
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..api import solve
+from ..errors import InputError
+from ..methods.solution import PairView, Solution
+from ..options import SolverSpec
+from ..results.interface import pair_forces
+from ..scenes import SizeField
+from .estimate import estimate
+from .sizing import owned_cells, vertex_sizes
+from .true_error import energy_error_all
+
+
+class Goal(StrEnum):
+    """The quantity a run is accurate in."""
+
+    PRESSURE = "pressure"  # relative L2 error of the contact pressure, worst pair
+    ENERGY = "energy"  # relative energy-norm error of the displacement
+    FORCE = "force"  # relative error of each pair's contact force, worst pair
+
+
+# Convergence rates in h of each goal's error: P1 multipliers against a square-root edge
+# (L2), Q1 in the energy norm, and the force (an energy-squared quantity).
+RATES = {Goal.PRESSURE: 1.5, Goal.ENERGY: 1.0, Goal.FORCE: 2.0}
+
+# The energy goal's error ratio e_h/2 / e_h is the residual estimate's, at most this (a
+# refinement that did not reduce the estimate says nothing of the error).
+Q_MAX = 0.9
+
+# The refined mesh of the pressure goal halves the cells within this many local contact
+# cell sizes of a contact surface (the zone and its edges; the rest keeps its size).
+BAND = 3.0
+
+# And the cells within this many zone lengths of a pair's contact zone: the pressure's error
+# is also the near field's (the stresses that set the zone's width), not only its own cells.
+REACH = 0.5
+
+# A peak pressure that grows by more than this factor when the contact cells are halved is
+# singular: a 1/sqrt peak grows by sqrt(2) = 1.41 per halving, a bounded one tends to 1.
+SINGULAR_GROWTH = 2**0.25
+
+
+class GoalUnbounded(InputError):
+    """The goal has no finite value on this scene (e.g. a pressure singular like 1/sqrt)."""
+
+
+@dataclass(frozen=True)
+class GoalEstimate:
+    """A goal's relative error estimate from one refined solve, and what it cost."""
+
+    goal: Goal
+    relative: float  # estimated relative error of the level's solution in the goal
+    parts: dict[str, float]  # per pair (pressure, force); energy: difference d and ratio q
+    rate: float  # r of the extrapolation d / (1 - 2^-r)
+    dofs: int  # DOFs of the refined solve
+    seconds: float  # remesh + refined solve + comparison
+    reference: Solution  # the refined solution (a better answer than the level's own)
+
+
+def refined_field(
+    sol: Solution,
+    far: float = 1.0,
+    near: float = 0.5,
+    band: float = BAND,
+    reach: float = REACH,
+) -> SizeField:
+    """The current mesh's sizes, times `near` near the contact surfaces, `far` elsewhere.
+
+    Near: within `band` local contact cell sizes of a contact surface, or within `reach`
+    times a pair's contact zone length of that zone. `far` 1 leaves the rest unchanged,
+    0.5 halves it too. Collective; the field's arrays on rank 0.
+    """
+    quads, verts = owned_cells(sol)
+    d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
+    h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
+    factor = np.full(len(h), far)
+    if near != far:
+        mid = quads.mean(axis=1)
+        pts, size = _surface_points(sol)
+        dist, nearest = cKDTree(pts).query(mid)
+        close = dist <= band * size[nearest]
+        for zone, length in _zones(sol):
+            if reach > 0 and len(zone):
+                close |= cKDTree(zone).query(mid)[0] <= reach * length
+        factor[close] = near
+    return vertex_sizes(sol.scene.comm, quads, verts, h * factor)
+
+
+def _zones(sol: Solution) -> list[tuple[np.ndarray, float]]:
+    """Per pair: midpoints of the active surface's loaded segments, and their total length."""
+    out = []
+    for pv in sol.pairs:
+        x, seg = pv.active.surface.x[:, :2], pv.active.surface.segments
+        p = np.zeros(len(x))
+        p[pv.nodes] = sol.pressure[pv.rows]
+        on = (p[seg[:, 0]] > 0) | (p[seg[:, 1]] > 0)
+        a, b = x[seg[on, 0]], x[seg[on, 1]]
+        out.append((0.5 * (a + b), float(np.sum(np.linalg.norm(b - a, axis=1)))))
+    return out
+
+
+def _surface_points(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
+    """Midpoints and lengths of every contact segment (both sides of every pair)."""
+    mids, lengths = [], []
+    for pv in sol.pairs:
+        for side in (pv.active, pv.passive):
+            if side is None:
+                continue
+            x, seg = side.surface.x[:, :2], side.surface.segments
+            mids.append(0.5 * (x[seg[:, 0]] + x[seg[:, 1]]))
+            lengths.append(np.linalg.norm(x[seg[:, 1]] - x[seg[:, 0]], axis=1))
+    return np.concatenate(mids), np.concatenate(lengths)
+
+
+def _pressure_curve(pv: PairView, pressure: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(s, p): the pair's multipliers along its active surface's arc length, sorted."""
+    s_all = pv.arc[0]
+    p = np.zeros(len(s_all))
+    p[pv.nodes] = pressure[pv.rows]
+    keep = np.isfinite(s_all)
+    order = np.argsort(s_all[keep], kind="stable")
+    return s_all[keep][order], p[keep][order]
+
+
+def _l2_pl(s: np.ndarray, v: np.ndarray) -> float:
+    """L2 norm of the piecewise-linear function with nodal values v at sorted abscissae s."""
+    h = np.diff(s)
+    a, b = v[:-1], v[1:]
+    return float(np.sqrt(np.sum(h * (a * a + a * b + b * b) / 3.0)))
+
+
+def pressure_difference(
+    coarse: tuple[np.ndarray, np.ndarray], fine: tuple[np.ndarray, np.ndarray]
+) -> tuple[float, float]:
+    """(||p_c - p_f||_L2, ||p_f||_L2) of two piecewise-linear pressures along arc length.
+
+    Both are evaluated on the union of their nodes, where the difference is again piecewise
+    linear, so the integral is exact.
+    """
+    s = np.union1d(coarse[0], fine[0])
+    pc = np.interp(s, *coarse, left=0.0, right=0.0)
+    pf = np.interp(s, *fine, left=0.0, right=0.0)
+    return _l2_pl(s, pc - pf), _l2_pl(s, pf)
+
+
+def _check_bounded(sol: Solution, ref: Solution) -> None:
+    """GoalUnbounded if a pair's peak pressure grows like a 1/sqrt singularity's."""
+    for pv, pr in zip(sol.pairs, ref.pairs, strict=True):
+        peak = float(np.max(sol.pressure[pv.rows], initial=0.0))
+        fine = float(np.max(ref.pressure[pr.rows], initial=0.0))
+        if peak > 0 and fine > SINGULAR_GROWTH * peak:
+            raise GoalUnbounded(
+                f"{pv.label}: the peak pressure grew x {fine / peak:.2f} on the refined "
+                "contact zone (a 1/sqrt singularity has no L2 pressure error to bound): use "
+                "--goal force or --goal energy"
+            )
+
+
+def _refined(
+    sol: Solution, field: SizeField, solver: SolverSpec | str, options: dict[str, Any]
+) -> Solution:
+    """The same scene solved on the mesh of `field`, the level's active set as first guess."""
+    scene = sol.scene.remeshed_to(field)
+    return solve(scene, sol.method, solver=solver, initial=sol, **options)
+
+
+def goal_estimate(
+    sol: Solution,
+    goal: Goal | str,
+    *,
+    solver: SolverSpec | str = "mumps",
+    options: dict[str, Any] | None = None,
+    rate: float | None = None,
+    reach: float = REACH,
+) -> GoalEstimate:
+    """The relative error of `sol` in `goal`, from a solve on a refined mesh (collective).
+
+    Args:
+        sol: A multiplier-method solution of a scene that can be remeshed.
+        goal: pressure (contact cells halved), energy or force (every cell halved).
+        solver: The refined solve's solver (the level's own, normally).
+        options: Further `api.solve` options of the level's solve (not `initial`).
+        rate: r of the extrapolation; if None, RATES[goal] (pressure, force) or the
+            residual estimate's observed rate between the two meshes (energy).
+        reach: The pressure goal's refined region around each zone, in zone lengths.
+
+    Raises:
+        GoalUnbounded: The pressure of a pair is singular (its L2 norm is infinite).
+    """
+    goal = Goal(goal)
+    r = RATES[goal] if rate is None else rate
+    t0 = time.perf_counter()
+    far = 1.0 if goal is Goal.PRESSURE else 0.5
+    ref = _refined(sol, refined_field(sol, far=far, reach=reach), solver, options or {})
+    q = 2.0**-r
+    parts: dict[str, float] = {}
+    if goal is Goal.ENERGY:
+        e = energy_error_all(sol, ref, sol.scene.comm)
+        parts["difference"] = e["relative"]
+        if rate is None:
+            # The residual estimate's ratio is the energy error's (its constant cancels).
+            q = min(estimate(ref).total / max(estimate(sol).total, 1e-300), Q_MAX)
+            r = -float(np.log2(q))
+        parts["ratio"] = q
+        relative = e["relative"] / np.sqrt(1.0 - q * q)
+    elif goal is Goal.PRESSURE:
+        _check_bounded(sol, ref)
+        for pv, pr in zip(sol.pairs, ref.pairs, strict=True):
+            d, n = pressure_difference(
+                _pressure_curve(pv, sol.pressure), _pressure_curve(pr, ref.pressure)
+            )
+            parts[pv.label] = d / n / (1.0 - q) if n > 0 else 0.0
+        relative = max(parts.values(), default=0.0)
+    else:
+        for k, pv in enumerate(sol.pairs):
+            fine = _force(ref, k)
+            parts[pv.label] = abs(_force(sol, k) - fine) / max(fine, 1e-300) / (1.0 - q)
+        relative = max(parts.values(), default=0.0)
+    return GoalEstimate(goal, float(relative), parts, r, ref.dofs, time.perf_counter() - t0, ref)
+
+
+def _force(sol: Solution, k: int) -> float:
+    """The magnitude of pair k's total contact force on its active body."""
+    return float(np.linalg.norm(pair_forces(sol, k)[0]))

@@ -1,0 +1,76 @@
+"""The goal estimates (contactfx/adapt/goal.py): a patch test, Hertz effectivity, refusals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import contactfx
+from contactfx.adapt.goal import (
+    Goal,
+    GoalUnbounded,
+    goal_estimate,
+    pressure_difference,
+    refined_field,
+)
+from contactfx.adapt.true_error import energy_error
+from contactfx.results.references import hertz_summary
+from contactfx.scenes import BlockParams, HertzParams, blocks, hertz
+
+
+def test_patch_test_pressure_estimate_is_round_off() -> None:
+    """Equal widths: mortar's pressure is the uniform one on both meshes, so they agree."""
+    sol = contactfx.solve(blocks(BlockParams(l2=10.0, size1=0.5, size2=0.4)), "mortar")
+    g = goal_estimate(sol, Goal.PRESSURE)
+    assert g.goal is Goal.PRESSURE
+    assert g.dofs > sol.dofs  # the refined mesh is another, finer one
+    assert g.relative < 1e-10, g.parts
+
+
+def test_pressure_difference_is_exact_for_piecewise_linear() -> None:
+    """Two hat functions on different nodes: the L2 difference against a fine quadrature."""
+    coarse = (np.array([0.0, 1.0, 2.0]), np.array([0.0, 1.0, 0.0]))
+    fine = (np.array([0.0, 0.7, 1.3, 2.0]), np.array([0.0, 0.9, 0.8, 0.0]))
+    d, n = pressure_difference(coarse, fine)
+    s = np.linspace(0.0, 2.0, 400001)
+    pc, pf = np.interp(s, *coarse), np.interp(s, *fine)
+    assert d == pytest.approx(np.sqrt(np.trapezoid((pc - pf) ** 2, s)), rel=1e-8)
+    assert n == pytest.approx(np.sqrt(np.trapezoid(pf**2, s)), rel=1e-8)
+
+
+def test_refined_field_halves_only_near_contact() -> None:
+    """Pressure goal: the contact band at half size, the far field untouched."""
+    sol = contactfx.solve(hertz(HertzParams(refine=0.2, h_far=10.0, refine_edge=0.0)), "mortar")
+    field = refined_field(sol)
+    uniform = refined_field(sol, near=1.0)
+    ratio = field.sizes / uniform.sizes
+    assert ratio.min() == pytest.approx(0.5, rel=1e-5)
+    assert np.median(ratio) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("refine", [0.1, 0.05, 0.025])
+def test_hertz_pressure_effectivity(refine: float) -> None:
+    """Ungraded Hertz starts: estimate / exact L2 pressure error within [0.9, 2]."""
+    scene = hertz(HertzParams(refine=refine, h_far=10.0, refine_edge=0.0, slope=0.3))
+    sol = contactfx.solve(scene, "mortar")
+    exact = float(hertz_summary(sol)["l2_error"])  # type: ignore[arg-type]
+    g = goal_estimate(sol, "pressure")
+    assert 0.9 <= g.relative / exact <= 2.0, (g.relative, exact)
+
+
+def test_singular_pressure_is_refused() -> None:
+    """A rigid flat punch: the peak grows like 1/sqrt, the L2 goal does not exist."""
+    scene = contactfx.load_scene_file("demos/scenes/rigid_punch.toml")
+    sol = contactfx.solve(scene, "nts")
+    with pytest.raises(GoalUnbounded, match="--goal force or --goal energy"):
+        goal_estimate(sol, Goal.PRESSURE, options={})
+
+
+def test_hertz_energy_effectivity() -> None:
+    """Coarse Hertz: estimate / energy error against an overkill solve within [1, 3]."""
+    sol = contactfx.solve(hertz(HertzParams(refine=0.4, h_far=10.0, refine_edge=0.0)), "mortar")
+    over = contactfx.solve(sol.scene.remeshed_to(refined_field(sol, far=0.25, near=0.25)), "mortar")
+    true = energy_error(sol, over)
+    assert true is not None
+    g = goal_estimate(sol, Goal.ENERGY)
+    assert 1.0 <= g.relative / true["relative"] <= 3.0, (g.relative, true)
