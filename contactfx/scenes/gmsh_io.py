@@ -32,6 +32,7 @@ from .model import (
     Groups,
     Load,
     Material,
+    Model,
     Obstacle,
     Reference,
     Scene,
@@ -267,6 +268,7 @@ class SceneParts:
     references: tuple[Reference, ...] = ()
     name: str = "scene"
     obstacles: tuple[Obstacle, ...] = ()
+    model: Model = Model.PLANE_STRAIN
 
 
 @dataclass(frozen=True)
@@ -328,10 +330,12 @@ def scene_from_gmsh(
         params={
             "mesh": str(path) if path is not None else "gmsh model",
             "size_factor": size_factor,
+            "model": parts.model.value,
             **(params or {}),
         },
         recipe=recipe,
         obstacles=parts.obstacles,
+        model=parts.model,
     )
     return check_scene(scene)
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from enum import StrEnum
 from functools import cached_property
 from typing import Any, Protocol
 
@@ -21,9 +22,29 @@ from ..contact.rigid import Circle, Plane, Polyline, RigidShape
 from ..errors import InputError, MeshError
 
 
+class Model(StrEnum):
+    """The 2D model of the bodies: plane strain, plane stress, or axisymmetric.
+
+    Axisymmetric: x is the radius r >= 0 and y the axis direction (the axis is x = 0).
+    """
+
+    PLANE_STRAIN = "plane_strain"
+    PLANE_STRESS = "plane_stress"
+    AXISYMMETRIC = "axisymmetric"
+
+    @classmethod
+    def parse(cls, value: Model | str, where: str = "model") -> Model:
+        """The model named `value` (InputError naming the choices otherwise)."""
+        try:
+            return cls(value)
+        except ValueError:
+            choices = ", ".join(m.value for m in cls)
+            raise InputError(f"{where}: unknown model '{value}' (choose {choices})") from None
+
+
 @dataclass(frozen=True)
 class Material:
-    """Isotropic linear elasticity in plane strain: Young's modulus and Poisson ratio."""
+    """Isotropic linear elasticity: Young's modulus and Poisson ratio."""
 
     E: float
     nu: float
@@ -284,6 +305,7 @@ class Scene:
     recipe: Recipe | None = field(default=None, compare=False, repr=False)
     curve_bodies: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
     obstacles: tuple[Obstacle, ...] = ()
+    model: Model = Model.PLANE_STRAIN
 
     @property
     def comm(self) -> MPI.Comm:

@@ -22,6 +22,7 @@ from .model import (
     HertzReference,
     Load,
     Material,
+    Model,
     Obstacle,
     Pressure,
     Reference,
@@ -33,6 +34,7 @@ from .model import (
 TOP_KEYS = {
     "mesh",
     "name",
+    "model",
     "bodies",
     "contact",
     "obstacle",
@@ -156,18 +158,7 @@ def _reference(k: int, entry: Any) -> Reference:
     return UniformStress(sig)  # type: ignore[arg-type]
 
 
-def parse_scene_file(
-    path: Path,
-) -> tuple[
-    Path,
-    str,
-    dict[str, Material],
-    list[ContactPair],
-    list[Dirichlet],
-    list[Load],
-    list[Reference],
-    list[Obstacle],
-]:
+def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
     """Read and check a scene file; return the mesh path and the scene's parts."""
     try:
         doc = tomllib.loads(path.read_text())
@@ -182,6 +173,7 @@ def parse_scene_file(
         raise InputError(f"{path.name}: missing key 'contact' (or 'obstacle')")
     mesh = path.parent / _string("mesh", doc["mesh"])
     name = str(doc.get("name", path.stem))
+    model = Model.parse(_string("model", doc.get("model", Model.PLANE_STRAIN.value)))
     if not isinstance(doc["bodies"], dict) or not doc["bodies"]:
         raise InputError("bodies: expected [bodies.NAME] tables with E and nu")
     bodies = {}
@@ -225,7 +217,10 @@ def parse_scene_file(
         )
     refs = [_reference(k, e) for k, e in enumerate(_entries(doc, "reference"))]
     obstacles = [_obstacle(k, e) for k, e in enumerate(_entries(doc, "obstacle"))]
-    return mesh, name, bodies, pairs, bcs, loads, refs, obstacles
+    parts = SceneParts(
+        bodies, tuple(pairs), tuple(bcs), tuple(loads), tuple(refs), name, tuple(obstacles), model
+    )
+    return mesh, parts
 
 
 def load_scene_file(
@@ -233,8 +228,5 @@ def load_scene_file(
 ) -> Scene:
     """The Scene of a TOML scene file (mesh path relative to the file)."""
     path = Path(path)
-    mesh, name, bodies, pairs, bcs, loads, refs, obstacles = parse_scene_file(path)
-    parts = SceneParts(
-        bodies, tuple(pairs), tuple(bcs), tuple(loads), tuple(refs), name, tuple(obstacles)
-    )
+    mesh, parts = parse_scene_file(path)
     return scene_from_gmsh(mesh, parts, comm, size_factor, {"scene_file": str(path)})

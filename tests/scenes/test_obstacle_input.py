@@ -61,9 +61,9 @@ def test_bad_obstacle_tables(tmp_path: Path, obstacle: str, needle: str) -> None
 
 def test_scene_file_and_python_api_agree(tmp_path: Path) -> None:
     """[[obstacle]] and Obstacle(...) through scene_from_gmsh make the same scene and answer."""
-    parsed = parse_scene_file(INDENTER)[-1]
+    parsed = parse_scene_file(INDENTER)[1].obstacles
     made = Obstacle("indenter", "circle", "top", center=(0, 20), radius=20, displacement=(0, -0.05))
-    assert parsed == [made]
+    assert parsed == (made,)
     scene = scene_from_gmsh(
         DEMO_SCENES / "rigid_block.geo",
         bodies={"block": {"E": 7000.0, "nu": 0.3}},
