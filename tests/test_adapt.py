@@ -123,6 +123,7 @@ def test_weight_below_one_refused(tmp_path: Path) -> None:
 
 def test_overshooting_mesh_is_replanned_not_dropped(monkeypatch: pytest.MonkeyPatch) -> None:
     """A remeshed level above --max-dofs is planned again with a smaller budget and kept."""
+    from contactfx.request import SolveRequest
     from contactfx.scenes import HertzParams
     from contactfx.scenes.builtin import hertz
     from contactfx.study import adapt as loop
@@ -142,6 +143,6 @@ def test_overshooting_mesh_is_replanned_not_dropped(monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(loop, "plan_mesh", recording)
     monkeypatch.setattr(loop, "_mesh_dofs", overshoot_once)
     scene = hertz(HertzParams(refine=2, h_far=2, refine_edge=0, slope=0.3))
-    result = loop.adapt(scene, "mortar", opts, say=lambda _: None)
+    result = loop.adapt(scene, SolveRequest.parse("mortar"), opts, say=lambda _: None)
     assert len(budgets) == 2 and budgets[1] == pytest.approx(budgets[0] * 0.95 / 2)
     assert len(result.levels) == 2 and result.levels[1].dofs <= opts.max_dofs

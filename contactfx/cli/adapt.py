@@ -15,10 +15,9 @@ from ..adapt.loop import AdaptOptions, AdaptResult, adapt, level_record, uniform
 from ..adapt.mesh_file import write_msh
 from ..adapt.sizing import SizingRule, default_contact_weight
 from ..errors import InputError
-from ..options import Method
 from ..results.files import write_fields, write_json
 from ..scenes import parse_scene_file
-from .params import build_from_args, is_scene_file, reject_structured_adapt, spec_from_args
+from .params import build_from_args, is_scene_file, reject_structured_adapt, request_from_args
 
 
 def check_remeshable(args: argparse.Namespace) -> None:
@@ -66,8 +65,6 @@ def run_adapt(args: argparse.Namespace) -> int:
     comm = MPI.COMM_WORLD
     if not args.verbose:
         logging.getLogger("contactfx").setLevel(logging.WARNING)
-    if args.method in (Method.SCHWARZ.value,):
-        raise InputError("adapt needs a multiplier or penalty method (nts, sts, mortar, penalty)")
     opts = AdaptOptions(
         args.tol,
         args.max_dofs,
@@ -77,12 +74,11 @@ def run_adapt(args: argparse.Namespace) -> int:
     )
     opts.check()
     check_remeshable(args)
-    spec = spec_from_args(args)
+    request = request_from_args(args)
     say = (lambda line: print(line, flush=True)) if comm.rank == 0 else (lambda line: None)
     t0 = time.perf_counter()
     scene = build_from_args(args)
     mesh_time = time.perf_counter() - t0
-    options = {"max_iterations": args.max_iterations}
     paper = not is_scene_file(args.scene)
     say(
         f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
@@ -90,10 +86,8 @@ def run_adapt(args: argparse.Namespace) -> int:
     )
     result = adapt(
         scene,
-        args.method,
+        request,
         opts,
-        solver=spec,
-        options=options,
         paper_interface=paper,
         say=say,
         mesh_time=mesh_time,
@@ -101,11 +95,9 @@ def run_adapt(args: argparse.Namespace) -> int:
     if args.compare_uniform:
         result.uniform = uniform_levels(
             scene,
-            args.method,
+            request,
             max(opts.max_dofs, result.levels[-1].dofs),
             max_levels=max(opts.max_levels, 2),
-            solver=spec,
-            options=options,
             paper_interface=paper,
             say=say,
         )
