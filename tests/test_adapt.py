@@ -123,10 +123,10 @@ def test_weight_below_one_refused(tmp_path: Path) -> None:
 
 def test_overshooting_mesh_is_replanned_not_dropped(monkeypatch: pytest.MonkeyPatch) -> None:
     """A remeshed level above --max-dofs is planned again with a smaller budget and kept."""
+    from contactfx.adapt import loop
     from contactfx.request import SolveRequest
     from contactfx.scenes import HertzParams
     from contactfx.scenes.builtin import hertz
-    from contactfx.study import adapt as loop
 
     budgets: list[float] = []
     plan, count = loop.plan_mesh, loop._mesh_dofs
