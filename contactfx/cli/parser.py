@@ -127,11 +127,11 @@ def _solver_options(p: argparse.ArgumentParser) -> Any:
     return v
 
 
-def _enforcement_option(group: Any, choices: list[Enforcement]) -> None:
+def _enforcement_option(group: Any) -> None:
     """--enforcement: how the constraint of the --method discretization is enforced."""
     group.add_argument(
         "--enforcement",
-        choices=[e.value for e in choices],
+        choices=[e.value for e in Enforcement],
         default=None,
         help="how the contact constraint is enforced on the --method discretization "
         "(default: multipliers, or the one --method penalty/schwarz names)",
@@ -156,7 +156,7 @@ def _solve_parser(sub: Any) -> None:
         "patch test on non-matching meshes); penalty and schwarz stand for mortar with that "
         "enforcement",
     )
-    _enforcement_option(m, list(Enforcement))
+    _enforcement_option(m)
     m.add_argument(
         "--penalty",
         type=float,
@@ -225,8 +225,6 @@ def _adapt_parser(sub: Any) -> None:
         choices=[v.value for v in Method if v is not Method.SCHWARZ],
         help="contact discretization (default mortar; penalty: mortar with penalty)",
     )
-    # Schwarz has no error estimate to adapt by.
-    _enforcement_option(m, [Enforcement.MULTIPLIERS, Enforcement.PENALTY])
     m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
     _solver_options(s)
     a = s.add_argument_group("adaptivity")
