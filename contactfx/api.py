@@ -21,7 +21,7 @@ from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.schwarz import solve_schwarz
 from .methods.solution import Solution
 from .options import Basis, Enforcement, Method, Predictor, SolverSpec
-from .request import SchwarzOptions, SolveRequest
+from .request import DEFAULT_MAX_ITERATIONS, DEFAULT_SOLVER, SchwarzOptions, SolveRequest
 from .results.summary import summary
 from .scenes import BlockParams, HertzParams, Scene, build_scene
 from .timers import Timers
@@ -63,10 +63,10 @@ def as_request(
     return SolveRequest.parse(
         method,
         enforcement=enforcement,
-        solver="mumps" if solver is None else solver,
+        solver=DEFAULT_SOLVER if solver is None else solver,
         basis=Basis.STANDARD if basis is None else basis,
         predictor=Predictor.AUTO if predictor is None else predictor,
-        max_iterations=50 if max_iterations is None else max_iterations,
+        max_iterations=DEFAULT_MAX_ITERATIONS if max_iterations is None else max_iterations,
         penalty=penalty,
         schwarz=schwarz,
         reference_timing=bool(reference_timing),

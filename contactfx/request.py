@@ -26,6 +26,10 @@ from .options import (
     solver_spec,
 )
 
+# The defaults of a request made from names (SolveRequest.parse, contactfx.solve).
+DEFAULT_SOLVER = "mumps"
+DEFAULT_MAX_ITERATIONS = 50
+
 
 @dataclass(frozen=True)
 class SchwarzOptions:
@@ -62,8 +66,8 @@ class SolveRequest:
     enforcement: Enforcement = Enforcement.MULTIPLIERS
     basis: Basis = Basis.STANDARD
     predictor: Predictor = Predictor.AUTO
-    solver: SolverSpec = field(default_factory=lambda: SOLVERS["mumps"])
-    max_iterations: int = 50
+    solver: SolverSpec = field(default_factory=lambda: SOLVERS[DEFAULT_SOLVER])
+    max_iterations: int = DEFAULT_MAX_ITERATIONS
     penalty: float | None = None
     schwarz: SchwarzOptions | None = None
     reference_timing: bool = False
@@ -102,10 +106,10 @@ class SolveRequest:
         method: Method | str = Method.MORTAR,
         *,
         enforcement: Enforcement | str | None = None,
-        solver: SolverSpec | str = "mumps",
+        solver: SolverSpec | str = DEFAULT_SOLVER,
         basis: Basis | str = Basis.STANDARD,
         predictor: Predictor | str = Predictor.AUTO,
-        max_iterations: int = 50,
+        max_iterations: int = DEFAULT_MAX_ITERATIONS,
         penalty: float | None = None,
         schwarz: SchwarzOptions | None = None,
         reference_timing: bool = False,
