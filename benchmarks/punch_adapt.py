@@ -28,6 +28,7 @@ import numpy as np
 from contactfx import load_scene_file, run_scene
 from contactfx.adapt.loop import AdaptOptions, adapt, uniform_levels
 from contactfx.adapt.sizing import SizingRule
+from contactfx.request import SolveRequest
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "demos" / "scenes"
@@ -109,9 +110,10 @@ def main() -> None:
     )
     start = load_scene_file(scene_with(tmp, "uniform", f"{args.h0}"))
     quiet = lambda line: None  # noqa: E731
+    nts = SolveRequest.parse("nts")
     result = adapt(
         start,
-        "nts",
+        nts,
         AdaptOptions(
             1e-9,
             args.max_dofs,
@@ -120,7 +122,7 @@ def main() -> None:
         ),
         say=print,
     )
-    uni = uniform_levels(start, "nts", args.uniform_dofs or args.max_dofs, say=quiet)
+    uni = uniform_levels(start, nts, args.uniform_dofs or args.max_dofs, say=quiet)
     rows = {}
     for name, levels in (("adaptive", result.levels), ("uniform", uni)):
         rows[name] = []

@@ -19,8 +19,18 @@ from .errors import (
     SingularSystemError,
     SolverError,
 )
-from .methods import SchwarzOptions, Solution
-from .options import SOLVERS, Basis, Method, Predictor, SolverKind, SolverSpec
+from .methods import Solution
+from .options import (
+    SOLVERS,
+    Basis,
+    Discretization,
+    Enforcement,
+    Method,
+    Predictor,
+    SolverKind,
+    SolverSpec,
+)
+from .request import SchwarzOptions, SolveRequest
 from .scenes import (
     HertzReference,
     Obstacle,
@@ -38,6 +48,8 @@ __all__ = [
     "Basis",
     "ContactFxError",
     "ConvergenceError",
+    "Discretization",
+    "Enforcement",
     "GeometryError",
     "HertzReference",
     "InputError",
@@ -49,6 +61,7 @@ __all__ = [
     "SchwarzOptions",
     "SingularSystemError",
     "Solution",
+    "SolveRequest",
     "SolverError",
     "SolverKind",
     "SolverSpec",

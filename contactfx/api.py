@@ -1,14 +1,14 @@
-"""The Python API: solve(scene, method) -> Solution, run_scene with its summary, run_case.
+"""The Python API: solve(scene, method) -> Solution, run_scene with its JSON summary, run_case.
 
-The CLI, the demos, the benchmarks and the tests are thin layers over these calls. Every
-option is validated here, once, into its typed value (options.py).
+The CLI, the demos, the benchmarks and the tests are thin layers over these calls. The
+options given by name become one SolveRequest (request.py), validated when it is made;
+below this module only the request travels.
 """
 
 from __future__ import annotations
 
 import resource
 import time
-from typing import Any
 
 from mpi4py import MPI
 
@@ -17,45 +17,93 @@ from .methods.active_set import ActiveSetOptions
 from .methods.multipliers import solve_contact
 from .methods.penalty import solve_penalty
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
-from .methods.schwarz import SchwarzOptions, solve_schwarz
+from .methods.schwarz import solve_schwarz
 from .methods.solution import Solution
-from .options import SOLVERS, Basis, Method, Predictor, SolverSpec, solver_spec
+from .options import Basis, Enforcement, Method, Predictor, SolverSpec
+from .request import DEFAULT_MAX_ITERATIONS, DEFAULT_SOLVER, SchwarzOptions, SolveRequest
 from .results.records import RunSummary
-from .results.summary import solver_label, summary
+from .results.summary import summary
 from .scenes import BlockParams, HertzParams, Scene, build_scene
 from .timers import Timers
 
 TIME_KEYS = ("mesh", "assemble", "search", "contact", "solve")
 
 
-def solve(
-    scene: Scene,
-    method: Method | str = Method.MORTAR,
+def as_request(
+    method: SolveRequest | Method | str = Method.MORTAR,
     *,
-    solver: SolverSpec | str = "mumps",
-    max_iterations: int = 50,
+    enforcement: Enforcement | str | None = None,
+    solver: SolverSpec | str | None = None,
+    basis: Basis | str | None = None,
+    predictor: Predictor | str | None = None,
+    max_iterations: int | None = None,
     penalty: float | None = None,
     schwarz: SchwarzOptions | None = None,
-    reference_timing: bool = False,
-    predictor: Predictor | str = Predictor.AUTO,
+    reference_timing: bool | None = None,
+) -> SolveRequest:
+    """`method` itself if it is a request (no option beside it), else the parsed request.
+
+    The options are `solve`'s; None takes the default.
+    """
+    if isinstance(method, SolveRequest):
+        given = {
+            "enforcement": enforcement,
+            "solver": solver,
+            "basis": basis,
+            "predictor": predictor,
+            "max_iterations": max_iterations,
+            "penalty": penalty,
+            "schwarz": schwarz,
+            "reference_timing": reference_timing,
+        }
+        named = [k for k, v in given.items() if v is not None]
+        if named:
+            raise InputError(f"option {named[0]} given beside a SolveRequest: set it in it")
+        return method
+    return SolveRequest.parse(
+        method,
+        enforcement=enforcement,
+        solver=DEFAULT_SOLVER if solver is None else solver,
+        basis=Basis.STANDARD if basis is None else basis,
+        predictor=Predictor.AUTO if predictor is None else predictor,
+        max_iterations=DEFAULT_MAX_ITERATIONS if max_iterations is None else max_iterations,
+        penalty=penalty,
+        schwarz=schwarz,
+        reference_timing=bool(reference_timing),
+    )
+
+
+def solve(
+    scene: Scene,
+    method: SolveRequest | Method | str = Method.MORTAR,
+    *,
+    enforcement: Enforcement | str | None = None,
+    solver: SolverSpec | str | None = None,
+    basis: Basis | str | None = None,
+    predictor: Predictor | str | None = None,
+    max_iterations: int | None = None,
+    penalty: float | None = None,
+    schwarz: SchwarzOptions | None = None,
+    reference_timing: bool | None = None,
     timers: Timers | None = None,
-    basis: Basis | str = Basis.STANDARD,
     initial: Solution | None = None,
 ) -> Solution:
-    """Solve the frictionless contact problem of `scene` with `method`.
+    """Solve the frictionless contact problem of `scene` as `method` asks.
 
     Args:
         scene: The scene (a built-in scene, a scene file, or `scene_from_gmsh`).
-        method: nts, sts, mortar (multipliers), penalty, or schwarz.
-        solver: A preset name of `SOLVERS` or a SolverSpec.
-        max_iterations: Limit of the active-set (or Schwarz) iterations.
+        method: A SolveRequest, or a method's name: nts, sts, mortar (multipliers), penalty
+            or schwarz (mortar with that enforcement).
+        enforcement: multipliers, penalty or schwarz on the discretization `method` names.
+        solver: A preset name of `SOLVERS` or a SolverSpec (default mumps).
+        basis: Mortar's multiplier basis: standard or dual (biorthogonal, D diagonal).
+        predictor: auto, coarse (a first active set from a coarser solve of the same scene)
+            or none; the converged solution does not depend on it.
+        max_iterations: Limit of the active-set (or Schwarz) iterations (default 50).
         penalty: The penalty method's normal stiffness (default 1e3 E_max / h).
         schwarz: The Schwarz method's controls.
         reference_timing: Also time one fresh solve of the final system (the cost floor).
-        predictor: auto, coarse (a first active set from a coarser solve of the same scene)
-            or none; the converged solution does not depend on it.
         timers: Where the labelled times go (a new Timers if None).
-        basis: Mortar's multiplier basis: standard or dual (biorthogonal, D diagonal).
         initial: A solution of the same scene on another mesh (an adaptive loop's previous
             level): its active set is the first guess of a multiplier method, in place of
             the predictor's (penalty and schwarz have no active-set guess to take).
@@ -63,72 +111,85 @@ def solve(
     Returns:
         The Solution: displacement, multipliers per pair, history and costs.
     """
-    method = Method.parse(method)
-    basis = Basis.parse(basis)
-    predictor = Predictor.parse(predictor)
-    spec = solver_spec(solver)
-    if basis is not Basis.STANDARD and method is not Method.MORTAR:
-        raise InputError(f"the {basis.value} multiplier basis applies to the mortar method only")
-    if method is Method.SCHWARZ and spec != SOLVERS["mumps"]:
-        raise InputError(
-            "schwarz factorizes each body with MUMPS: the solver option does not apply to it"
-        )
-    timers = timers or Timers()
-    aso = ActiveSetOptions(max_iterations)
-    if method is Method.PENALTY:
-        return solve_penalty(scene, penalty, spec, aso, timers)
-    if method is Method.SCHWARZ:
-        return solve_schwarz(
-            scene, schwarz or SchwarzOptions(max_iterations=max_iterations), timers
-        )
-    init = (
-        coarse_initial_set(initial, margin=coarse_margin(spec))
-        if initial is not None
-        else predict(scene, method, spec, predictor, aso, basis, timers)
-    )
-    return solve_contact(
-        scene,
+    request = as_request(
         method,
-        spec,
-        aso,
-        timers,
-        reference_timing=reference_timing,
-        initial_active=init,
+        enforcement=enforcement,
+        solver=solver,
         basis=basis,
+        predictor=predictor,
+        max_iterations=max_iterations,
+        penalty=penalty,
+        schwarz=schwarz,
+        reference_timing=reference_timing,
     )
+    return solve_request(scene, request, timers, initial)
+
+
+def solve_request(
+    scene: Scene,
+    request: SolveRequest,
+    timers: Timers | None = None,
+    initial: Solution | None = None,
+) -> Solution:
+    """Run the method of `request` on `scene` (see `solve`)."""
+    timers = timers or Timers()
+    aso = ActiveSetOptions(request.max_iterations)
+    if request.enforcement is Enforcement.PENALTY:
+        return solve_penalty(scene, request, timers, aso=aso)
+    if request.enforcement is Enforcement.SCHWARZ:
+        return solve_schwarz(scene, request, timers)
+    init = (
+        coarse_initial_set(initial, margin=coarse_margin(request.solver))
+        if initial is not None
+        else predict(scene, request, aso, timers)
+    )
+    return solve_contact(scene, request, timers, aso=aso, initial_active=init)
 
 
 def run_scene(
     scene: Scene,
-    method: Method | str = Method.MORTAR,
+    method: SolveRequest | Method | str = Method.MORTAR,
     *,
-    solver: SolverSpec | str = "mumps",
+    enforcement: Enforcement | str | None = None,
+    solver: SolverSpec | str | None = None,
+    basis: Basis | str | None = None,
+    predictor: Predictor | str | None = None,
+    max_iterations: int | None = None,
+    penalty: float | None = None,
+    schwarz: SchwarzOptions | None = None,
+    reference_timing: bool | None = None,
     t_start: float | None = None,
     timers: Timers | None = None,
     paper_interface: bool = False,
-    **options: Any,
+    initial: Solution | None = None,
 ) -> tuple[Solution, RunSummary]:
     """Solve `scene` and return the solution with its summary (times from `t_start`).
 
-    `options` go to `solve`; `paper_interface` adds the x-sorted `interface` block of pair
-    0 (the paper's scenes: one horizontal contact line). The summary's `to_json()` is the
-    JSON of `contactfx solve --json`.
+    `method` and the options are `solve`'s; `paper_interface` adds the x-sorted `interface`
+    block of pair 0 (the paper's scenes: one horizontal contact line). The summary's
+    `to_json()` is the JSON of `contactfx solve --json`.
     """
     t_start = time.perf_counter() if t_start is None else t_start
     timers = timers or Timers()
-    spec = solver_spec(solver)
-    sol = solve(scene, method, solver=spec, timers=timers, **options)
+    request = as_request(
+        method,
+        enforcement=enforcement,
+        solver=solver,
+        basis=basis,
+        predictor=predictor,
+        max_iterations=max_iterations,
+        penalty=penalty,
+        schwarz=schwarz,
+        reference_timing=reference_timing,
+    )
+    sol = solve_request(scene, request, timers, initial)
     times = {k: timers.seconds.get(k, 0.0) for k in TIME_KEYS}
     for key in ("predictor", "reference_solve", "reference_lu", "reference_ldlt"):
         if key in timers.seconds:
             times[key] = timers.seconds[key]
     times["total"] = time.perf_counter() - t_start
     return sol, summary(
-        sol,
-        times,
-        solver=solver_label(sol.method, spec),
-        memory=peak_memory(scene.comm),
-        paper_interface=paper_interface,
+        sol, times, request=request, memory=peak_memory(scene.comm), paper_interface=paper_interface
     )
 
 
@@ -145,15 +206,22 @@ def peak_memory(comm: MPI.Comm) -> dict[str, float]:
 def run_case(
     kind: str,
     params: BlockParams | HertzParams,
-    method: Method | str,
+    method: SolveRequest | Method | str,
     active: int = 2,
-    solver: SolverSpec | str = "mumps",
     comm: MPI.Comm = MPI.COMM_WORLD,
-    **options: Any,
+    *,
+    enforcement: Enforcement | str | None = None,
+    solver: SolverSpec | str | None = None,
+    basis: Basis | str | None = None,
+    predictor: Predictor | str | None = None,
+    max_iterations: int | None = None,
+    penalty: float | None = None,
+    schwarz: SchwarzOptions | None = None,
+    reference_timing: bool | None = None,
 ) -> tuple[Solution, RunSummary]:
     """Mesh, assemble and solve a built-in scene; return the solution and its summary.
 
-    `options` go to `solve`; the summary carries the paper's `interface` block.
+    `method` and the options are `solve`'s; the summary carries the paper's `interface` block.
     """
     t_start = time.perf_counter()
     timers = Timers()
@@ -162,9 +230,15 @@ def run_case(
     return run_scene(
         scene,
         method,
+        enforcement=enforcement,
         solver=solver,
+        basis=basis,
+        predictor=predictor,
+        max_iterations=max_iterations,
+        penalty=penalty,
+        schwarz=schwarz,
+        reference_timing=reference_timing,
         t_start=t_start,
         timers=timers,
         paper_interface=True,
-        **options,
     )

@@ -1,4 +1,4 @@
-"""The choices a user makes, as typed values validated once: method, basis, predictor, solver.
+"""The choices a user makes, as typed values: discretization, enforcement, basis, solver.
 
 A `SolverSpec` says which linear solver runs (`kind`), the PETSc options it is configured
 with (PETSc keys only) and the tolerances the code itself applies. Nothing infers the kind
@@ -22,8 +22,57 @@ def _unknown(enum: type[StrEnum], value: object, what: str) -> InputError:
     return InputError(f"unknown {what} '{value}' (choose {choices})")
 
 
+class Discretization(StrEnum):
+    """The discrete contact operator (B, weighted gap): which kernel builds it."""
+
+    NTS = "nts"
+    STS = "sts"
+    MORTAR = "mortar"
+
+    @property
+    def kernel(self) -> Kernel:
+        """The kernel of contactfx/contact that assembles this discretization."""
+        return _KERNELS[self]
+
+    @classmethod
+    def parse(cls, value: Discretization | str) -> Discretization:
+        """The discretization named `value`."""
+        try:
+            return cls(value)
+        except ValueError:
+            raise _unknown(cls, value, "discretization") from None
+
+
+_KERNELS: Mapping[Discretization, Kernel] = MappingProxyType(
+    {
+        Discretization.NTS: Kernel.NTS,
+        Discretization.STS: Kernel.STS,
+        Discretization.MORTAR: Kernel.MORTAR,
+    }
+)
+
+
+class Enforcement(StrEnum):
+    """How the contact constraint is enforced on a discretization."""
+
+    MULTIPLIERS = "multipliers"  # Lagrange multipliers: saddle points in an active-set loop
+    PENALTY = "penalty"  # a normal stiffness on the penetrating rows, no multipliers
+    SCHWARZ = "schwarz"  # Dirichlet-Neumann iteration between the two bodies
+
+    @classmethod
+    def parse(cls, value: Enforcement | str) -> Enforcement:
+        """The enforcement named `value`."""
+        try:
+            return cls(value)
+        except ValueError:
+            raise _unknown(cls, value, "enforcement") from None
+
+
 class Method(StrEnum):
-    """Contact enforcement methods."""
+    """The names of --method: a discretization, or an alias of a (discretization, enforcement).
+
+    The JSON key "method" holds these names; `pair` is the alias table.
+    """
 
     NTS = "nts"
     STS = "sts"
@@ -32,17 +81,19 @@ class Method(StrEnum):
     SCHWARZ = "schwarz"
 
     @property
+    def pair(self) -> tuple[Discretization, Enforcement]:
+        """The discretization and the enforcement this name stands for."""
+        return _ALIASES[self]
+
+    @property
     def kernel(self) -> Kernel:
         """The discrete contact operator (B, weighted gap) this method is built on."""
-        return {
-            Method.NTS: Kernel.NTS,
-            Method.STS: Kernel.STS,
-        }.get(self, Kernel.MORTAR)
+        return self.pair[0].kernel
 
     @property
     def has_multipliers(self) -> bool:
         """Whether the method solves saddle points with Lagrange multipliers."""
-        return self in (Method.NTS, Method.STS, Method.MORTAR)
+        return self.pair[1] is Enforcement.MULTIPLIERS
 
     @classmethod
     def parse(cls, value: Method | str) -> Method:
@@ -51,6 +102,18 @@ class Method(StrEnum):
             return cls(value)
         except ValueError:
             raise _unknown(cls, value, "method") from None
+
+
+_ALIASES: Mapping[Method, tuple[Discretization, Enforcement]] = MappingProxyType(
+    {
+        Method.NTS: (Discretization.NTS, Enforcement.MULTIPLIERS),
+        Method.STS: (Discretization.STS, Enforcement.MULTIPLIERS),
+        Method.MORTAR: (Discretization.MORTAR, Enforcement.MULTIPLIERS),
+        # Penalty and Schwarz as they always ran: on the mortar operator.
+        Method.PENALTY: (Discretization.MORTAR, Enforcement.PENALTY),
+        Method.SCHWARZ: (Discretization.MORTAR, Enforcement.SCHWARZ),
+    }
+)
 
 
 class Basis(StrEnum):
@@ -103,6 +166,16 @@ class SolverKind(StrEnum):
         return self in (SolverKind.CONDENSED, SolverKind.CONDENSED_DIRECT)
 
 
+class SchurPre(StrEnum):
+    """A Schur-complement fieldsplit's preconditioning matrix for S."""
+
+    SELFP = "selfp"  # PETSc's A11 - A10 inv(diag(A00)) A01
+    USER = "user"  # the code supplies the augmented-Lagrangian diagonal -I/gamma
+
+
+SCHUR_KEY = "pc_fieldsplit_schur_precondition"
+
+
 @dataclass(frozen=True)
 class SolverSpec:
     """A linear solver: its kind, its PETSc options and the tolerances the code applies.
@@ -110,6 +183,7 @@ class SolverSpec:
     `petsc` holds PETSc keys only (no leading dash). `rtol` is the final relative tolerance
     of an iterative solver (the condensed solver's CG); `loose_rtol` the relative reduction
     the condensed loop's solves stop at before the set is stationary (None: solve to rtol).
+    `schur` is a fieldsplit's Schur preconditioner; its PETSc option is derived from it.
     """
 
     kind: SolverKind
@@ -117,13 +191,25 @@ class SolverSpec:
     rtol: float = 1e-9
     loose_rtol: float | None = None
     name: str = "custom"
+    schur: SchurPre | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "petsc", MappingProxyType(dict(self.petsc)))
         self._check()
+        petsc = dict(self.petsc)
+        if self.schur is not None:
+            petsc[SCHUR_KEY] = self.schur.value
+        object.__setattr__(self, "petsc", MappingProxyType(petsc))
 
     def _check(self) -> None:
-        """Refuse PETSc options that contradict the kind (they would change the code path)."""
+        """Refuse PETSc options that contradict the kind or the Schur preconditioner."""
+        given = self.petsc.get(SCHUR_KEY)
+        if given is not None and (self.schur is None or str(given) != self.schur.value):
+            raise InputError(
+                f"solver '{self.name}': PETSc option {SCHUR_KEY}={given} contradicts its "
+                f"Schur preconditioner ({self.schur.value if self.schur else 'none'})"
+            )
+        if self.schur is not None and self.kind is not SolverKind.FIELDSPLIT:
+            raise InputError(f"solver '{self.name}': a Schur preconditioner needs a fieldsplit")
         pc = self.petsc.get("pc_type")
         bad = {
             SolverKind.DIRECT: pc not in ("lu", "cholesky"),
@@ -156,10 +242,11 @@ class SolverSpec:
         """The spec with PETSc options KEY=VALUE added (checked against the kind).
 
         For the condensed solver `ksp_rtol` is the tolerance the code applies itself (its
-        final solves), so it sets `rtol` rather than a PETSc option that would be overridden.
+        final solves), so it sets `rtol` rather than a PETSc option that would be overridden;
+        for a fieldsplit pc_fieldsplit_schur_precondition sets `schur`.
         """
         petsc = dict(self.petsc)
-        rtol = self.rtol
+        rtol, schur = self.rtol, self.schur
         for item in items:
             key, sep, value = item.partition("=")
             key = key.strip().lstrip("-")
@@ -171,8 +258,16 @@ class SolverSpec:
                 except ValueError:
                     raise InputError(f"--petsc-option {item}: not a number") from None
                 continue
+            if key == SCHUR_KEY and self.kind is SolverKind.FIELDSPLIT:
+                # The choice is a field of the spec (the code supplies the "user" matrix).
+                try:
+                    schur = SchurPre(value)
+                except ValueError:
+                    raise _unknown(SchurPre, value, SCHUR_KEY) from None
             petsc[key] = value
-        return replace(self, petsc=petsc, rtol=rtol)
+        if self.kind is SolverKind.FIELDSPLIT:
+            petsc.pop(SCHUR_KEY, None)
+        return replace(self, petsc=petsc, rtol=rtol, schur=schur)
 
 
 _MUMPS_LU: dict[str, object] = {
@@ -207,7 +302,6 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "pc_type": "fieldsplit",
                 "pc_fieldsplit_type": "schur",
                 "pc_fieldsplit_schur_fact_type": "full",
-                "pc_fieldsplit_schur_precondition": "selfp",
                 "fieldsplit_u_ksp_type": "preonly",
                 "fieldsplit_u_pc_type": "lu",
                 "fieldsplit_u_pc_factor_mat_solver_type": "mumps",
@@ -218,6 +312,7 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "fieldsplit_lambda_pc_type": "jacobi",
             },
             name="fieldsplit",
+            schur=SchurPre.SELFP,
         ),
         # A00 by one GAMG V-cycle with the bodies' rigid modes as near-nullspace, S by the
         # augmented-Lagrangian diagonal -I/gamma (linalg/saddle.py: schur_al_diagonal).
@@ -231,7 +326,6 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "pc_type": "fieldsplit",
                 "pc_fieldsplit_type": "schur",
                 "pc_fieldsplit_schur_fact_type": "upper",
-                "pc_fieldsplit_schur_precondition": "user",
                 "fieldsplit_u_ksp_type": "preonly",
                 "fieldsplit_u_pc_type": "gamg",
                 "fieldsplit_u_pc_gamg_threshold": 0.01,
@@ -242,6 +336,7 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "fieldsplit_lambda_pc_type": "jacobi",
             },
             name="fieldsplit-gamg",
+            schur=SchurPre.USER,
         ),
         # Multipliers eliminated (D diagonal: NTS or dual mortar), CG on the SPD displacement
         # system, GAMG (Chebyshev/Jacobi, one level of aggressive coarsening) with the bodies'

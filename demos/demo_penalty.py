@@ -35,6 +35,7 @@ from mpi4py import MPI
 from contactfx.methods.multipliers import solve_contact
 from contactfx.methods.penalty import DEFAULT_FACTOR, ConditionOptions, penetration, solve_penalty
 from contactfx.options import Method
+from contactfx.request import SolveRequest
 from contactfx.results.references import hertz_summary
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene
 
@@ -78,7 +79,7 @@ rows = []
 t0 = time.perf_counter()
 for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
     scene = build_scene(kind, params, active=2, comm=comm)
-    ref = solve_contact(scene, Method.MORTAR)
+    ref = solve_contact(scene, SolveRequest.parse(Method.MORTAR))
     eu = unit(ref)
     u_ref = ref.u.x.array.copy()
     u_scale = comm.allreduce(float(np.abs(u_ref).max()), op=MPI.MAX)
@@ -86,7 +87,8 @@ for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
     ref_l2 = hertz_summary(ref).l2_error if kind == "hertz" else 0.0
     for factor in FACTORS:
         eps = factor * eu
-        sol = solve_penalty(scene, eps, condition=ConditionOptions(max_it=CG_MAX_IT))
+        request = SolveRequest.parse("penalty", penalty=eps)
+        sol = solve_penalty(scene, request, condition=ConditionOptions(max_it=CG_MAX_IT))
         du = comm.allreduce(float(np.abs(sol.u.x.array - u_ref).max()), op=MPI.MAX)
         cond = sol.penalty.condition
         row = {

@@ -35,6 +35,7 @@ from mpi4py import MPI
 from contactfx.methods.multipliers import solve_contact
 from contactfx.methods.penalty import solve_penalty
 from contactfx.options import Method
+from contactfx.request import SolveRequest
 from contactfx.results.interface import cartesian_interface as interface
 from contactfx.results.paper import mismatch, patch_errors
 from contactfx.results.stress import body_stress_deviation, surface_stress
@@ -63,7 +64,10 @@ def say(*args: object) -> None:
 
 def solve(scene, method: Method):
     """The Lagrange-multiplier methods, or the penalty baseline at its default eps."""
-    return solve_penalty(scene) if method == Method.PENALTY else solve_contact(scene, method)
+    request = SolveRequest.parse(method)
+    if method == Method.PENALTY:
+        return solve_penalty(scene, request)
+    return solve_contact(scene, request)
 
 
 # -

@@ -18,7 +18,7 @@ from ..api import run_scene
 from ..errors import InputError
 from ..methods.predictor import scene_dofs
 from ..methods.solution import Solution
-from ..options import SolverSpec
+from ..request import SolveRequest
 from ..results.records import RunSummary
 from ..scenes import Scene
 from ..timers import Timers
@@ -145,9 +145,7 @@ def solve_level(
     scene: Scene,
     index: int,
     mesh_time: float,
-    method: str,
-    solver: SolverSpec | str,
-    options: dict[str, Any],
+    request: SolveRequest,
     paper_interface: bool,
     previous: Solution | None = None,
 ) -> AdaptLevel:
@@ -158,15 +156,8 @@ def solve_level(
     recombine it.
     """
     t0 = time.perf_counter()
-    if previous is not None:
-        options = {**options, "initial": previous}
     sol, run = run_scene(
-        scene,
-        method,
-        solver=solver,
-        timers=Timers(),
-        paper_interface=paper_interface,
-        **options,
+        scene, request, timers=Timers(), paper_interface=paper_interface, initial=previous
     )
     est = estimate(sol)
     run = run.with_estimate(est.summary()).with_times(mesh=mesh_time)
@@ -180,11 +171,9 @@ REPLANS = 2
 
 def adapt(
     scene: Scene,
-    method: str,
+    request: SolveRequest,
     opts: AdaptOptions,
     *,
-    solver: SolverSpec | str = "mumps",
-    options: dict[str, Any] | None = None,
     paper_interface: bool = False,
     say: Callable[[str], None] | None = None,
     mesh_time: float = 0.0,
@@ -204,9 +193,7 @@ def adapt(
     stop = f"max levels ({opts.max_levels})"
     for k in range(opts.max_levels):
         previous = levels[-1].solution if levels else None
-        level = solve_level(
-            scene, k, mesh_time, method, solver, options or {}, paper_interface, previous
-        )
+        level = solve_level(scene, k, mesh_time, request, paper_interface, previous)
         levels.append(level)
         say(level_line(level))
         reached = opts.met(level.est)
@@ -253,13 +240,11 @@ def adapt(
 
 def uniform_levels(
     scene: Scene,
-    method: str,
+    request: SolveRequest,
     max_dofs: int,
     *,
     ratio: float = 2.0,
     max_levels: int = 8,
-    solver: SolverSpec | str = "mumps",
-    options: dict[str, Any] | None = None,
     paper_interface: bool = False,
     say: Callable[[str], None] | None = None,
 ) -> list[AdaptLevel]:
@@ -275,7 +260,7 @@ def uniform_levels(
     for k in range(max_levels):
         if scene_dofs(current) > ratio**2 * max_dofs:
             break
-        level = solve_level(current, k, mesh_time, method, solver, options or {}, paper_interface)
+        level = solve_level(current, k, mesh_time, request, paper_interface)
         out.append(level)
         say("uniform " + level_line(level))
         if level.dofs >= max_dofs:

@@ -16,7 +16,7 @@ from ..adapt.sizing import SizingRule, default_contact_weight
 from ..errors import InputError
 from ..results.files import write_fields, write_json
 from ..scenes import parse_scene_file
-from .params import build_from_args, is_scene_file, reject_structured_adapt, spec_from_args
+from .params import build_from_args, is_scene_file, reject_structured_adapt, request_from_args
 
 
 def check_remeshable(args: argparse.Namespace) -> None:
@@ -52,12 +52,11 @@ def run_adapt(args: argparse.Namespace) -> int:
     )
     opts.check()
     check_remeshable(args)
-    spec = spec_from_args(args)
+    request = request_from_args(args)
     say = (lambda line: print(line, flush=True)) if comm.rank == 0 else (lambda line: None)
     t0 = time.perf_counter()
     scene = build_from_args(args)
     mesh_time = time.perf_counter() - t0
-    options = {"max_iterations": args.max_iterations}
     paper = not is_scene_file(args.scene)
     say(
         f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
@@ -65,10 +64,8 @@ def run_adapt(args: argparse.Namespace) -> int:
     )
     result = adapt(
         scene,
-        args.method,
+        request,
         opts,
-        solver=spec,
-        options=options,
         paper_interface=paper,
         say=say,
         mesh_time=mesh_time,
@@ -76,11 +73,9 @@ def run_adapt(args: argparse.Namespace) -> int:
     if args.compare_uniform:
         result.uniform = uniform_levels(
             scene,
-            args.method,
+            request,
             max(opts.max_dofs, result.levels[-1].dofs),
             max_levels=max(opts.max_levels, 2),
-            solver=spec,
-            options=options,
             paper_interface=paper,
             say=say,
         )

@@ -12,7 +12,8 @@ from pathlib import Path
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..options import SolverSpec, solver_spec
+from ..options import Basis, Predictor, SolverSpec, solver_spec
+from ..request import SolveRequest
 from ..scenes import BLOCK_SCENES, BlockParams, HertzParams, Scene, build_scene, load_scene_file
 
 BLOCK_KEYS = (
@@ -128,6 +129,23 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
 def spec_from_args(args: argparse.Namespace) -> SolverSpec:
     """The spec of --solver with every --petsc-option applied (checked against its kind)."""
     return solver_spec(args.solver).with_petsc(args.petsc_option)
+
+
+def request_from_args(args: argparse.Namespace) -> SolveRequest:
+    """The SolveRequest of --method, --enforcement, --solver and the other method options.
+
+    The options a subcommand does not have take their defaults.
+    """
+    return SolveRequest.parse(
+        args.method,
+        enforcement=getattr(args, "enforcement", None),
+        solver=spec_from_args(args),
+        basis=getattr(args, "basis", Basis.STANDARD),
+        predictor=getattr(args, "predictor", Predictor.AUTO),
+        max_iterations=args.max_iterations,
+        penalty=getattr(args, "penalty", None),
+        reference_timing=getattr(args, "reference_timing", False),
+    )
 
 
 def build_from_args(args: argparse.Namespace) -> Scene:

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from ..options import SOLVERS, Basis, Method, Predictor
+from ..options import SOLVERS, Basis, Enforcement, Method, Predictor
 from ..scenes import BLOCK_SCENES, MESHERS
 from .params import BLOCK_KEYS, HERTZ_KEYS, PARAM_HELP
 
@@ -127,6 +127,17 @@ def _solver_options(p: argparse.ArgumentParser) -> Any:
     return v
 
 
+def _enforcement_option(group: Any) -> None:
+    """--enforcement: how the constraint of the --method discretization is enforced."""
+    group.add_argument(
+        "--enforcement",
+        choices=[e.value for e in Enforcement],
+        default=None,
+        help="how the contact constraint is enforced on the --method discretization "
+        "(default: multipliers, or the one --method penalty/schwarz names)",
+    )
+
+
 def _solve_parser(sub: Any) -> None:
     s = sub.add_parser(
         "solve",
@@ -142,8 +153,10 @@ def _solve_parser(sub: Any) -> None:
         default=Method.MORTAR.value,
         choices=[m.value for m in Method],
         help="contact discretization (default mortar: the only one that passes the "
-        "patch test on non-matching meshes)",
+        "patch test on non-matching meshes); penalty and schwarz stand for mortar with that "
+        "enforcement",
     )
+    _enforcement_option(m)
     m.add_argument(
         "--penalty",
         type=float,
@@ -210,7 +223,7 @@ def _adapt_parser(sub: Any) -> None:
         "--method",
         default=Method.MORTAR.value,
         choices=[v.value for v in Method if v is not Method.SCHWARZ],
-        help="contact discretization (default mortar)",
+        help="contact discretization (default mortar; penalty: mortar with penalty)",
     )
     m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
     _solver_options(s)

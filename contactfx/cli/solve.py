@@ -12,12 +12,12 @@ from mpi4py import MPI
 from ..adapt.estimate import estimate
 from ..api import run_scene
 from ..errors import InputError
-from ..options import Method
+from ..options import Enforcement
 from ..results.figures import contact_window, deformed_fields, plot_interface, plot_pair
 from ..results.files import write_contact_surfaces, write_fields, write_json
 from ..results.records import RunSummary
 from ..timers import Timers
-from .params import build_from_args, is_scene_file, spec_from_args
+from .params import build_from_args, is_scene_file, request_from_args
 
 
 def terminal_summary(run: RunSummary) -> list[str]:
@@ -61,11 +61,9 @@ def terminal_summary(run: RunSummary) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     """Run one solve and write its outputs; return the exit code."""
     comm = MPI.COMM_WORLD
-    method = Method(args.method)
-    spec = spec_from_args(args)
-    if args.penalty is not None and method is not Method.PENALTY:
-        raise InputError("--penalty applies to --method penalty only")
-    if args.estimate and method is Method.SCHWARZ:
+    request = request_from_args(args)
+    schwarz = request.enforcement is Enforcement.SCHWARZ
+    if args.estimate and schwarz:
         raise InputError("--estimate needs a multiplier or penalty method, not schwarz")
     t_start = time.perf_counter()
     timers = Timers()
@@ -73,16 +71,10 @@ def run(args: argparse.Namespace) -> int:
         scene = build_from_args(args)
     sol, record = run_scene(
         scene,
-        method,
-        solver=spec,
+        request,
         paper_interface=not is_scene_file(args.scene),
         t_start=t_start,
         timers=timers,
-        max_iterations=args.max_iterations,
-        penalty=args.penalty,
-        reference_timing=args.reference_timing,
-        predictor=args.predictor,
-        basis=args.basis,
     )
     cells: tuple[Any, ...] = ()
     if args.estimate:

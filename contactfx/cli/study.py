@@ -9,9 +9,10 @@ from pathlib import Path
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..options import SOLVERS, Method
+from ..options import Method
+from ..request import SolveRequest
 from ..study import builtin_levels, run_study, scene_file_levels, size_factors, write_outputs
-from ..study.adaptive import adaptive_methods, adaptive_runs
+from ..study.adaptive import adaptive_requests, adaptive_runs
 from ..study.levels import Level
 from ..study.report import adaptive_lines, level_lines, table_lines
 from .params import (
@@ -47,9 +48,9 @@ def levels_from_args(args: argparse.Namespace, comm: MPI.Comm) -> list[Level]:
     return builtin_levels(args.scene, scene_params(args), factors, args.active or 2, comm)
 
 
-def check_adaptive(args: argparse.Namespace, methods: list[str]) -> None:
+def check_adaptive(args: argparse.Namespace, requests: list[SolveRequest]) -> None:
     """InputError before anything runs if --adaptive cannot be done."""
-    if not adaptive_methods(methods):
+    if not adaptive_requests(requests):
         raise InputError("study --adaptive needs a method with an estimate (not only schwarz)")
     if args.pressure_tol is not None and not args.pressure_tol > 0:
         raise InputError(f"--pressure-tol must be > 0 (got {args.pressure_tol})")
@@ -64,13 +65,11 @@ def run_command(args: argparse.Namespace) -> int:
         logging.getLogger("contactfx").setLevel(logging.WARNING)
     methods = parse_methods(args.methods)
     spec = spec_from_args(args)
-    if "schwarz" in methods and spec != SOLVERS["mumps"]:
-        raise InputError(
-            "schwarz factorizes each body with MUMPS: --solver and --petsc-option "
-            "do not apply to it"
-        )
+    requests = [
+        SolveRequest.parse(m, solver=spec, max_iterations=args.max_iterations) for m in methods
+    ]
     if args.adaptive:
-        check_adaptive(args, methods)
+        check_adaptive(args, requests)
     levels = levels_from_args(args, comm)
     say = print if comm.rank == 0 else (lambda *a, **k: None)
     say(
@@ -80,10 +79,8 @@ def run_command(args: argparse.Namespace) -> int:
     )
     study = run_study(
         levels,
-        methods,
-        solver=spec,
+        requests,
         ratio=args.ratio,
-        options={"max_iterations": args.max_iterations},
         comm=comm,
         say=lambda line: say(line, flush=True),
         settings={
@@ -98,8 +95,7 @@ def run_command(args: argparse.Namespace) -> int:
         study.adaptive = adaptive_runs(
             study,
             levels[0].build(),
-            solver=spec,
-            options={"max_iterations": args.max_iterations},
+            requests,
             paper_interface=levels[0].paper_interface,
             max_levels=3 * len(levels),
             pressure_tol=args.pressure_tol,

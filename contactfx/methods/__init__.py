@@ -1,9 +1,10 @@
 """The outer iterations over linear solves, and what a solve returns."""
 
+from ..request import SchwarzOptions
 from .active_set import ActiveSetOptions, InitialSet, lcp_active_set
 from .multipliers import solve_contact
 from .penalty import ConditionOptions, solve_penalty
-from .schwarz import SchwarzOptions, solve_schwarz
+from .schwarz import solve_schwarz
 from .solution import Fields, PairView, PenaltyResult, Solution
 
 __all__ = [

@@ -33,7 +33,7 @@ class ActiveSetOptions:
     max_iterations: int = 50
     penetration_tol: float = 1e-6  # allowed initial penetration relative to the element size
     tolerance: float = 1e-6  # complementarity residual (relative) required at the end
-    predictor: bool = True  # probe candidate sets with multi-RHS solves (direct solvers)
+    probes: bool = True  # probe candidate sets with multi-RHS solves (direct solvers)
     # Largest candidate set probed (its dense block: 8 c^2 bytes, 512 MB at 8000). Above it
     # the loop runs unprobed, a cliff: on the default-graded structured Hertz mesh at 1.23M
     # DOFs (3,298 candidates) that took 16 steps and 89 s, probing them all 2 steps and 33 s;

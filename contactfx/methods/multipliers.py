@@ -21,7 +21,8 @@ from ..discretize.setup import ContactSetup, prepare_contact
 from ..discretize.supports import rigid_body_modes
 from ..errors import EliminationError, InputError
 from ..linalg import LinearSolver, SaddleResult
-from ..options import Basis, Method, SolverKind, SolverSpec, solver_spec
+from ..options import SolverKind, SolverSpec
+from ..request import SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
 from .active_set import (
@@ -36,8 +37,6 @@ from .solution import Solution, finish
 from .solvers import make_solver
 
 log = logging.getLogger("contactfx")
-
-DEFAULT_OPTIONS = ActiveSetOptions()
 
 
 class MultiplierIteration:
@@ -84,7 +83,7 @@ class MultiplierIteration:
             size = layout.size
             if not (
                 self.aso.start_all
-                and self.aso.predictor
+                and self.aso.probes
                 and self.direct
                 and self.solver.cheap_responses
                 and 0 < size
@@ -103,7 +102,7 @@ class MultiplierIteration:
             return every
         x_mine = self.setup.layout.x[self.setup.layout.mine]
         active = active | np.asarray(guess.active(x_mine), dtype=bool)
-        if guess.uncertain is not None and self.aso.predictor and self.direct:
+        if guess.uncertain is not None and self.aso.probes and self.direct:
             # Probe only the band where the guess is unsure: the rest of it stays in contact.
             self.band = np.asarray(guess.uncertain(x_mine), dtype=bool)
             if 0 < comm.allreduce(int((active & self.band).sum())) <= self.aso.max_probes:
@@ -174,7 +173,7 @@ class MultiplierIteration:
             if comm.allreduce(bool(np.array_equal(predicted, active)), op=MPI.LAND):
                 return None
             return Proposal(predicted, "the probes' complementarity problem")
-        if self.aso.predictor and self.direct and not (entered == 0 and self.given_start):
+        if self.aso.probes and self.direct and not (entered == 0 and self.given_start):
             # Probe the union of the current and the updated set: on the Hertz scene the plain
             # update adds every penetrating node and then drops one or two edge nodes per
             # iteration; one multi-right-hand-side solve replaces those iterations. If nodes
@@ -230,20 +229,6 @@ def _solver(setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool)
     )
 
 
-def check_solver(method: Method, basis: Basis, spec: SolverSpec) -> None:
-    """InputError if the solver cannot handle the method's multipliers.
-
-    A diagonal D per method; curved surfaces and obstacles (whose rows also touch the
-    neighbours' pivots) are handled by the coupled elimination of linalg/pivots.py.
-    """
-    diagonal = method is Method.NTS or (method is Method.MORTAR and basis is Basis.DUAL)
-    if spec.kind.condensed and not diagonal:
-        raise InputError(
-            "the condensed solver needs a diagonal D: use --method nts or "
-            "--method mortar --basis dual"
-        )
-
-
 def _timed_fresh_solve(
     setup: ContactSetup, spec: SolverSpec, scene: Scene, active: np.ndarray
 ) -> tuple[SaddleResult, float]:
@@ -280,32 +265,25 @@ def reference_solve(
 
 def solve_contact(
     scene: Scene,
-    method: Method,
-    solver: SolverSpec | str = "mumps",
-    aso: ActiveSetOptions = DEFAULT_OPTIONS,
+    request: SolveRequest,
     timers: Timers | None = None,
-    reference_timing: bool = False,
+    *,
+    aso: ActiveSetOptions | None = None,
     initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None,
-    basis: Basis = Basis.STANDARD,
     label: str = "active set",
 ) -> Solution:
-    """Solve the frictionless unilateral contact problem of `scene` with `method`.
+    """Solve the frictionless unilateral contact problem of `scene` with Lagrange multipliers.
 
-    `initial_active` (node coordinates -> bool, or an InitialSet) adds nodes to the first
-    active set; only the loop's cost depends on it, never the converged solution. `basis`
-    dual takes mortar's biorthogonal multipliers (D diagonal). `label` heads the log lines.
+    `request` gives the discretization, the basis, the solver and the iteration limit (its
+    enforcement is the multipliers': `contactfx.solve` dispatches the others); `aso` other
+    loop controls. `initial_active` (node coordinates -> bool, or an InitialSet) adds nodes
+    to the first active set; only the loop's cost depends on it, never the converged
+    solution. `label` heads the log lines.
     """
-    if not method.has_multipliers:
-        raise InputError(
-            f"the {method.value} method has no saddle-point multipliers: call "
-            "contactfx.solve (it dispatches every method)"
-        )
-    if basis is not Basis.STANDARD and method is not Method.MORTAR:
-        raise InputError(f"the {basis.value} multiplier basis applies to the mortar method only")
-    spec = solver_spec(solver)
-    check_solver(method, basis, spec)
+    aso = aso or ActiveSetOptions(request.max_iterations)
+    spec = request.solver
     timers = timers or Timers()
-    setup = prepare_contact(scene, method.kernel, aso.penetration_tol, timers, basis)
+    setup = prepare_contact(scene, request.kernel, aso.penetration_tol, timers, request.basis)
     try:
         # One solver for the whole loop: fixed matrix pattern, reused analysis and setup.
         linear = _solver(setup, spec, scene, reuse=True)
@@ -320,11 +298,17 @@ def solve_contact(
             step, active, history = run_active_set(setup, iteration, active, aso, timers)
         finally:
             linear.destroy()
-        ref = reference_solve(setup, spec, scene, active, timers) if reference_timing else None
-        sol = finish(setup, method, scene, iteration.u, step.lam, step.gap, active, history, timers)
+        ref = (
+            reference_solve(setup, spec, scene, active, timers)
+            if request.reference_timing
+            else None
+        )
+        sol = finish(
+            setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
+        )
     finally:
         setup.destroy()
-    sol.basis = basis
+    sol.basis = request.basis
     if ref is not None:
         sol.reference_linear_iterations = ref.iterations
     return sol

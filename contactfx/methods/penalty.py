@@ -1,6 +1,7 @@
-"""Penalty baseline: the mortar gap operator enforced by a normal stiffness, no multipliers.
+"""Penalty baseline: a contact gap operator enforced by a normal stiffness, no multipliers.
 
-With the mortar operator row j gives the weighted gap g~_j = gap_j + B_j u = int N_j g dGamma
+On any discretization (nts, sts, mortar: the weights w_j of its rows; the mortar operator
+below) row j gives the weighted gap g~_j = gap_j + B_j u = int N_j g dGamma
 and the weight w_j = int N_j dGamma, so g_j = g~_j / w_j is a nodal gap (cm). The penalty
 energy 1/2 sum_{j in A} eps w_j g_j^2 = 1/2 sum_A eps g~_j^2 / w_j over the penetrating nodes A
 gives the stiffness K + eps B_A^T W^-1 B_A and the nodal contact traction p_j = -eps g_j
@@ -21,9 +22,9 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..discretize.setup import ContactSetup, prepare_contact
-from ..errors import InputError, SolverError
+from ..errors import SolverError
 from ..linalg.petsc_options import petsc_error_message, petsc_options, reason_name
-from ..options import Method, SolverSpec, solver_spec
+from ..request import SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
 from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
@@ -157,35 +158,29 @@ class PenaltyIteration:
 
 def solve_penalty(
     scene: Scene,
-    penalty: float | None = None,
-    solver: SolverSpec | str = "mumps",
-    aso: ActiveSetOptions | None = None,
+    request: SolveRequest,
     timers: Timers | None = None,
+    *,
+    aso: ActiveSetOptions | None = None,
     condition: ConditionOptions | None = None,
 ) -> Solution:
-    """Solve the unilateral contact of `scene` by the penalty method on the mortar gap.
+    """Solve the unilateral contact of `scene` by the penalty method on the request's gap.
 
-    `condition`: also estimate the condition number of the converged penalty matrix.
+    Any discretization's operator serves (nts, sts or mortar: `request.kernel`); the
+    request's solver is a factorization (SolveRequest refuses the others). `condition`: also
+    estimate the condition number of the converged penalty matrix.
     """
-    aso = aso or ActiveSetOptions()
-    spec = solver_spec(solver)
-    if spec.augmented:
-        raise InputError(
-            "the penalty method has no multiplier block: use the mumps solver or "
-            "single-field PETSc options, not a fieldsplit"
-        )
+    aso = aso or ActiveSetOptions(request.max_iterations)
     timers = timers or Timers()
-    setup = prepare_contact(scene, Method.PENALTY.kernel, aso.penetration_tol, timers)
+    setup = prepare_contact(scene, request.kernel, aso.penetration_tol, timers)
     try:
-        eps = default_penalty(setup.e_max, setup.h) if penalty is None else float(penalty)
-        if not (np.isfinite(eps) and eps > 0):
-            raise InputError(f"the penalty parameter must be a positive number (got {eps})")
-        iteration = PenaltyIteration(setup, eps, spec.petsc, False)
+        eps = default_penalty(setup.e_max, setup.h) if request.penalty is None else request.penalty
+        iteration = PenaltyIteration(setup, eps, request.solver.petsc, False)
         active = setup.initial_active(aso.penetration_tol * setup.h)
         step, active, history = run_active_set(setup, iteration, active, aso, timers)
         estimate = None if condition is None else _condition(setup, eps, active, condition)
         sol = finish(
-            setup, Method.PENALTY, scene, iteration.u, step.lam, step.gap, active, history, timers
+            setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
         )
     finally:
         setup.destroy()

@@ -8,6 +8,7 @@ whole solve. Whether it pays is `use_coarse`'s rule (measured in docs/scale.md).
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -15,7 +16,8 @@ from scipy.spatial import cKDTree
 from ..discretize.mesh_utils import owned_facets
 from ..errors import InputError
 from ..logs import stage
-from ..options import SOLVERS, Basis, Method, Predictor, SolverKind, SolverSpec
+from ..options import SOLVERS, Predictor, SolverKind, SolverSpec
+from ..request import SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
 from .active_set import ActiveSetOptions, InitialSet
@@ -129,15 +131,10 @@ def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0)
 
 
 def predict(
-    scene: Scene,
-    method: Method,
-    spec: SolverSpec,
-    predictor: Predictor,
-    aso: ActiveSetOptions,
-    basis: Basis,
-    timers: Timers,
+    scene: Scene, request: SolveRequest, aso: ActiveSetOptions, timers: Timers
 ) -> InitialSet | None:
     """The coarse predictor's first set for `scene`, or None where it is not used."""
+    predictor, spec = request.predictor, request.solver
     if not use_coarse(predictor, scene, spec):
         return None
     if not scene.can_remesh:
@@ -151,6 +148,8 @@ def predict(
         return None
     with timers("predictor"), stage("predictor"):
         coarse = scene.remeshed(coarse_factor(spec))
-        coarse_spec = predictor_solver(spec, coarse)
-        sol = solve_contact(coarse, method, coarse_spec, aso, basis=basis, label="predictor")
+        coarse_request = replace(
+            request, solver=predictor_solver(spec, coarse), reference_timing=False
+        )
+        sol = solve_contact(coarse, coarse_request, aso=aso, label="predictor")
         return coarse_initial_set(sol, margin=coarse_margin(spec))

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -37,6 +36,7 @@ from ..discretize.supports import check_held
 from ..discretize.surfaces import GatheredSurface
 from ..errors import ConvergenceError, GeometryError, InputError
 from ..options import Method
+from ..request import SchwarzOptions, SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
 from .schwarz_sweep import OwnedNodes, Roles, Sweep, Transfer
@@ -47,17 +47,6 @@ log = logging.getLogger("contactfx")
 # Largest angle (as |1 - |n_y||) between a contact-segment normal and the vertical: the
 # Dirichlet condition is set on u_y, which is the normal component only on a flat interface.
 _FLAT_TOL = 1e-10
-
-
-@dataclass(frozen=True)
-class SchwarzOptions:
-    """Controls of the Dirichlet-Neumann iteration."""
-
-    relaxation: float = 0.5  # fixed relaxation, and the first step of Aitken's
-    aitken: bool = True  # Aitken's dynamic relaxation after the first iteration
-    tol: float = 1e-8  # relative change of interface displacement and traction
-    max_iterations: int = 100
-    divergence: float = 1e8  # stop early once the residual grew by this factor
 
 
 def _check_flat(s1: GatheredSurface, s2: GatheredSurface) -> None:
@@ -131,14 +120,15 @@ def _transfer(r: Roles, ndofs: int, comm: MPI.Comm) -> Transfer:
     return Transfer(keep, D, M, spla.splu(D), wgap, op, layout, order)
 
 
-def solve_schwarz(
-    scene: Scene, options: SchwarzOptions = SchwarzOptions(), timers: Timers | None = None
-) -> Solution:
+def solve_schwarz(scene: Scene, request: SolveRequest, timers: Timers | None = None) -> Solution:
     """Solve a two-body full-contact scene by the relaxed Dirichlet-Neumann iteration.
 
     Body N (held by its supports) takes Neumann data, body D (held only by the contact)
     Dirichlet data; the contact line must be straight, horizontal and closed everywhere.
+    The transfer is the mortar discretization's (the request's, which only mortar passes);
+    `request.schwarz_options` are the iteration's controls.
     """
+    options = request.schwarz_options
     if scene.obstacles:
         raise InputError(
             "schwarz does not take rigid obstacles ([[obstacle]]): use nts, sts, mortar or penalty"
@@ -149,8 +139,6 @@ def solve_schwarz(
             f"{len(scene.bodies)} bodies and {len(scene.contacts)} pairs): use "
             "nts, sts or mortar"
         )
-    if not 0.0 < options.relaxation <= 2.0:
-        raise InputError(f"relaxation must lie in (0, 2] (got {options.relaxation})")
     timers = timers or Timers()
     el, ndofs, gathered = assemble_and_gather(scene, timers)
     roles = _roles(scene, el, gathered)

@@ -15,7 +15,7 @@ from ..linalg.nullspace import near_nullspace
 from ..linalg.policy import FactorizationPolicy
 from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
-from ..options import SolverKind, SolverSpec
+from ..options import SchurPre, SolverKind, SolverSpec
 
 # MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the ordering below on
 # the host. Parallel analysis with PT-Scotch (ICNTL(28) = 2, ICNTL(29) = 1) orders
@@ -116,5 +116,5 @@ def make_solver(
         policy=FactorizationPolicy(reuse) if direct else None,
         fieldsplit=spec.kind is SolverKind.FIELDSPLIT,
         # PETSc then asks the code for the Schur preconditioning matrix: -I/gamma.
-        schur_user=spec.petsc.get("pc_fieldsplit_schur_precondition") == "user",
+        schur_user=spec.schur is SchurPre.USER,
     )

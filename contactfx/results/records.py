@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..options import Method
+from ..options import Discretization, Enforcement, Method
 from ..scenes import Obstacle
 from .obstacles import obstacle_json
 
@@ -187,6 +187,8 @@ class RunSummary:
     times: dict[str, float]
     contacts: tuple[ContactSummary, ...]
     solver: str  # the label of the linear solver
+    discretization: Discretization
+    enforcement: Enforcement
     memory: dict[str, float]
     active_nodes: int
     extras: MethodExtras = MethodExtras()
@@ -236,6 +238,8 @@ class RunSummary:
         if self.patch is not None:
             out["patch"] = self.patch.to_json()
         out["solver"] = self.solver
+        out["discretization"] = self.discretization.value
+        out["enforcement"] = self.enforcement.value
         out["memory"] = self.memory
         if self.estimate is not None:
             out["estimate"] = self.estimate.to_json()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from ..methods.solution import Solution
 from ..options import Method, SolverSpec
+from ..request import SolveRequest
 from ..scenes import HertzReference, UniformStress
 from .interface import cartesian_interface, contacts_summary
 from .records import (
@@ -60,7 +61,7 @@ def summary(
     sol: Solution,
     times: dict[str, float],
     *,
-    solver: str,
+    request: SolveRequest,
     memory: dict[str, float],
     paper_interface: bool = False,
 ) -> RunSummary:
@@ -69,7 +70,7 @@ def summary(
     Args:
         sol: The solved scene.
         times: Labelled wall-clock seconds of the run.
-        solver: The linear solver's label (`solver_label`).
+        request: What was solved and how (the solver's label, the two axes).
         memory: Peak resident memory (MB), summed over the ranks and the largest rank's.
         paper_interface: Also the paper's x-sorted `interface` of pair 0 (sigma_yy of both
             bodies), for scenes with one horizontal contact line (the built-in scenes).
@@ -93,7 +94,9 @@ def summary(
         active_set=sol.history,
         times=times,
         contacts=contacts_summary(sol),
-        solver=solver,
+        solver=solver_label(request.method, request.solver),
+        discretization=request.discretization,
+        enforcement=request.enforcement,
         memory=memory,
         active_nodes=int(sol.active.sum()),
         extras=method_extras(sol),

@@ -12,12 +12,12 @@ the ones before it.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Sequence
 
 from ..adapt.loop import AdaptLevel, AdaptOptions, adapt
 from ..adapt.sizing import SizingRule, default_contact_weight
-from ..options import Method, SolverSpec
+from ..options import Enforcement
+from ..request import SolveRequest
 from ..scenes import Scene
 from .core import Study, exact_errors, self_reference
 from .measures import contact_size, profiles
@@ -32,9 +32,9 @@ NO_TOL = 1e-12
 GROWTH = 2.0
 
 
-def adaptive_methods(methods: list[str]) -> list[str]:
-    """The study's methods that have an error estimate (all but schwarz)."""
-    return [m for m in methods if m != Method.SCHWARZ.value]
+def adaptive_requests(requests: Sequence[SolveRequest]) -> list[SolveRequest]:
+    """The requests whose solutions have an error estimate (all but schwarz's)."""
+    return [r for r in requests if r.enforcement is not Enforcement.SCHWARZ]
 
 
 def budget(study: Study, method: str) -> int | None:
@@ -64,16 +64,17 @@ def _prefixed(say: Callable[[str], None] | None, prefix: str) -> Callable[[str],
 def adaptive_runs(
     study: Study,
     scene: Scene,
+    requests: Sequence[SolveRequest],
     *,
-    solver: SolverSpec | str = "mumps",
-    options: dict[str, Any] | None = None,
     paper_interface: bool = False,
     max_levels: int = 12,
     growth: float = GROWTH,
     pressure_tol: float | None = None,
     say: Callable[[str], None] | None = None,
 ) -> list[AdaptiveRun]:
-    """Run the adaptive loop of every method from `scene` (level 0) and measure its levels.
+    """Run the adaptive loop of every request from `scene` (level 0) and measure its levels.
+
+    `requests` are the study's (those it ran, by label; schwarz's are skipped).
 
     With `pressure_tol` the contact cells are sized for the pressure too, and the contact
     terms are not weighted (as adapt's defaults).
@@ -81,16 +82,15 @@ def adaptive_runs(
     rule = SizingRule(growth=growth, contact_weight=default_contact_weight(pressure_tol))
     ref = self_reference(study.runs, study.methods) if study.reference["kind"] == "self" else None
     out: list[AdaptiveRun] = []
-    for m in adaptive_methods(study.methods):
-        cap = budget(study, m)
+    for request in adaptive_requests(requests):
+        m = request.label
+        cap = budget(study, m) if m in study.methods else None
         if cap is None:
             continue
         result = adapt(
             scene,
-            m,
+            request,
             AdaptOptions(NO_TOL, cap, max_levels, rule, pressure_tol),
-            solver=solver,
-            options=options,
             paper_interface=paper_interface,
             say=_prefixed(say, f"adaptive {m}: "),
         )

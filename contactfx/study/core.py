@@ -9,15 +9,16 @@ failed and the study goes on; other exceptions are bugs and propagate.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 from mpi4py import MPI
 
-from ..api import run_scene
-from ..errors import ContactFxError
-from ..options import Method, SolverSpec
+from ..api import as_request, run_scene
+from ..errors import ContactFxError, InputError
+from ..options import Method
+from ..request import SolveRequest
 from ..results.records import RunSummary
 from ..scenes import HertzReference, Reference, Scene, UniformStress
 from ..timers import Timers
@@ -54,26 +55,18 @@ def exact_errors(kind: str, summary: RunSummary) -> dict[str, float | None]:
 
 
 def solve_one(
-    scene: Scene,
-    method: str,
-    level: Level,
-    mesh_time: float,
-    kind: str,
-    solver: SolverSpec | str,
-    options: dict[str, Any],
+    scene: Scene, request: SolveRequest, level: Level, mesh_time: float, kind: str
 ) -> Run:
-    """Solve one level with one method; a ContactFxError makes a failed Run."""
-    run = Run(method, level.index, level.factor)
+    """Solve one level as `request` asks; a ContactFxError makes a failed Run."""
+    run = Run(request.label, level.index, level.factor)
     t0 = time.perf_counter()
     try:
         sol, record = run_scene(
             scene,
-            method,
-            solver=solver,
+            request,
             t_start=t0,
             timers=Timers(),
             paper_interface=level.paper_interface,
-            **options,
         )
     except ContactFxError as err:
         run.status, run.message = "failed", f"{type(err).__name__}: {err}"
@@ -220,20 +213,22 @@ def fit_rates(
 
 def run_study(
     levels: list[Level],
-    methods: list[str],
+    requests: Sequence[SolveRequest | Method | str],
     *,
-    solver: SolverSpec | str = "mumps",
     ratio: float = 2.0,
-    options: dict[str, Any] | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
     say: Callable[[str], None] | None = None,
     settings: dict[str, Any] | None = None,
 ) -> Study:
-    """Run every method on every level (coarsest first) and measure them against the reference.
+    """Run every request on every level (coarsest first) and measure them against the reference.
 
-    `options` go to run_scene (max_iterations, penalty, ...); `say` prints progress (rank 0).
+    A method's name stands for its request with the defaults; each run is labelled by its
+    request's `label` (the method's name). `say` prints progress (rank 0).
     """
-    methods = [Method(m).value for m in methods]
+    asked = [as_request(r) for r in requests]
+    methods = [r.label for r in asked]
+    if len(set(methods)) != len(methods):
+        raise InputError(f"the study lists a method twice: {', '.join(methods)}")
     say = say or (lambda line: print(line, flush=True) if comm.rank == 0 else None)
     progress = Progress(methods, len(levels), ratio, say)
     runs: list[Run] = []
@@ -252,8 +247,8 @@ def run_study(
         mesh_time = time.perf_counter() - t0
         kind, name = kind or reference_kind(scene), scene.name
         references = references or scene.references
-        for k, m in enumerate(methods):
-            runs.append(solve_one(scene, m, level, mesh_time, kind, solver, options or {}))
+        for k, request in enumerate(asked):
+            runs.append(solve_one(scene, request, level, mesh_time, kind))
             progress.finished(runs[-1], mesh_time if k == 0 else None)
         del scene
     reference = apply_reference(kind or "self", runs, methods, references)

@@ -124,6 +124,7 @@ def test_overshooting_mesh_is_replanned_not_dropped() -> None:
     from contactfx.adapt import loop
     from contactfx.adapt.sizing import plan_mesh
     from contactfx.methods.predictor import scene_dofs
+    from contactfx.request import SolveRequest
     from contactfx.scenes import HertzParams
     from contactfx.scenes.builtin import hertz
 
@@ -140,7 +141,12 @@ def test_overshooting_mesh_is_replanned_not_dropped() -> None:
     opts = loop.AdaptOptions(max_levels=2, max_dofs=20_000)
     scene = hertz(HertzParams(refine=2, h_far=2, refine_edge=0, slope=0.3))
     result = loop.adapt(
-        scene, "mortar", opts, say=lambda _: None, count_dofs=overshoot_once, plan=recording
+        scene,
+        SolveRequest.parse("mortar"),
+        opts,
+        say=lambda _: None,
+        count_dofs=overshoot_once,
+        plan=recording,
     )
     assert len(budgets) == 2 and budgets[1] == pytest.approx(budgets[0] * 0.95 / 2)
     assert len(result.levels) == 2 and result.levels[1].dofs <= opts.max_dofs

@@ -18,6 +18,7 @@ from conftest import ROOT
 from contactfx import load_scene_file, run_scene
 from contactfx.adapt.loop import AdaptOptions, adapt
 from contactfx.adapt.sizing import SizingRule
+from contactfx.request import SolveRequest
 
 SCENES = ROOT / "demos" / "scenes"
 
@@ -52,7 +53,7 @@ def sadowsky(data: dict, b: float = 1.0) -> tuple[float, float, bool]:
 def test_adaptive_beats_uniform_on_the_flat_punch(tmp_path: Path) -> None:
     start = load_scene_file(uniform_punch(tmp_path, 0.5))
     opts = AdaptOptions(1e-9, 100_000, 3, SizingRule(growth=2))
-    finest = adapt(start, "nts", opts, say=lambda line: None).levels[-1]
+    finest = adapt(start, SolveRequest.parse("nts"), opts, say=lambda line: None).levels[-1]
     # The uniform mesh with every size 0.2 has more DOFs than the adaptive one (gmsh
     # meets a planned size field only within ~10 %, so "equal" is "at least as many").
     _, data = run_scene(start.remeshed(0.4), "nts")

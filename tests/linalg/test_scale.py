@@ -22,6 +22,7 @@ from contactfx.meshes.hertz_structured import graded_points, hertz_grid
 from contactfx.methods.active_set import ActiveSetOptions
 from contactfx.methods.multipliers import solve_contact
 from contactfx.options import SOLVERS, Method, Predictor
+from contactfx.request import SolveRequest
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
 from contactfx.timers import Timers
 
@@ -158,8 +159,8 @@ def test_near_nullspace_is_the_kernel_of_free_bodies() -> None:
 def test_gamg_fieldsplit_agrees_with_mumps(kind, params, method) -> None:
     """GAMG fieldsplit (rtol 1e-10) gives the MUMPS displacement and pressure to ~1e-6."""
     scene = build_scene(kind, params)
-    ref = solve_contact(scene, method, "mumps")
-    it = solve_contact(scene, method, "fieldsplit-gamg")
+    ref = solve_contact(scene, SolveRequest.parse(method, solver="mumps"))
+    it = solve_contact(scene, SolveRequest.parse(method, solver="fieldsplit-gamg"))
     assert np.array_equal(it.active, ref.active)
     du = np.abs(it.u.x.array - ref.u.x.array).max() / np.abs(ref.u.x.array).max()
     dp = np.abs(it.pressure - ref.pressure).max() / np.abs(ref.pressure).max()
@@ -213,7 +214,7 @@ def test_structured_hertz_geometry_and_contact() -> None:
     for name in ("contact1", "contact2", "symmetry", "support", "load"):
         n = MPI.COMM_WORLD.allreduce(len(scene.facet_tags.find(scene.groups.by_name[name][1])))
         assert n > 0, name
-    sol = solve_contact(scene, Method.MORTAR, "mumps")
+    sol = solve_contact(scene, SolveRequest.parse(Method.MORTAR, solver="mumps"))
     a_exact = scene.params["hertz_exact"]["a"]
     xs = sol.layout.x[sol.active, 0]
     # Half-width within one contact element of Hertz's a.
@@ -237,9 +238,11 @@ def test_coarse_predictor_same_answer_one_factorization(structured_pair, method)
 
     fine, coarse = structured_pair
     # The plain loop: from the touching nodes (the default now starts from every row).
-    plain = solve_contact(fine, method, "mumps", ActiveSetOptions(start_all=False))
-    init = coarse_initial_set(solve_contact(coarse, method, "mumps"))
-    sol = solve_contact(fine, method, "mumps", initial_active=init)
+    plain = solve_contact(
+        fine, SolveRequest.parse(method, solver="mumps"), aso=ActiveSetOptions(start_all=False)
+    )
+    init = coarse_initial_set(solve_contact(coarse, SolveRequest.parse(method, solver="mumps")))
+    sol = solve_contact(fine, SolveRequest.parse(method, solver="mumps"), initial_active=init)
     assert np.array_equal(sol.active, plain.active)
     p_max = np.abs(plain.pressure).max()
     assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max
@@ -260,8 +263,10 @@ def test_start_from_every_row_same_answer_one_factorization(structured_pair, met
     Then exactly two solves: the probing one, and one that only releases rows (capacitance).
     """
     fine, _ = structured_pair
-    plain = solve_contact(fine, method, "mumps", ActiveSetOptions(start_all=False))
-    sol = solve_contact(fine, method, "mumps")
+    plain = solve_contact(
+        fine, SolveRequest.parse(method, solver="mumps"), aso=ActiveSetOptions(start_all=False)
+    )
+    sol = solve_contact(fine, SolveRequest.parse(method, solver="mumps"))
     assert np.array_equal(sol.active, plain.active)
     p_max = np.abs(plain.pressure).max()
     assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max
@@ -310,8 +315,12 @@ def test_any_initial_set_converges_to_the_same_answer(structured_pair, guess) ->
     fine, _ = structured_pair
     a = fine.params["hertz_exact"]["a"]
     radius = {"inside": 0.5 * a, "far": 3.0 * a, "nothing": -1.0}[guess]
-    plain = solve_contact(fine, Method.MORTAR, "mumps")
-    sol = solve_contact(fine, Method.MORTAR, "mumps", initial_active=lambda x: x[:, 0] <= radius)
+    plain = solve_contact(fine, SolveRequest.parse(Method.MORTAR, solver="mumps"))
+    sol = solve_contact(
+        fine,
+        SolveRequest.parse(Method.MORTAR, solver="mumps"),
+        initial_active=lambda x: x[:, 0] <= radius,
+    )
     assert np.array_equal(sol.active, plain.active)
     p_max = np.abs(plain.pressure).max()
     assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max

@@ -8,6 +8,7 @@ from mpi4py import MPI
 from contactfx.api import run_case
 from contactfx.errors import InputError, SingularSystemError
 from contactfx.methods.active_set import lcp_active_set
+from contactfx.request import SolveRequest
 from contactfx.results.references import exact_pressure, fit_half_width, l2_error
 from contactfx.scenes import BlockParams, HertzParams, hertz_exact
 
@@ -87,8 +88,10 @@ def test_plain_update_needs_many_more_iterations() -> None:
     from contactfx.scenes import build_scene
 
     scene = build_scene("hertz", _graded(0.02, 0.2), comm=MPI.COMM_SELF)
-    fast = solve_contact(scene, Method.MORTAR)
-    slow = solve_contact(scene, Method.MORTAR, aso=ActiveSetOptions(predictor=False))
+    fast = solve_contact(scene, SolveRequest.parse(Method.MORTAR))
+    slow = solve_contact(
+        scene, SolveRequest.parse(Method.MORTAR), aso=ActiveSetOptions(probes=False)
+    )
     assert fast.iterations <= 4 < 10 < slow.iterations
     assert np.array_equal(fast.active, slow.active)
     assert np.allclose(fast.pressure, slow.pressure, rtol=0, atol=1e-9 * fast.pressure.max())

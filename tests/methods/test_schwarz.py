@@ -13,6 +13,7 @@ from conftest import cli
 from contactfx.api import run_case
 from contactfx.errors import ConvergenceError, InputError
 from contactfx.methods.schwarz import SchwarzOptions, solve_schwarz
+from contactfx.request import SolveRequest
 from contactfx.results.interface import u_at_points
 from contactfx.results.stress import body_stress_deviation
 from contactfx.scenes import BLOCK_SCENES, build_scene
@@ -155,10 +156,10 @@ def test_hertz_is_rejected() -> None:
 
     hertz = build_scene("hertz", HertzParams(refine=0.2, refine_edge=0.0))
     with pytest.raises(InputError, match="straight horizontal contact line"):
-        solve_schwarz(hertz)
+        solve_schwarz(hertz, SolveRequest.parse("schwarz"))
     scene = build_scene("blocks", BLOCK_SCENES["S1"])
     with pytest.raises(InputError, match="relaxation"):
-        solve_schwarz(scene, SchwarzOptions(relaxation=0.0))
+        solve_schwarz(scene, SolveRequest.parse("schwarz", schwarz=SchwarzOptions(relaxation=0.0)))
 
 
 def test_cli_writes_the_usual_schema(tmp_path) -> None:

@@ -33,6 +33,7 @@ from contactfx import cli, load_scene_file, run_scene, solve
 from contactfx.api import run_case
 from contactfx.cli import solve as cli_solve
 from contactfx.methods.solution import Solution
+from contactfx.request import SolveRequest
 from contactfx.results import RunSummary
 from contactfx.results.interface import u_at_points
 from contactfx.scenes import BLOCK_SCENES, HertzParams, hertz
@@ -230,7 +231,7 @@ def structured_hertz(solver: str, refine: float, h_far: float) -> Callable[[], A
         from contactfx.options import Method
 
         scene = hertz(HertzParams(refine=refine, h_far=h_far, mesh="structured"))
-        sol = solve_contact(scene, Method.MORTAR, solver)
+        sol = solve_contact(scene, SolveRequest.parse(Method.MORTAR, solver=solver))
         return sol, {"x": sol.layout.x, "p": sol.pressure}
 
     return run
