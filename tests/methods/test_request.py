@@ -47,9 +47,10 @@ HERTZ = HertzParams(refine=0.1)
 def test_penalty_on_nts_and_sts_passes_the_patch_test(discretization: str) -> None:
     """Uniform pressure p carried with the uniform penetration p / eps, as on mortar."""
     eps, p = 1e7, MATCHING.p
-    sol, data = run_case(
+    sol, run = run_case(
         "blocks", MATCHING, discretization, enforcement="penalty", penalty=eps, comm=MPI.COMM_SELF
     )
+    data = run.to_json()
     assert (data["method"], data["discretization"], data["enforcement"]) == (
         "penalty",
         discretization,
