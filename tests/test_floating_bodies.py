@@ -18,6 +18,7 @@ import pytest
 from conftest import ROOT, cli, run_cli
 
 from contactfx import load_scene_file, run_scene
+from contactfx.discretize.load_paths import carrying_rows, pulled_away
 from contactfx.discretize.setup import prepare_contact
 from contactfx.errors import SingularSystemError
 from contactfx.methods.active_set import ActiveSetOptions
@@ -47,6 +48,40 @@ def refused_before_any_solve(path: Path, method: str) -> str:
     with pytest.raises(SingularSystemError) as err:
         prepare_contact(load_scene_file(path), kernel, ActiveSetOptions().penetration_tol, Timers())
     return str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("rows", "load", "carries"),
+    [
+        # One free mode (y of a block): a floor below (+1), a plate above (-1), no load: the
+        # pair can squeeze the block, both carry.
+        ([[1.0], [-1.0]], [0.0], [True, True]),
+        # Both rows push up and nothing loads the block: no equilibrium with lam > 0.
+        ([[1.0], [2.0]], [0.0], [False, False]),
+        # The same rows under a downward load: both can carry it.
+        ([[1.0], [2.0]], [-1.0], [True, True]),
+        # The far pair's statics (modes b2_y, b3_y): pair 0 pushes b2 up, pair 1 pushes b2
+        # down and b3 up, pair 2 acts on no free mode (b4 on the fixed b1: elastic, free).
+        ([[1.0, 0.0], [-1.0, 1.0], [0.0, 0.0]], [0.0, 0.0], [False, False, True]),
+        # The correct stack (modes b2_y, b3_y, b4_y), p on b4: every pair carries it.
+        ([[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]], [0.0, 0.0, -1.0], [True] * 3),
+    ],
+)
+def test_rows_that_can_carry_load_by_statics(
+    rows: list[list[float]], load: list[float], carries: list[bool]
+) -> None:
+    """Which rows are positive in some lam >= 0 with rows^T lam + load = 0 (hand statics)."""
+    got = carrying_rows(np.array(rows), np.array(load))
+    assert got is not None and got.tolist() == carries
+
+
+def test_load_that_pulls_a_block_off_has_no_equilibrium() -> None:
+    """Rows push up only, the load pulls up: no lam >= 0 balances it; the motion that
+    proves it opens every gap (rows . y >= 0) and the load does work on it."""
+    a, load = np.array([[1.0, 0.0], [2.0, 1.0]]), np.array([1.0, 0.0])
+    assert carrying_rows(a, load) is None
+    y = pulled_away(a, load)
+    assert np.all(a @ y >= -1e-9) and load @ y == pytest.approx(1.0)
 
 
 @pytest.mark.serial

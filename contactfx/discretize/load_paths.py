@@ -27,8 +27,9 @@ from mpi4py import MPI
 from petsc4py import PETSc
 from scipy.optimize import linprog
 
+from ..contact.geometry import Surface
 from ..errors import SingularSystemError
-from ..scenes import Scene
+from ..scenes import Body, Scene
 from .pairs import PairData
 from .supports import Holding, _free_motions, body_blocks, rigid_modes_at
 
@@ -57,7 +58,7 @@ def surface_modes(pairs: list[PairData], hold: Holding, ndofs: int) -> sp.csr_ma
     """(ndofs, 3 nb) rigid modes of every body at the dofs of the pairs' surfaces."""
     dofs, x, body = [], [], []
     for p in pairs:
-        sides = [(p.active.surface, p.active_body)]
+        sides: list[tuple[Surface, Body | None]] = [(p.active.surface, p.active_body)]
         if p.passive is not None:
             sides.append((p.passive.surface, p.passive_body))
         for surf, b in sides:
@@ -102,8 +103,11 @@ def mode_loads(scene: Scene, V: fem.FunctionSpace, f: PETSc.Vec, hold: Holding) 
     return work
 
 
-def _carrying(a: np.ndarray, load: np.ndarray) -> np.ndarray | None:
-    """Rows (of a (n, k)) positive in some lam >= 0 with a^T lam + load = 0; None: no such lam."""
+def carrying_rows(a: np.ndarray, load: np.ndarray) -> np.ndarray | None:
+    """Rows (of a (n, k)) positive in some lam >= 0 with a^T lam + load = 0; None: no such lam.
+
+    A row of zeros (no free mode acts on it) counts as carrying: statics do not bound it.
+    """
     n = a.shape[0]
     on = np.abs(a).max(axis=1, initial=0.0) > 0.0
     out = np.ones(n, dtype=bool)
@@ -131,7 +135,7 @@ def _carrying(a: np.ndarray, load: np.ndarray) -> np.ndarray | None:
     return out
 
 
-def _pulled_away(a: np.ndarray, load: np.ndarray) -> np.ndarray:
+def pulled_away(a: np.ndarray, load: np.ndarray) -> np.ndarray:
     """A free-mode combination y with a y >= 0 (no gap closes) and load . y = 1 (Farkas)."""
     k = a.shape[1]
     on = np.abs(a).max(axis=1, initial=0.0) > 0.0
@@ -240,8 +244,8 @@ def load_paths(
     load[np.abs(load) <= LOAD_RTOL * float(np.abs(work).sum())] = 0.0
     verdict: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
     if scene.comm.rank == 0:
-        carries = _carrying(a, load)
-        verdict = (carries, _pulled_away(a, load) if carries is None else None)
+        carries = carrying_rows(a, load)
+        verdict = (carries, pulled_away(a, load) if carries is None else None)
     carries, away = scene.comm.bcast(verdict, root=0)
     if carries is None:
         assert away is not None
