@@ -158,7 +158,7 @@ def _named(hold: Holding, free: np.ndarray, loose: list[int]) -> list[str]:
     return [f"'{hold.bodies[k].name}' ({_free_motions(free[:, 3 * k : 3 * k + 3])})" for k in loose]
 
 
-def _advice(pairs: list[PairData], hold: Holding, loose: list[int]) -> str:
+def advice(pairs: list[PairData], hold: Holding, loose: list[int]) -> str:
     """What to add or check: [[contact]] pairs only if the loose bodies have some."""
     mine = [
         p for p in pairs if {hold.index(p.active_body), hold.index(p.passive_body)} & set(loose)
@@ -206,7 +206,7 @@ def floating_message(
             f"no support and no contact that can carry load ({when}){pairs_text}: "
             f"{'their' if many else 'its'} position is undetermined (K is singular)"
         )
-    return "; ".join(parts) + ": " + _advice(pairs, hold, loose)
+    return "; ".join(parts) + ": " + advice(pairs, hold, loose)
 
 
 def load_paths(

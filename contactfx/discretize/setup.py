@@ -23,7 +23,7 @@ from .coupling import (
     petsc_constraint,
 )
 from .elasticity import Elasticity, assemble_elasticity
-from .load_paths import load_paths
+from .load_paths import advice, load_paths
 from .obstacles import (
     GatheredObstacle,
     build_obstacle_pairs,
@@ -149,8 +149,7 @@ class ContactSetup:
             f"bod{'ies' if len(names) > 1 else 'y'} {', '.join(names)} "
             f"{'are' if len(names) > 1 else 'is'} held by no support and no contact "
             f"{when}{pairs}: {'their' if len(names) > 1 else 'its'} position is undetermined "
-            "(K is singular); check that each [[contact]] pair names two surfaces that touch, "
-            "or add a [[dirichlet]] support"
+            f"(K is singular); {advice(self.pairs, hold, loose)}"
         )
 
     def destroy(self) -> None:
