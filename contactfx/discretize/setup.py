@@ -11,7 +11,6 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..contact import ContactOperator, Kernel
-from ..contact.geometry import nodal_normals
 from ..errors import GeometryError, SingularSystemError
 from ..options import Basis
 from ..scenes import Body, Scene
@@ -24,6 +23,7 @@ from .coupling import (
     petsc_constraint,
 )
 from .elasticity import Elasticity, assemble_elasticity
+from .load_paths import advice, load_paths
 from .obstacles import (
     GatheredObstacle,
     build_obstacle_pairs,
@@ -33,7 +33,7 @@ from .obstacles import (
     node_free_rows,
 )
 from .pairs import GatheredPair, PairData, build_pairs, gather_pairs, stack
-from .supports import Holding, check_held, holding
+from .supports import Holding, holding
 from .surfaces import check_facing
 
 # An active row whose traction is below this fraction of the largest holds nothing.
@@ -57,8 +57,7 @@ class ContactSetup:
     h: float  # median contact weight (about the contact element size)
     needs_contact: list[Body]  # bodies whose supports alone leave a rigid mode free
     holding: Holding  # the bodies' rigid frames and what their supports fix
-    row_normal: np.ndarray  # (n, 2) active-surface normal at every multiplier row (global)
-    row_bodies: np.ndarray  # (n, 2) body indices (active, passive side) of every row
+    row_modes: np.ndarray  # (n, 3 nb) B m of every rigid mode m at every row (global)
 
     def normalized_gap(self, u: fem.Function) -> np.ndarray:
         """Nodal gap (weighted gap / weight) of the owned rows at displacement u."""
@@ -126,15 +125,7 @@ class ContactSetup:
         glob = np.zeros(self.layout.size, dtype=bool)
         for idx, vals in self.comm.allgather((self.layout.mine, np.asarray(holds, dtype=bool))):
             glob[idx] = vals
-        rows = np.flatnonzero(glob)
-        hold = self.holding
-        contact = hold.contact_rows(
-            self.layout.x[rows],
-            self.row_normal[rows],
-            self.row_bodies[rows, 0],
-            self.row_bodies[rows, 1],
-        )
-        return hold.free_modes(contact), glob
+        return self.holding.free_modes(self.row_modes[glob]), glob
 
     def _floating_message(
         self, loose: list[int], free: np.ndarray, holds: np.ndarray, when: str
@@ -158,8 +149,7 @@ class ContactSetup:
             f"bod{'ies' if len(names) > 1 else 'y'} {', '.join(names)} "
             f"{'are' if len(names) > 1 else 'is'} held by no support and no contact "
             f"{when}{pairs}: {'their' if len(names) > 1 else 'its'} position is undetermined "
-            "(K is singular); check that each [[contact]] pair names two surfaces that touch, "
-            "or add a [[dirichlet]] support"
+            f"(K is singular); {advice(self.pairs, hold, loose)}"
         )
 
     def destroy(self) -> None:
@@ -289,10 +279,9 @@ def prepare_contact(
     # Checked at their reference positions, the obstacles now take their prescribed motion.
     op = moved(op, pairs)
     hold = holding(scene, V, el.bc_dofs)
-    needs_contact = check_held(
-        scene, V, el.bc_dofs, [(p.active_body, p.passive_body, p.active) for p in pairs], hold
-    )
-    row_normal, row_bodies = row_frames(pairs, layout, hold)
+    # Before any solve: a body that only rows carrying no load could hold floats, whatever
+    # round-off the singular solve would show (decided from statics, see load_paths).
+    paths = load_paths(scene, V, el.f, pairs, op.B, order, layout.pair, hold)
     mine = layout.mine
     return ContactSetup(
         comm,
@@ -306,22 +295,7 @@ def prepare_contact(
         op.gap[order][mine],
         w_all[mine],
         h,
-        needs_contact,
+        hold.needs_contact(),
         hold,
-        row_normal,
-        row_bodies,
+        paths.rows,
     )
-
-
-def row_frames(
-    pairs: list[PairData], layout: Multipliers, hold: Holding
-) -> tuple[np.ndarray, np.ndarray]:
-    """(normal (n, 2), body indices (n, 2)) of every multiplier row, in the layout order."""
-    normal = np.zeros((layout.size, 2))
-    bodies = np.zeros((layout.size, 2), dtype=np.int64)
-    for p in pairs:
-        rows = np.flatnonzero(layout.pair == p.index)
-        nodes = np.searchsorted(p.active.gblock, layout.gblock[rows])
-        normal[rows] = nodal_normals(p.active.surface)[nodes]
-        bodies[rows] = (hold.index(p.active_body), hold.index(p.passive_body))
-    return normal, bodies

@@ -4,7 +4,9 @@ tests/scenes/stacked_blocks.toml stacks four blocks under p = 10 (each block's o
 motion left by its supports is the translation along y). stacked_blocks_far_pair.toml writes
 the third pair against the bottom block, two blocks away: the check before the solve sees
 every body held (contact taken as bilateral), but b4 is pushed onto b1 and b2, b3 carry no
-load. Before the fix this ended with exit 0 and a JSON, b2 and b3 at arbitrary positions.
+load. Before the fix this ended with exit 0 and a JSON, b2 and b3 at arbitrary positions;
+later the loop found them from round-off multipliers (a verdict that changed with the BLAS
+kernel). Now prepare_contact, which never solves, refuses from the statics of the rows.
 """
 
 from __future__ import annotations
@@ -16,10 +18,16 @@ import pytest
 from conftest import ROOT, cli, run_cli
 
 from contactfx import load_scene_file, run_scene
+from contactfx.discretize.load_paths import carrying_rows, pulled_away
+from contactfx.discretize.setup import prepare_contact
 from contactfx.errors import SingularSystemError
+from contactfx.methods.active_set import ActiveSetOptions
+from contactfx.options import Method
+from contactfx.timers import Timers
 
 SCENES = ROOT / "tests" / "scenes"
 STACK = SCENES / "stacked_blocks.toml"
+DISK = SCENES / "disk_between_plates.toml"
 FAR = SCENES / "stacked_blocks_far_pair.toml"
 P, L = 10.0, 2.0  # the pressure on b4's top and the blocks' width
 
@@ -31,6 +39,49 @@ def assert_names_the_floating_bodies(message: str) -> None:
     assert "0 (b2_bottom on b1_top)" in message and "1 (b3_bottom on b2_top)" in message
     assert "b4_bottom on b1_top" not in message, message
     assert "[[contact]]" in message  # and what to check
+    assert "before the first solve" in message, message
+
+
+def refused_before_any_solve(path: Path, method: str) -> str:
+    """The message of prepare_contact's refusal: it assembles and checks, it never solves."""
+    kernel = Method(method).kernel
+    with pytest.raises(SingularSystemError) as err:
+        prepare_contact(load_scene_file(path), kernel, ActiveSetOptions().penetration_tol, Timers())
+    return str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("rows", "load", "carries"),
+    [
+        # One free mode (y of a block): a floor below (+1), a plate above (-1), no load: the
+        # pair can squeeze the block, both carry.
+        ([[1.0], [-1.0]], [0.0], [True, True]),
+        # Both rows push up and nothing loads the block: no equilibrium with lam > 0.
+        ([[1.0], [2.0]], [0.0], [False, False]),
+        # The same rows under a downward load: both can carry it.
+        ([[1.0], [2.0]], [-1.0], [True, True]),
+        # The far pair's statics (modes b2_y, b3_y): pair 0 pushes b2 up, pair 1 pushes b2
+        # down and b3 up, pair 2 acts on no free mode (b4 on the fixed b1: elastic, free).
+        ([[1.0, 0.0], [-1.0, 1.0], [0.0, 0.0]], [0.0, 0.0], [False, False, True]),
+        # The correct stack (modes b2_y, b3_y, b4_y), p on b4: every pair carries it.
+        ([[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [0.0, -1.0, 1.0]], [0.0, 0.0, -1.0], [True] * 3),
+    ],
+)
+def test_rows_that_can_carry_load_by_statics(
+    rows: list[list[float]], load: list[float], carries: list[bool]
+) -> None:
+    """Which rows are positive in some lam >= 0 with rows^T lam + load = 0 (hand statics)."""
+    got = carrying_rows(np.array(rows), np.array(load))
+    assert got is not None and got.tolist() == carries
+
+
+def test_load_that_pulls_a_block_off_has_no_equilibrium() -> None:
+    """Rows push up only, the load pulls up: no lam >= 0 balances it; the motion that
+    proves it opens every gap (rows . y >= 0) and the load does work on it."""
+    a, load = np.array([[1.0, 0.0], [2.0, 1.0]]), np.array([1.0, 0.0])
+    assert carrying_rows(a, load) is None
+    y = pulled_away(a, load)
+    assert np.all(a @ y >= -1e-9) and load @ y == pytest.approx(1.0)
 
 
 @pytest.mark.serial
@@ -47,11 +98,12 @@ def test_stacked_blocks_carry_the_load_through_every_pair() -> None:
 @pytest.mark.serial
 @pytest.mark.parametrize("method", ["mortar", "nts", "penalty"])
 def test_far_pair_leaves_two_bodies_floating_and_is_refused(method: str) -> None:
-    """Every method that runs the active-set loop stops on the floating bodies."""
-    scene = load_scene_file(FAR)
+    """Every method refuses before its first solve (no round-off of a singular one decides)."""
+    message = refused_before_any_solve(FAR, method)
+    assert_names_the_floating_bodies(message)
     with pytest.raises(SingularSystemError) as err:
-        run_scene(scene, method)
-    assert_names_the_floating_bodies(str(err.value))
+        run_scene(load_scene_file(FAR), method)
+    assert str(err.value) == message
 
 
 @pytest.mark.serial
@@ -80,10 +132,53 @@ def test_far_pair_refused_on_two_ranks(tmp_path: Path) -> None:
 
 
 @pytest.mark.serial
-def test_loop_that_gives_up_on_a_floating_body_names_it() -> None:
-    """An iteration limit reached with bodies floating reports them, not the limit (their
-    singular solves are why the set wanders)."""
+@pytest.mark.parametrize("max_iterations", [1, 2, 50])
+def test_refusal_comes_before_the_loop_whatever_max_iterations(
+    max_iterations: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The loop is never entered: its iteration limit cannot change the verdict."""
+    import contactfx.methods.multipliers as multipliers
+
+    entered: list[int] = []
+
+    def no_loop(*args: object, **kwargs: object) -> None:
+        entered.append(1)
+        raise AssertionError("the active-set loop ran")
+
+    monkeypatch.setattr(multipliers, "run_active_set", no_loop)
     with pytest.raises(SingularSystemError) as err:
-        run_scene(load_scene_file(FAR), "mortar", max_iterations=2)
+        run_scene(load_scene_file(FAR), "mortar", max_iterations=max_iterations)
+    assert not entered
     assert_names_the_floating_bodies(str(err.value))
-    assert "in the last solve (after 2 iterations)" in str(err.value)
+
+
+@pytest.mark.serial
+def test_loop_safety_net_names_bodies_left_free_by_a_set() -> None:
+    """The check inside the loop (kept as a safety net) on the correct stack: a set without
+    pair 1's rows leaves b3 and b4 (which rests on b3) free, and it says so."""
+    setup = prepare_contact(
+        load_scene_file(STACK), Method.MORTAR.kernel, ActiveSetOptions().penetration_tol, Timers()
+    )
+    pair = setup.layout.pair[setup.layout.mine]
+    setup.check_held_by(pair >= 0, "in a set with every row")
+    with pytest.raises(SingularSystemError) as err:
+        setup.check_held_by(pair != 1, "in a set without pair 1")
+    message = str(err.value)
+    assert "'b3'" in message and "'b4'" in message, message
+    assert "'b1'" not in message and "'b2'" not in message, message
+    assert "1 (b3_bottom on b2_top)" in message and "in a set without pair 1" in message
+    setup.destroy()
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("method", ["nts", "mortar", "penalty"])
+def test_disk_between_rigid_plates_is_refused_along_the_plates_normal(method: str) -> None:
+    """The plates push along y only (their normal, not the rim's radial normals): nothing
+    holds the disk along x. Refused before any solve, naming that motion; the advice fits a
+    scene of obstacles (no [[contact]] pair to check)."""
+    message = refused_before_any_solve(DISK, method)
+    assert "body 'disk'" in message and "translation along x" in message, message
+    assert "translation along y" not in message, message
+    assert "before the first solve" in message, message
+    assert "[[dirichlet]]" in message and "[[obstacle]]" in message, message
+    assert "[[contact]]" not in message, message

@@ -181,7 +181,9 @@ def test_flat_punch_converges_to_sadowsky() -> None:
 
 def test_block_resting_on_a_rigid_floor_is_held() -> None:
     """The floor holds a block vertically: with only ux = 0 on its symmetry line it solves
-    (sigma_yy = -p exactly); without the floor the free-body check names the translation."""
+    (sigma_yy = -p exactly); a wall on the side instead of the floor pushes along x only, so
+    the free-body check names the translation along y before any solve (the side's bottom
+    node on the floor would hold the block: the floor on "side" is no free-body case)."""
     path = DEMO_SCENES / "rigid_block.geo"
     floor = Obstacle("floor", "plane", "base", point=(0.0, -20.0), normal=(0.0, 1.0))
     kwargs = {
@@ -196,10 +198,10 @@ def test_block_resting_on_a_rigid_floor_is_held() -> None:
         data = data.to_json()
         assert data["patch"]["max"] < 1e-8, data["patch"]
         assert data["contacts"][0]["force_passive"][1] == pytest.approx(-40.0, rel=1e-10)
-    with pytest.raises(SingularSystemError, match="translation along y"):
-        run_scene(
-            scene_from_gmsh(path, obstacles=[replace(floor, surface="side")], **kwargs), "nts"
-        )
+    wall = Obstacle("wall", "plane", "side", point=(20.0, 0.0), normal=(-1.0, 0.0))
+    with pytest.raises(SingularSystemError, match="translation along y") as err:
+        run_scene(scene_from_gmsh(path, obstacles=[wall], **kwargs), "nts")
+    assert "before the first solve" in str(err.value) and "[[obstacle]]" in str(err.value)
 
 
 def test_obstacle_and_body_pair_together_equal_a_roller() -> None:

@@ -1,0 +1,267 @@
+"""Which contact rows can carry load, and so which bodies are held, decided before any solve.
+
+On a free rigid mode m of a body (a mode its Dirichlet supports leave free) equilibrium
+K u = f + B^T lam holds exactly whatever the elasticity, since K m = 0 and m vanishes at the
+supported dofs:  m . f + (B m) . lam = 0,  lam >= 0.  A row whose lam_i is zero in every
+such nonnegative equilibrium carries no load in any solution: it cannot hold a body, however
+its gap closes. The rows are B's own rows, so a pair against a rigid obstacle acts along the
+obstacle's normal, not along the body's surface normals. Rows on which no free mode acts are
+unconstrained by these equations (elasticity decides them) and count as able to carry load.
+
+The rows that can carry load come from one linear program (HiGHS): the equilibria form a
+convex cone in (lam, s) (s scales the load), so the rows positive in some equilibrium are
+positive together in one, and maximizing sum min(lam_i, 1) over it finds them all at once
+(each t_i is 1 or 0 at the optimum, far from HiGHS's feasibility tolerance). If no
+nonnegative lam balances the load, a Farkas certificate (a combination of free modes along
+which the load does work and no gap closes) names the bodies that the load pulls away.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+from scipy.optimize import linprog
+
+from ..contact.geometry import Surface
+from ..errors import SingularSystemError
+from ..scenes import Body, Scene
+from .pairs import PairData
+from .supports import Holding, _free_motions, body_blocks, rigid_modes_at
+
+# A row's entry below this fraction of the largest is round-off of the geometry (a flat
+# edge's normal has a ~1e-17 tangential part); the load on a free mode below this fraction
+# of the load scale (sum |m| |f|) is round-off of the assembly (the lifting of a prescribed
+# displacement does no work on a rigid mode, up to cancellation).
+ROW_RTOL = 1e-9
+LOAD_RTOL = 1e-10
+
+
+@dataclass(frozen=True)
+class LoadPaths:
+    """The verdict before any solve: which multiplier rows can carry load.
+
+    `rows` (n, 3 nb): B m for each rigid mode m of each body (column 3 k + j: mode j of
+    body k), one row per multiplier row in the layout order. `carries` (n,): whether the
+    row can be positive in a nonnegative equilibrium of the free rigid modes.
+    """
+
+    rows: np.ndarray
+    carries: np.ndarray
+
+
+def surface_modes(pairs: list[PairData], hold: Holding, ndofs: int) -> sp.csr_matrix:
+    """(ndofs, 3 nb) rigid modes of every body at the dofs of the pairs' surfaces."""
+    dofs, x, body = [], [], []
+    for p in pairs:
+        sides: list[tuple[Surface, Body | None]] = [(p.active.surface, p.active_body)]
+        if p.passive is not None:
+            sides.append((p.passive.surface, p.passive_body))
+        for surf, b in sides:
+            dofs.append(surf.dofs)
+            x.append(surf.x)
+            body.append(np.full(surf.n_nodes, hold.index(b)))
+    d, xs, k = np.vstack(dofs), np.vstack(x), np.concatenate(body)
+    # A node on two surfaces (a passive surface of two pairs) must enter once.
+    _, first = np.unique(d[:, 0], return_index=True)
+    d, xs, k = d[first], xs[first], k[first]
+    vals, rows, cols = [], [], []
+    for kb in np.unique(k):
+        sel = k == kb
+        m = rigid_modes_at(xs[sel], hold.centres[kb], hold.sizes[kb])  # (n, 2, 3)
+        for c in (0, 1):
+            for j in range(3):
+                vals.append(m[:, c, j])
+                rows.append(d[sel, c])
+                cols.append(np.full(int(sel.sum()), 3 * kb + j))
+    return sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(ndofs, 3 * len(hold.bodies)),
+    )
+
+
+def mode_loads(scene: Scene, V: fem.FunctionSpace, f: PETSc.Vec, hold: Holding) -> np.ndarray:
+    """(3 nb,) work of the assembled load on each rigid mode, round-off set to exact zero."""
+    nloc = V.dofmap.index_map.size_local
+    x = V.tabulate_dof_coordinates()[:nloc, :2]
+    fa = f.array_r.reshape(-1, 2)[:nloc]
+    work = np.zeros(3 * len(hold.bodies))
+    scale = 0.0
+    for k, body in enumerate(hold.bodies):
+        b = body_blocks(V, scene.body_cells(body))
+        b = b[b < nloc]
+        m = rigid_modes_at(x[b], hold.centres[k], hold.sizes[k])
+        work[3 * k : 3 * k + 3] = np.einsum("nc,ncj->j", fa[b], m)
+        scale += float(np.einsum("nc,ncj->", np.abs(fa[b]), np.abs(m)))
+    work = np.asarray(scene.comm.allreduce(work, op=MPI.SUM))
+    scale = scene.comm.allreduce(scale, op=MPI.SUM)
+    work[np.abs(work) <= LOAD_RTOL * scale] = 0.0
+    return work
+
+
+def carrying_rows(a: np.ndarray, load: np.ndarray) -> np.ndarray | None:
+    """Rows (of a (n, k)) positive in some lam >= 0 with a^T lam + load = 0; None: no such lam.
+
+    A row of zeros (no free mode acts on it) counts as carrying: statics do not bound it.
+    """
+    n = a.shape[0]
+    on = np.abs(a).max(axis=1, initial=0.0) > 0.0
+    out = np.ones(n, dtype=bool)
+    j = np.flatnonzero(on)
+    if not j.size:
+        return out if not load.any() else None
+    # Each lam_i scaled by its row's size: the same signs, a well-scaled program.
+    aj = a[j] / np.abs(a[j]).max(axis=1, keepdims=True)
+    fl = load / max(float(np.abs(load).max()), 1e-300)
+    m, k = len(j), a.shape[1]
+    # Unknowns (lam, s, t): a^T lam + load s = 0, t <= lam, s >= 1, 0 <= t <= 1.
+    a_eq = sp.hstack([sp.csr_matrix(aj.T), sp.csr_matrix(fl.reshape(k, 1)), sp.csr_matrix((k, m))])
+    eye = sp.identity(m, format="csr")
+    a_ub = sp.hstack([-eye, sp.csr_matrix((m, 1)), eye])
+    c = np.concatenate([np.zeros(m + 1), -np.ones(m)])
+    bounds = [(0.0, None)] * m + [(1.0, None)] + [(0.0, 1.0)] * m
+    res = linprog(c, a_ub, np.zeros(m), a_eq, np.zeros(k), bounds=bounds, method="highs")
+    if res.status == 2:
+        return None
+    if res.status != 0:
+        raise SingularSystemError(
+            f"the check of which contacts can hold the bodies failed: {res.message}"
+        )
+    out[j] = res.x[m + 1 :] > 0.5
+    return out
+
+
+def pulled_away(a: np.ndarray, load: np.ndarray) -> np.ndarray:
+    """A free-mode combination y with a y >= 0 (no gap closes) and load . y = 1 (Farkas)."""
+    k = a.shape[1]
+    on = np.abs(a).max(axis=1, initial=0.0) > 0.0
+    aj = a[on] / np.abs(a[on]).max(axis=1, keepdims=True)
+    fl = load / max(float(np.abs(load).max()), 1e-300)
+    res = linprog(
+        np.zeros(k),
+        -aj if aj.size else None,
+        np.zeros(len(aj)) if aj.size else None,
+        fl.reshape(1, k),
+        np.ones(1),
+        bounds=[(None, None)] * k,
+        method="highs",
+    )
+    return np.asarray(res.x) if res.status == 0 else np.ones(k)
+
+
+def _named(hold: Holding, free: np.ndarray, loose: list[int]) -> list[str]:
+    """'name' (every free motion) of each loose body."""
+    return [f"'{hold.bodies[k].name}' ({_free_motions(free[:, 3 * k : 3 * k + 3])})" for k in loose]
+
+
+def advice(pairs: list[PairData], hold: Holding, loose: list[int]) -> str:
+    """What to add or check: [[contact]] pairs only if the loose bodies have some."""
+    mine = [
+        p for p in pairs if {hold.index(p.active_body), hold.index(p.passive_body)} & set(loose)
+    ]
+    if any(p.passive_body is not None for p in mine):
+        return (
+            "check that each [[contact]] pair names two surfaces that touch, or add a "
+            "[[dirichlet]] support"
+        )
+    return "add a [[dirichlet]] support or an [[obstacle]] that holds it"
+
+
+def floating_message(
+    pairs: list[PairData], layout_pair: np.ndarray, hold: Holding, paths: LoadPaths
+) -> str | None:
+    """One line naming the bodies the supports and load-carrying rows leave free, or None."""
+    free = hold.free_modes(paths.rows[paths.carries])
+    loose = hold.loose(free)
+    if not loose:
+        return None
+    bilateral = set(hold.loose(hold.free_modes(paths.rows)))
+    when = "before the first solve"
+    parts = [
+        f"body '{hold.bodies[k].name}' can still move freely after its supports and contacts "
+        f"({_free_motions(free[:, 3 * k : 3 * k + 3])}; {when})"
+        for k in loose
+        if k in bilateral
+    ]
+    held = [k for k in loose if k not in bilateral]
+    if held:
+        names = _named(hold, free, held)
+        lost = [
+            f"{p.index} ({p.pair.active} on {p.pair.passive})"
+            for p in pairs
+            if {hold.index(p.active_body), hold.index(p.passive_body)} & set(held)
+            and not paths.carries[layout_pair == p.index].any()
+        ]
+        many = len(names) > 1
+        s = "s" if len(lost) > 1 else ""
+        pairs_text = (
+            f": pair{s} {', '.join(lost)} carr{'y' if s else 'ies'} no load" if lost else ""
+        )
+        parts.append(
+            f"bod{'ies' if many else 'y'} {', '.join(names)} {'are' if many else 'is'} held by "
+            f"no support and no contact that can carry load ({when}){pairs_text}: "
+            f"{'their' if many else 'its'} position is undetermined (K is singular)"
+        )
+    return "; ".join(parts) + ": " + advice(pairs, hold, loose)
+
+
+def load_paths(
+    scene: Scene,
+    V: fem.FunctionSpace,
+    f: PETSc.Vec,
+    pairs: list[PairData],
+    B: sp.csr_matrix,
+    order: np.ndarray,
+    layout_pair: np.ndarray,
+    hold: Holding,
+) -> LoadPaths:
+    """The rows B m of the layout's multiplier rows and which of them can carry load.
+
+    Collective: every rank gets rank 0's verdict. Raises SingularSystemError, naming every
+    free motion of each loose body, if the supports and all rows (bilateral) leave a body
+    free, if no nonnegative contact force balances the load on the free modes (the load
+    pulls the bodies apart), or if the rows that can carry load leave a body free.
+    """
+    rows = np.asarray((B[order] @ surface_modes(pairs, hold, B.shape[1])).toarray())
+    rows[np.abs(rows) <= ROW_RTOL * float(np.abs(rows).max(initial=0.0))] = 0.0
+    every = LoadPaths(rows, np.ones(len(rows), dtype=bool))
+    # Free even with every row bilateral: no load can make the system regular.
+    message = floating_message(pairs, layout_pair, hold, every)
+    if message is not None:
+        raise SingularSystemError(message)
+    free = hold.free_modes()
+    if not free.shape[0]:
+        return every
+    free[np.abs(free) < 1e-12] = 0.0  # eigh's round-off on the held modes
+    a = rows @ free.T
+    a[np.abs(a) <= ROW_RTOL * float(np.abs(a).max(initial=0.0))] = 0.0
+    work = mode_loads(scene, V, f, hold)
+    load = free @ work
+    load[np.abs(load) <= LOAD_RTOL * float(np.abs(work).sum())] = 0.0
+    verdict: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
+    if scene.comm.rank == 0:
+        carries = carrying_rows(a, load)
+        verdict = (carries, pulled_away(a, load) if carries is None else None)
+    carries, away = scene.comm.bcast(verdict, root=0)
+    if carries is None:
+        assert away is not None
+        motion = (free.T @ away)[None, :]
+        motion /= float(np.abs(motion).max())
+        loose = hold.loose(motion)
+        said = [
+            f"body '{hold.bodies[k].name}' is not held by its supports and no contact can push "
+            f"against the load ({hold.describe(motion, k)})"
+            for k in loose
+        ]
+        raise SingularSystemError(
+            f"{'; '.join(said)}; decided before the first solve: the load pulls the bodies apart"
+        )
+    paths = LoadPaths(rows, carries)
+    message = floating_message(pairs, layout_pair, hold, paths)
+    if message is not None:
+        raise SingularSystemError(message)
+    return paths
