@@ -24,11 +24,25 @@ def tick_values(lo: float, hi: float) -> list[float]:
     for mantissas in ((1,), (1, 2, 5), tuple(range(1, 10))):
         decades = range(int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi))) + 1)
         values = [m * 10.0**k for k in decades for m in mantissas]
-        inside = sorted({float(f"{v:.12g}") for v in values if lo <= v <= hi})
+        inside = _spaced(sorted({float(f"{v:.12g}") for v in values if lo <= v <= hi}), lo, hi)
         if len(inside) >= 3:
             return inside
     linear = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]).tick_values(lo, hi)
     return [float(f"{v:.12g}") for v in linear if lo <= v <= hi]
+
+
+def _spaced(values: list[float], lo: float, hi: float) -> list[float]:
+    """`values` without those closer than 1/12 of the axis to a kept one (powers of ten first).
+
+    9000 and 10000 at the end of a 9000..45000 axis print on top of each other.
+    """
+    gap = (np.log10(hi) - np.log10(lo)) / 12
+    logs = {v: float(np.log10(v)) for v in values}
+    keep = [v for v in values if abs(logs[v] - round(logs[v])) < 1e-9]
+    for v in values:
+        if v not in keep and all(abs(logs[v] - logs[k]) >= gap for k in keep):
+            keep.append(v)
+    return sorted(keep)
 
 
 def readable_ticks(ax: plt.Axes) -> None:

@@ -9,6 +9,7 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
+import numpy as np
 import pytest
 from conftest import COARSE_HERTZ, ROOT, cli
 
@@ -92,3 +93,7 @@ def test_ticks_are_plain_numbers(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
             minor = [t.get_text() for t in axis.get_minorticklabels() if t.get_text()]
             assert len(major) >= 2 and not minor, (major, minor)
             assert all(re.fullmatch(r"[0-9.e+-]+", t) for t in major), major
+    # Ticks near both ends of a short axis (9000 and 10000) must not run into each other.
+    ticks = charts.tick_values(8900.0, 45000.0)
+    steps = np.diff(np.log10(ticks))
+    assert len(ticks) >= 3 and steps.min() >= np.log10(45000 / 8900) / 12, ticks
