@@ -65,15 +65,24 @@ class AdaptOptions:
             return None
         if not self.pressure_met(est):
             return None
-        reached = f"estimate {est.relative:.3g} <= tol {self.tol:g}"
+        # Percent, as the level lines print the estimates.
+        reached = f"estimate {100 * est.relative:.2g} % <= tol {100 * self.tol:g} %"
         if self.pressure_tol is None or est.pressure is None:
             return reached
-        return f"{reached}, pressure estimate {est.pressure.relative:.3g} <= {self.pressure_tol:g}"
+        return (
+            f"{reached}, pressure estimate {100 * est.pressure.relative:.2g} % "
+            f"<= {100 * self.pressure_tol:g} %"
+        )
 
     def check(self) -> None:
         """InputError for a value out of range."""
         if not (self.tol > 0):
             raise InputError(f"--tol must be > 0 (got {self.tol})")
+        if not (self.rule.growth > 1.0):
+            raise InputError(
+                f"--growth must be > 1: the most cells of a level relative to the previous "
+                f"one (got {self.rule.growth:g})"
+            )
         if self.max_dofs < 10:
             raise InputError(f"--max-dofs must be at least 10 (got {self.max_dofs})")
         if not (self.rule.contact_weight >= 1.0):
@@ -230,8 +239,8 @@ def adapt(
             stop = f"the next mesh would have {dofs} DOFs > --max-dofs {opts.max_dofs}"
             break
         say(
-            f"  remeshed: {dofs} DOFs planned for a relative estimate of "
-            f"{sizes.predicted:.3g} ({mesh_time:.2f} s)"
+            f"  remeshed: {dofs} DOFs planned for an estimate of "
+            f"{100 * sizes.predicted:.3g} % ({mesh_time:.2f} s)"
         )
         scene = nxt
     say(f"stopped: {stop}")
@@ -276,8 +285,13 @@ def level_line(level: AdaptLevel) -> str:
     run = level.summary
     e = level.est.summary()
     ref = ""
-    if run.hertz:
+    if len(run.hertz) == 1:
         ref = f", Hertz L2 {100 * run.hertz[0].l2_error:.3f} %"
+    elif run.hertz:
+        # Every pair: the first alone hid a pair ten times worse.
+        ref = ", Hertz L2 " + ", ".join(
+            f"pair {h.pair} {100 * h.l2_error:.3f} %" for h in run.hertz
+        )
     elif run.patch is not None:
         ref = f", patch max {run.patch.max:.2e}"
     pressure = f", pressure {100 * e.pressure:.3g} %" if e.pressure else ""

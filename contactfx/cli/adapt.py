@@ -9,11 +9,12 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from ..adapt.charts import plot_adapt
+from ..adapt.charts import chart_title, plot_adapt
 from ..adapt.loop import AdaptOptions, adapt, uniform_levels
 from ..adapt.mesh_file import write_msh
 from ..adapt.sizing import SizingRule, default_contact_weight
 from ..errors import InputError
+from ..methods.predictor import scene_dofs
 from ..results.files import write_fields, write_json
 from ..scenes import parse_scene_file
 from .params import build_from_args, is_scene_file, reject_structured_adapt, request_from_args
@@ -57,6 +58,14 @@ def run_adapt(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     scene = build_from_args(args)
     mesh_time = time.perf_counter() - t0
+    start = scene_dofs(scene)
+    if start > opts.max_dofs:
+        # Refused before solving: a level 0 over budget could only stop at once, and a stop
+        # after a solve reads as if the loop had run out of room on its own.
+        raise InputError(
+            f"the starting mesh already has {start} DOFs > --max-dofs {opts.max_dofs}: "
+            "raise --max-dofs or start from a coarser mesh"
+        )
     paper = not is_scene_file(args.scene)
     say(
         f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
@@ -87,7 +96,7 @@ def run_adapt(args: argparse.Namespace) -> int:
         assert msh is not None
         write_json(out / "adapt.json", result.to_json(args.scene, args.method, opts, args.solver))
         levels, uni = result.levels, result.uniform
-        title = f"{args.scene}, {args.method}: adaptive against uniform refinement"
+        title = chart_title(args.scene, args.method, bool(uni))
         written += [
             out / "adapt.json",
             msh,

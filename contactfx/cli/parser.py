@@ -79,9 +79,9 @@ def _study_parser(sub: Any) -> None:
         action="store_true",
         help="also run the adaptive loop (contactfx adapt) of each method from level 0 up "
         "to its finest level's DOFs: the adaptive levels on the time chart, in study.json "
-        "(`adaptive`) and on accuracy_vs_dofs.png (one rank; not schwarz)",
+        "(`adaptive`) and on accuracy_vs_dofs.png (also under mpirun; not schwarz)",
     )
-    s.add_argument(
+    st.add_argument(
         "--pressure-tol",
         type=float,
         default=None,
@@ -232,14 +232,17 @@ def _adapt_parser(sub: Any) -> None:
         "--tol", type=float, default=0.05, help="relative estimate to reach (default 0.05)"
     )
     a.add_argument(
-        "--max-dofs", type=int, default=200_000, help="DOF budget of a mesh (default 200000)"
+        "--max-dofs",
+        type=int,
+        default=200_000,
+        help="DOF budget of a mesh; a starting mesh above it is refused (default 200000)",
     )
     a.add_argument("--max-levels", type=int, default=8, help="most levels (default 8)")
     a.add_argument(
         "--growth",
         type=float,
         default=4.0,
-        help="most cells of a level relative to the previous one (default 4)",
+        help="most cells of a level relative to the previous one, > 1 (default 4)",
     )
     a.add_argument(
         "--weight-contact",

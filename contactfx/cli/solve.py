@@ -20,6 +20,16 @@ from ..timers import Timers
 from .params import build_from_args, is_scene_file, request_from_args
 
 
+def half_width_failure(run: RunSummary, pair: int) -> str:
+    """Why a pair has no fitted half-width: too few active nodes, or no fit."""
+    n = run.contacts[pair].active_nodes if pair < len(run.contacts) else 0
+    if n < 4:
+        # The fit of p^2 = p0^2 (1 - x^2/a^2) has two unknowns: with a node or two to spare
+        # it follows the discretization's wiggles, not the ellipse.
+        return f"{n} active node{'s' * (n != 1)}, too few to fit the half-width"
+    return f"no half-width fits the pressures of the {n} active nodes"
+
+
 def terminal_summary(run: RunSummary) -> list[str]:
     """What a user came for, last: each pair's force, and the errors against references."""
     lines = [
@@ -39,11 +49,13 @@ def terminal_summary(run: RunSummary) -> list[str]:
             "(relative to the exact uniform stress)"
         )
     for h in run.hertz:
-        a = h.a
-        a_err = f"{100 * (a / h.a_exact - 1):+.2f} %" if a else "n/a"
+        if h.a is None:
+            a_text = f"a: n/a ({half_width_failure(run, h.pair)}; exact {h.a_exact:.4g})"
+        else:
+            a_err = 100 * (h.a / h.a_exact - 1)
+            a_text = f"a = {h.a:.4g} (exact {h.a_exact:.4g}, {a_err:+.2f} %)"
         lines.append(
-            f"Hertz, pair {h.pair}: a = {a or float('nan'):.4g} (exact "
-            f"{h.a_exact:.4g}, {a_err}), p0 = {h.p0:.4g} (exact "
+            f"Hertz, pair {h.pair}: {a_text}, p0 = {h.p0:.4g} (exact "
             f"{h.p0_exact:.4g}, {100 * (h.p0 / h.p0_exact - 1):+.2f} %), "
             f"L2 error {100 * h.l2_error:.2f} %"
         )

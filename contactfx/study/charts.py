@@ -10,8 +10,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullFormatter
 
+from ..adapt.charts import readable_ticks as _ticks
+from ..adapt.charts import tick_values as tick_values
 from .core import Study, series
 from .measures import ROUND_OFF, fit_rate
 from .report import main_errors
@@ -91,33 +92,6 @@ def _draw(ax: plt.Axes, study: Study, name: str, x: str, label: str | None = Non
             mfc=None if label is None else "none",
             label=f"{m}{'' if label is None else ', ' + label}: {text}",
         )
-
-
-def tick_values(lo: float, hi: float) -> list[float]:
-    """At least three readable values in [lo, hi] (lo > 0) for a log axis.
-
-    Decades: 1 x 10^k; a few decades: 1, 2, 5 x 10^k; about one: every integer times 10^k;
-    shorter (h over one or two refinements): evenly spaced round numbers.
-    """
-    for mantissas in ((1,), (1, 2, 5), tuple(range(1, 10))):
-        decades = range(int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi))) + 1)
-        values = [m * 10.0**k for k in decades for m in mantissas]
-        inside = sorted({float(f"{v:.12g}") for v in values if lo <= v <= hi})
-        if len(inside) >= 3:
-            return inside
-    linear = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]).tick_values(lo, hi)
-    return [float(f"{v:.12g}") for v in linear if lo <= v <= hi]
-
-
-def _ticks(ax: plt.Axes) -> None:
-    """Plain-number labels, at least three on each axis however short its range."""
-    for axis in (ax.xaxis, ax.yaxis):
-        lo, hi = sorted(axis.get_view_interval())
-        if not lo > 0:
-            continue
-        axis.set_major_locator(FixedLocator(tick_values(lo, hi)))
-        axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-        axis.set_minor_formatter(NullFormatter())
 
 
 def _finish(fig: plt.Figure, path: Path, title: str) -> Path:
@@ -228,7 +202,7 @@ def plot_dofs(study: Study, path: Path) -> Path:
 
 
 def plot_time(study: Study, path: Path, extra: Sequence[tuple[str, Study]] = ()) -> Path:
-    """Error against wall time after meshing, every method on each panel.
+    """Error against wall time (meshing included), every method on each panel.
 
     With study --adaptive also the adaptive levels, at their cumulative time (solves,
     estimates and remeshing of all levels up to each); without an exact solution those are
@@ -240,7 +214,7 @@ def plot_time(study: Study, path: Path, extra: Sequence[tuple[str, Study]] = ())
         for label, other in extra:
             _draw(ax, other, name, "time", label)
         _draw_adaptive(ax, study, name, "cumulative")
-        ax.set_xlabel("wall time after meshing (s): assembly, search, solves", fontsize=11)
+        ax.set_xlabel("wall time (s): meshing, assembly, search, solves", fontsize=11)
         ax.set_ylabel(_label(study, name), fontsize=11)
         ax.grid(True, which="both", alpha=0.3)
         _ticks(ax)

@@ -166,7 +166,8 @@ def series(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The (x, value) points a rate is fitted to and a chart draws, coarse to fine.
 
-    x is h ("h") or the time after meshing ("time"). The value is the error against the
+    x is h ("h") or the run's whole wall time, meshing included ("time": a fine level's
+    meshing is most of its cost). The value is the error against the
     exact solution, or (self-convergence, `kind` "self") the difference from the same
     method's next finer level: the finest level is the reference and has none, and the
     differences of successive levels fall like h^r for any r, with no model of the
@@ -176,7 +177,7 @@ def series(
     for r in runs:
         if r.method != method or not r.ok:
             continue
-        x = r.h if against == "h" else r.after_mesh
+        x = r.h if against == "h" else r.times.get("total")
         e = (r.successive if kind == "self" else r.errors).get(name)
         if x and e is not None and e > 0:
             pts.append((r.level, x, e))
@@ -193,7 +194,7 @@ def monotone(errors: np.ndarray) -> bool:
 def fit_rates(
     runs: list[Run], methods: list[str], names: list[str], against: str, reference: dict[str, Any]
 ) -> tuple[dict[str, dict[str, float | None]], dict[str, dict[str, str]]]:
-    """Fitted rates of each error against h ("h") or the time after meshing ("time").
+    """Fitted rates of each error against h ("h") or the wall time with meshing ("time").
 
     The log-log slope of `series`; returns (rates, flags), flags naming the non-monotone
     series (the slope is reported but is not a convergence rate).

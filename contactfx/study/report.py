@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from .measures import ROUND_OFF
-from .progress import format_seconds
+from .progress import error_heading, format_seconds
 from .runs import Run, Study
 
 TIME_KEYS = ("mesh", "assemble", "search", "contact", "solve", "predictor", "total")
@@ -114,17 +114,30 @@ def _rate_cell(study: Study, method: str, name: str, rate: float | None) -> str:
 
 def level_lines(study: Study) -> list[str]:
     """Which sizes each level used."""
-    return [
-        f"level {lv.index}: factor {lv.factor:.4g}: "
-        + ", ".join(f"{k} {v:.4g}" for k, v in lv.sizes.items())
-        for lv in study.levels
-    ]
+    lines = []
+    for lv in study.levels:
+        # A scene file's only size is the factor itself: say it once.
+        sizes = {k: v for k, v in lv.sizes.items() if not (k == "size_factor" and v == lv.factor)}
+        lines.append(
+            f"level {lv.index}: factor {lv.factor:.4g}"
+            + "".join(f", {k} {v:.4g}" for k, v in sizes.items())
+        )
+    return lines
 
 
 def table_lines(study: Study) -> list[str]:
     """The final table: one row per run, then the fitted rates and the reference."""
     names = main_errors(study)
-    head = ["method", "level", "h", "elements", "dofs", "its", "after mesh (s)", *names]
+    head = [
+        "method",
+        "level",
+        "h",
+        "elements",
+        "dofs",
+        "its",
+        "after mesh (s)",
+        *(error_heading(n) for n in names),
+    ]
     rows = []
     for r in study.runs:
         if r.ok:
@@ -179,9 +192,12 @@ def adaptive_lines(study: Study) -> list[str]:
     if not study.adaptive:
         return []
     names = main_errors(study)
-    lines = ["", "adaptive levels (time: cumulative solves, estimates and remeshing):"]
+    lines = [
+        "",
+        "adaptive levels (time: cumulative level-0 meshing, solves, estimates and remeshing):",
+    ]
     for r in study.adaptive:
-        errs = ", ".join(f"{n} {_num(r.errors.get(n))}" for n in names)
+        errs = ", ".join(f"{error_heading(n)} {_num(r.errors.get(n))}" for n in names)
         lines.append(
             f"  {r.method} level {r.level}: {r.dofs} dofs, estimate {r.estimate:.3g}, "
             f"{errs}, {r.cumulative:.2f} s"

@@ -130,7 +130,7 @@ class Study:
             "description": "each method's adaptive loop (contactfx adapt) from level 0's mesh "
             "up to the DOFs of its finest uniform level; errors measured as the uniform runs' "
             "(without an exact solution: against the reference, not the next level)",
-            "time": "cumulative: the solves, estimates and remeshing of the levels up to each "
-            "(level 0's mesh excluded); after_mesh is the level's own solve",
+            "time": "cumulative: level 0's meshing, then the solves, estimates and remeshing "
+            "of the levels up to each; after_mesh is the level's own solve",
             "runs": [asdict(r) for r in self.adaptive],
         }
