@@ -11,16 +11,33 @@ PYTHON312 := $(shell python3.12 -c 'import sys' >/dev/null 2>&1 && echo python3.
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: demo test bench bench-scale clean venv
+.PHONY: demo test bench bench-scale clean venv lock
 
 venv: $(STAMP)
 
-$(STAMP): pyproject.toml
+# The venv gets exactly the versions of requirements.lock (every package, pinned); without
+# the file it resolves pyproject.toml's ranges. `make lock` re-resolves the file.
+LOCK      := requirements.lock
+UV        := uv==0.13.9
+PIP       := pip==26.3
+
+$(STAMP): pyproject.toml $(wildcard $(LOCK))
 	@test -n "$(PYTHON312)" || { echo "python3.12 not found" >&2; exit 1; }
 	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[test]"
+	$(PY) -m pip install --quiet $(PIP)
+	@if [ -f $(LOCK) ]; then \
+	  $(PY) -m pip install --quiet -r $(LOCK) && $(PY) -m pip install --quiet --no-deps -e . ; \
+	else \
+	  $(PY) -m pip install --quiet -e ".[test]" ; \
+	fi
 	@touch $(STAMP)
+
+# Re-resolve the lock from pyproject.toml's ranges (newest versions the index serves today).
+lock:
+	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
+	$(PY) -m pip install --quiet $(UV)
+	$(VENV)/bin/uv pip compile pyproject.toml --extra test --python-version 3.12 --universal \
+	  --no-header --quiet -o $(LOCK)
 
 demo: $(STAMP)
 	$(PY) demos/demo_blocks.py
