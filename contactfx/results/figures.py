@@ -16,6 +16,29 @@ from .obstacles import outline
 from .records import RunSummary
 from .stress import sigma_field
 
+# A field whose spread is below this fraction of its scale is uniform to round-off: it is
+# drawn as uniform (a band around its mean), not autoscaled onto its noise.
+ROUND_OFF_SPREAD = 1e-6
+
+
+def round_off_band(values: np.ndarray, scale: float = 0.0) -> tuple[float, float] | None:
+    """Display limits for values uniform to round-off, or None if they vary for real.
+
+    `scale`: the size the values are compared with (e.g. the largest traction of the chart;
+    by default the values' own largest magnitude). A uniform field is shown as its mean
+    +- 5 % of the scale, so its noise draws as the flat line it is.
+    """
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return None
+    ref = max(scale, float(np.abs(v).max()))
+    if float(v.max() - v.min()) > ROUND_OFF_SPREAD * ref:
+        return None
+    half = 0.05 * ref if ref > 0 else 1.0
+    mean = float(v.mean())
+    return mean - half, mean + half
+
 
 def deformed_fields(
     sol: Solution,
@@ -54,21 +77,38 @@ def deformed_fields(
         outline(ob, x[:, :2]) + scale * np.asarray(ob.displacement) for ob in sol.scene.obstacles
     ]
     # pyvista annotates window_size as list[int]; it takes any sequence (as BasePlotter says).
-    plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 600), off_screen=True)
-    for col, (name, label) in enumerate((("u_y", "u_y (cm)"), ("sigma_yy", "sigma_yy (MPa)"))):
+    plotter = pyvista.Plotter(shape=(1, 2), window_size=(1600, 700), off_screen=True)
+    units = sol.scene.units
+    for col, (name, label) in enumerate(
+        (("u_y", f"u_y ({units.length})"), ("sigma_yy", f"sigma_yy ({units.stress})"))
+    ):
         plotter.subplot(0, col)
+        values = np.asarray(warped[name])
+        band = round_off_band(values)
+        if band is not None:
+            label += f": uniform {float(values.mean()):.6g} (spread {np.ptp(values):.1e})"
         plotter.add_mesh(
             warped,
             scalars=name,
             cmap="turbo",
+            clim=band,
             show_edges=False,
+            # Below the field, not over it: the view leaves the bottom fifth for it.
             scalar_bar_args={
                 "title": label,
-                "vertical": True,
-                "position_x": 0.86,
-                "position_y": 0.15,
+                "vertical": False,
+                "position_x": 0.15,
+                "position_y": 0.06,
+                "width": 0.7,
+                "height": 0.1,
+                "n_labels": 3 if band is not None else 4,
+                "fmt": "%.4g",
+                "title_font_size": 16,
+                "label_font_size": 14,
             },
         )
+        # The labels below the bar, the title above it (by default both sit above, overlapping).
+        plotter.scalar_bars[label].SetTextPositionToPrecedeScalarBar()
         for xy in outlines:
             pts = np.column_stack([xy, np.zeros(len(xy))])
             plotter.add_mesh(pyvista.lines_from_points(pts), color="black", line_width=2)
@@ -76,10 +116,24 @@ def deformed_fields(
         plotter.view_xy()
         if window is not None:
             _zoom(plotter, window)
+        _leave_room_below(plotter)
     path.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(path))
     plotter.close()
     return path
+
+
+def _leave_room_below(plotter: Any) -> None:
+    """Zoom out and lift the view so the field keeps clear of the colour bar at the bottom."""
+    cam = plotter.camera
+    cam.parallel_projection = True
+    scale = cam.parallel_scale
+    fx, fy, fz = cam.focal_point
+    px, py, pz = cam.position
+    shift = 0.25 * scale
+    cam.focal_point = (fx, fy - shift, fz)
+    cam.position = (px, py - shift, pz)
+    cam.parallel_scale = 1.3 * scale
 
 
 def _zoom(plotter: Any, window: tuple[float, float, float, float]) -> None:
@@ -160,8 +214,9 @@ def plot_interface(run: RunSummary, path: Path, title: str = "") -> Path:
         zoom = contact_zoom(x, np.asarray(itf["pressure"], dtype=float) > 0.0)
         if zoom is not None:
             ax.set_xlim(*zoom)
-    ax.set_xlabel("x (cm)")
-    ax.set_ylabel("MPa")
+    ax.set_xlabel(f"x ({run.units.length})")
+    ax.set_ylabel(run.units.stress)
+    ax.ticklabel_format(axis="y", useOffset=False)
     ax.set_title(title or f"{run.scene} / {run.method.value}: contact line")
     ax.grid(alpha=0.3)
     ax.legend()
@@ -216,9 +271,17 @@ def plot_pair(run: RunSummary, k: int, path: Path) -> Path:
         ax.set_xlim(*zoom)
     if active.any():
         ax.axvspan(s[active].min(), s[active].max(), color="0.9", zorder=0, label="active set")
-    ax.set_ylabel("normal traction (compression > 0)")
-    bx.set_ylabel("sigma_nt")
-    bx.set_xlabel("s, arc length along the active surface")
+    # Traction scale of the chart: a curve uniform to round-off against it is drawn flat.
+    scale = float(np.nanmax(np.abs(arr("pressure")), initial=0.0))
+    for a_ in (ax, bx):
+        a_.ticklabel_format(axis="y", useOffset=False)
+        band = round_off_band(np.concatenate([ln.get_ydata() for ln in a_.get_lines()]), scale)
+        if band is not None:
+            a_.set_ylim(*band)
+    units = run.units
+    ax.set_ylabel(f"normal traction ({units.stress}, compression > 0)")
+    bx.set_ylabel(f"sigma_nt ({units.stress})")
+    bx.set_xlabel(f"s, arc length along the active surface ({units.length})")
     on = f"obstacle '{c.passive}'" if c.obstacle is not None else c.passive
     ax.set_title(f"{run.scene} / {run.method.value}: pair {k}, {c.active} on {on}")
     for a_ in (ax, bx):

@@ -7,13 +7,13 @@ study and the adaptive loop read its attributes. Its `to_json()` is the schema o
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from ..options import Discretization, Enforcement, Method
-from ..scenes import Obstacle
+from ..scenes import Obstacle, Units
 from .obstacles import obstacle_json
 
 # The JSON's `estimate.norm`: what the relative values are relative to.
@@ -190,6 +190,7 @@ class RunSummary:
     discretization: Discretization
     enforcement: Enforcement
     memory: dict[str, float]
+    units: Units = field(default_factory=Units)  # labels for pictures; not in the JSON
     active_nodes: int
     extras: MethodExtras = MethodExtras()
     interface: dict[str, list[float | None]] | None = None  # the paper's view of pair 0

@@ -98,6 +98,7 @@ def summary(
         discretization=request.discretization,
         enforcement=request.enforcement,
         memory=memory,
+        units=scene.units,
         active_nodes=int(sol.active.sum()),
         extras=method_extras(sol),
         interface=cartesian_interface(sol) if paper_interface else None,

@@ -30,6 +30,7 @@ from .model import (
     SizeField,
     Traction,
     UniformStress,
+    Units,
 )
 from .scene_file import load_scene_file, parse_scene_file
 
@@ -57,6 +58,7 @@ __all__ = [
     "SizeField",
     "Traction",
     "UniformStress",
+    "Units",
     "blocks",
     "build_scene",
     "from_gmsh",

@@ -26,6 +26,7 @@ from .model import (
     Scene,
     SizeField,
     UniformStress,
+    Units,
 )
 from .structured import build_hertz_structured
 
@@ -202,6 +203,7 @@ def _two_body_scene(
         name=name,
         params={**asdict(params), "active": active, **extra},
         recipe=BuiltinRecipe(params, active, size_field),
+        units=Units("cm", "MPa"),  # the paper's
     )
     return check_scene(scene)
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +37,7 @@ from .model import (
     Reference,
     Scene,
     SizeField,
+    Units,
 )
 
 # The other 2D element types of gmsh, named for the error message.
@@ -269,6 +270,7 @@ class SceneParts:
     name: str = "scene"
     obstacles: tuple[Obstacle, ...] = ()
     model: Model = Model.PLANE_STRAIN
+    units: Units = field(default_factory=Units)
 
 
 @dataclass(frozen=True)
@@ -336,6 +338,7 @@ def scene_from_gmsh(
         recipe=recipe,
         obstacles=parts.obstacles,
         model=parts.model,
+        units=parts.units,
     )
     return check_scene(scene)
 

@@ -43,6 +43,17 @@ class Model(StrEnum):
 
 
 @dataclass(frozen=True)
+class Units:
+    """The names of the scene's units of length and stress (labels only: nothing converts).
+
+    A scene that names none is drawn with the axes "length" and "stress".
+    """
+
+    length: str = "length"
+    stress: str = "stress"
+
+
+@dataclass(frozen=True)
 class Material:
     """Isotropic linear elasticity: Young's modulus and Poisson ratio."""
 
@@ -306,6 +317,7 @@ class Scene:
     curve_bodies: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
     obstacles: tuple[Obstacle, ...] = ()
     model: Model = Model.PLANE_STRAIN
+    units: Units = field(default_factory=Units)
 
     @property
     def comm(self) -> MPI.Comm:

@@ -29,12 +29,14 @@ from .model import (
     Scene,
     Traction,
     UniformStress,
+    Units,
 )
 
 TOP_KEYS = {
     "mesh",
     "name",
     "model",
+    "units",
     "bodies",
     "contact",
     "obstacle",
@@ -158,6 +160,12 @@ def _reference(k: int, entry: Any) -> Reference:
     return UniformStress(sig)  # type: ignore[arg-type]
 
 
+def _units(table: Any) -> Units:
+    """The `units` table: the names of the length and stress units (labels for pictures)."""
+    e = _keys("units", table, {"length", "stress"}, set())
+    return Units(**{k: _string(f"units.{k}", v) for k, v in e.items()})
+
+
 def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
     """Read and check a scene file; return the mesh path and the scene's parts."""
     try:
@@ -174,6 +182,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
     mesh = path.parent / _string("mesh", doc["mesh"])
     name = str(doc.get("name", path.stem))
     model = Model.parse(_string("model", doc.get("model", Model.PLANE_STRAIN.value)))
+    units = _units(doc.get("units", {}))
     if not isinstance(doc["bodies"], dict) or not doc["bodies"]:
         raise InputError("bodies: expected [bodies.NAME] tables with E and nu")
     bodies = {}
@@ -218,7 +227,15 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
     refs = [_reference(k, e) for k, e in enumerate(_entries(doc, "reference"))]
     obstacles = [_obstacle(k, e) for k, e in enumerate(_entries(doc, "obstacle"))]
     parts = SceneParts(
-        bodies, tuple(pairs), tuple(bcs), tuple(loads), tuple(refs), name, tuple(obstacles), model
+        bodies,
+        tuple(pairs),
+        tuple(bcs),
+        tuple(loads),
+        tuple(refs),
+        name,
+        tuple(obstacles),
+        model,
+        units,
     )
     return mesh, parts
 

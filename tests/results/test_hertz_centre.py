@@ -21,7 +21,7 @@ from conftest import ROOT
 from contactfx import load_scene_file, run_scene
 from contactfx.options import Method
 from contactfx.results.references import exact_pressure, hertz_summary
-from contactfx.scenes import HertzReference
+from contactfx.scenes import HertzReference, Units
 
 SCENES = ROOT / "tests" / "scenes"
 
@@ -138,8 +138,9 @@ def test_pair_chart_places_exact_hertz_at_the_centre(
         interface=itf, active_body="b1", passive_body="b2", active="c1", passive="c2", obstacle=None
     )
     hertz = SimpleNamespace(pair=0, a_exact=1.0, p0_exact=10.0, s_centre=0.05)
+    units = Units()
     run = SimpleNamespace(
-        scene="synthetic", method=Method.MORTAR, contacts=[contact], hertz=[hertz]
+        scene="synthetic", method=Method.MORTAR, contacts=[contact], hertz=[hertz], units=units
     )
     figures: list[Figure] = []
     monkeypatch.setattr(Figure, "savefig", lambda fig, *_, **__: figures.append(fig))
