@@ -13,6 +13,7 @@ from mpi4py import MPI
 from ..discretize.elasticity import sigma, sigma_zz
 from ..discretize.mesh_utils import owned_facets, vertex_coordinates, vertex_to_block
 from ..methods.solution import Solution
+from ..scenes import Model
 
 REF_VERTICES = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
 
@@ -94,6 +95,8 @@ def sigma_zz_field(sol: Solution) -> fem.Function:
     Q = fem.functionspace(msh, ("DG", 0))
     s = fem.Function(Q, name="sigma_zz")
     el = sol.fields
+    if sol.scene.model is Model.PLANE_STRESS:
+        return s  # zero (a constant expression has no mesh to interpolate on)
     expr = sigma_zz(sol.u, el.E, el.nu, sol.scene.model)
     s.interpolate(fem.Expression(expr, Q.element.interpolation_points))
     return s
