@@ -14,7 +14,15 @@ from mpi4py import MPI
 from ..errors import InputError
 from ..options import Basis, Predictor, SolverSpec, solver_spec
 from ..request import SolveRequest
-from ..scenes import BLOCK_SCENES, BlockParams, HertzParams, Scene, build_scene, load_scene_file
+from ..scenes import (
+    BLOCK_SCENES,
+    BlockParams,
+    HertzParams,
+    Model,
+    Scene,
+    build_scene,
+    load_scene_file,
+)
 
 BLOCK_KEYS = (
     "l1",
@@ -90,7 +98,9 @@ def is_scene_file(scene: str) -> bool:
 def reject_builtin_options(args: argparse.Namespace) -> None:
     """InputError if a scene file comes with options that only the built-in scenes take."""
     given = [k for k in (*BLOCK_KEYS, *HERTZ_KEYS) if getattr(args, k) is not None]
-    given += [k for k in ("preset", "mesh", "active") if getattr(args, k) is not None]
+    given += [
+        k for k in ("preset", "mesh", "active", "model") if getattr(args, k, None) is not None
+    ]
     if given:
         raise InputError(
             f"option --{given[0].replace('_', '-')} applies to the built-in "
@@ -112,6 +122,8 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
             f"unknown scene '{args.scene}' (choose blocks, hertz or a .toml scene file)"
         )
     given = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    if getattr(args, "model", None) is not None:
+        given["model"] = Model.parse(args.model, "--model")
     if args.mesh is not None:
         if args.scene != "hertz":
             raise InputError("option --mesh applies to the hertz scene only")

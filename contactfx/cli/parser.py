@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..options import SOLVERS, Basis, Enforcement, Method, Predictor
-from ..scenes import BLOCK_SCENES, MESHERS
+from ..scenes import BLOCK_SCENES, MESHERS, Model
 from .params import BLOCK_KEYS, HERTZ_KEYS, PARAM_HELP
 
 
@@ -33,6 +33,13 @@ def _builtin_scene_options(p: argparse.ArgumentParser) -> None:
         default=None,
         help="hertz only: gmsh graded quads (default) or a structured graded mesh "
         "built in DOLFINx (fast to make for millions of DOFs)",
+    )
+    g.add_argument(
+        "--model",
+        choices=[m.value for m in Model],
+        default=None,
+        help="the 2D model: plane_strain (default), plane_stress or axisymmetric (x = r, "
+        "y the axis: blocks are stacked cylinders, hertz a sphere on a block, P the total force)",
     )
     g.add_argument(
         "--active",

@@ -24,6 +24,9 @@ class Surface:
     segments: np.ndarray  # (m, 2) int64, node indices (into x) of each segment
     normals: np.ndarray  # (m, 2) float64, unit OUTWARD normal of the body on each segment
     dofs: np.ndarray  # (n, 2) int64, global dof numbers (x and y component) of each node
+    # The curve of an axisymmetric model (x = r): every contact integral over it is over the
+    # revolved surface, with the measure 2 pi r ds (`radial_weight`).
+    axisymmetric: bool = False
 
     def __post_init__(self) -> None:
         x = np.ascontiguousarray(self.x, dtype=np.float64).reshape(-1, 2)
@@ -56,6 +59,17 @@ def segment_lengths(surface: Surface) -> np.ndarray:
     """Length of every segment, shape (m,)."""
     d = surface.x[surface.segments[:, 1]] - surface.x[surface.segments[:, 0]]
     return np.hypot(d[:, 0], d[:, 1])
+
+
+def radial_weight(surface: Surface, points: np.ndarray) -> np.ndarray:
+    """The factor of ds at `points` (p, 2) of the surface: 2 pi x if axisymmetric, else 1.
+
+    Every contact kernel multiplies its quadrature weights by it at its quadrature points,
+    so that D, M, the gaps' weights and the nodal weights are integrals over the revolved
+    surface (and the multipliers stay pressures, the nodal forces totals over the turn).
+    """
+    x = np.asarray(points, dtype=np.float64).reshape(-1, 2)[:, 0]
+    return 2.0 * np.pi * x if surface.axisymmetric else np.ones_like(x)
 
 
 def segment_midpoints(surface: Surface) -> np.ndarray:

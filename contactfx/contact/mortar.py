@@ -41,7 +41,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .geometry import Surface, chains, nodal_normals, project, segment_lengths
+from .geometry import Surface, chains, nodal_normals, project, radial_weight, segment_lengths
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
 
 # Gauss points per sub-segment: the integrand N_j N_A is quadratic there, so 2 are exact.
@@ -188,6 +188,8 @@ def _gauss_points(
     seg_p = np.repeat(seg_p, GAUSS_POINTS)
     na = linear_shape(xi)
     x = np.einsum("pk,pkd->pd", na, active.x[active.segments[seg_a]])
+    if active.axisymmetric:
+        w = w * radial_weight(active, x)
     # Orthogonal projection onto the line of the paired passive segment (not clamped: it may
     # fall just outside it where the nodal normals tilt the cut; the foot stays on the line).
     xa, xb = passive.x[passive.segments[seg_p, 0]], passive.x[passive.segments[seg_p, 1]]
@@ -281,11 +283,21 @@ def overlap_weights(
     seg_a, _, xi_int = subsegments(active, passive, near)
     lo, hi = xi_int[:, 0], xi_int[:, 1]
     length = segment_lengths(active)[seg_a]
+    nodes = active.segments[seg_a]
+    if active.axisymmetric:
+        # int N_j 2 pi r ds: quadratic in xi, 2 Gauss points are exact.
+        gx, gw = gauss_unit(GAUSS_POINTS)
+        xi = lo[:, None] + (hi - lo)[:, None] * gx
+        na = linear_shape(xi)  # (s, g, 2)
+        x = np.einsum("sgk,skd->sgd", na, active.x[nodes])
+        r = radial_weight(active, x.reshape(-1, 2)).reshape(xi.shape)
+        wq = (length * (hi - lo))[:, None] * gw * r
+        vals = np.einsum("sg,sgk->sk", wq, na)
+        return np.bincount(nodes.ravel(), weights=vals.ravel(), minlength=active.n_nodes)
     # Exact integrals of 1 - xi and xi over [lo, hi].
     half_sq = 0.5 * (hi - lo) * (hi + lo)
     w1 = length * half_sq
     w0 = length * (hi - lo) - w1
-    nodes = active.segments[seg_a]
     return np.bincount(
         nodes.ravel(), weights=np.stack([w0, w1], axis=1).ravel(), minlength=active.n_nodes
     )

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .geometry import Surface, nodal_normals, segment_lengths
+from .geometry import Surface, nodal_normals, radial_weight, segment_lengths
 from .mortar import SLIVER, _check_basis, _dual_values
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
 from .rigid import Circle, Closest, Plane, Polyline, RigidShape
@@ -132,7 +132,10 @@ def _piece_points(
     span = b - a
     xi = (a[:, None] + span[:, None] * gx).ravel()
     w = (span[:, None] * gw * length[s][:, None]).ravel()
-    return np.repeat(s, n_gauss), xi, w
+    on = np.repeat(s, n_gauss)
+    if active.axisymmetric:
+        w = w * radial_weight(active, _points(active, active.segments[on], linear_shape(xi)))
+    return on, xi, w
 
 
 def _round(shape: RigidShape) -> int:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import Surface, project, segment_lengths
+from .geometry import Surface, project, radial_weight, segment_lengths
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
 
 GAUSS_POINTS = 4
@@ -19,7 +19,10 @@ def gauss_points(active: Surface) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ma = active.n_segments
     e = np.repeat(np.arange(ma), GAUSS_POINTS)
     w = np.tile(gw, ma) * segment_lengths(active)[e]
-    return w, linear_shape(np.tile(gx, ma)), active.segments[e]
+    na, nodes = linear_shape(np.tile(gx, ma)), active.segments[e]
+    if active.axisymmetric:
+        w = w * radial_weight(active, np.einsum("pk,pkd->pd", na, active.x[nodes]))
+    return w, na, nodes
 
 
 def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOperator:

@@ -1,18 +1,26 @@
-"""Plane-strain linear elasticity of every body: space, materials, loads, Dirichlet conditions."""
+"""Linear elasticity of every body: space, materials, loads, Dirichlet conditions.
+
+The 2D model (scenes.Model) decides the law and the measure: plane strain (eps_zz = 0),
+plane stress (sigma_zz = 0: the in-plane law with lambda* = 2 lambda mu / (lambda + 2 mu)),
+axisymmetric (x = r, y the axis; the hoop strain u_r / r, and every integral over the
+revolved body: 2 pi r dx in the volume, 2 pi r ds on the loaded curves). docs/models.md.
+"""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import cast
+from typing import Any, cast
 
 import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from dolfinx import fem, mesh
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..errors import MeshError
-from ..scenes import Pressure, Scene
+from ..scenes import Model, Pressure, Scene
 
 
 @dataclass(frozen=True)
@@ -41,12 +49,110 @@ def material_fields(scene: Scene) -> tuple[fem.Function, fem.Function]:
     return E, nu
 
 
-def sigma(u: ufl.core.expr.Expr, E: fem.Function, nu: fem.Function) -> ufl.core.expr.Expr:
-    """Plane-strain Cauchy stress of the displacement u."""
-    lmbda = E * nu / ((1 + nu) * (1 - 2 * nu))
+def lame(E: ufl.core.expr.Expr, nu: ufl.core.expr.Expr, model: Model) -> tuple[Any, Any]:
+    """(lambda, mu) of the model's law; plane stress: lambda* = 2 lambda mu / (lambda + 2 mu)."""
     mu = E / (2 * (1 + nu))
-    eps = ufl.sym(ufl.grad(u))
-    return 2 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(2)
+    if model is Model.PLANE_STRESS:
+        return E * nu / (1 - nu * nu), mu
+    return E * nu / ((1 + nu) * (1 - 2 * nu)), mu
+
+
+def radius(msh: mesh.Mesh) -> ufl.core.expr.Expr:
+    """The radius r = x of an axisymmetric model (a UFL expression on the mesh)."""
+    return ufl.SpatialCoordinate(msh)[0]
+
+
+def hoop_strain(u: ufl.core.expr.Expr, msh: mesh.Mesh, at_nodes: bool = True) -> ufl.core.expr.Expr:
+    """eps_theta = u_r / r; with `at_nodes`, on the axis (r = 0) its limit d u_r / d r.
+
+    `at_nodes` is for expressions evaluated at cell vertices (collective: "on the axis" is up
+    to round-off of the mesh size, gmsh writes 1e-17 for 0); forms, whose quadrature points
+    lie inside the cells, take plain u_r / r (FFCx cannot factor a conditional of arguments).
+    """
+    r = radius(msh)
+    if not at_nodes:
+        return u[0] / r
+    extent = float(np.max(np.abs(msh.geometry.x[:, 0]), initial=0.0))
+    tol = 1e-12 * msh.comm.allreduce(extent, op=MPI.MAX)
+    return ufl.conditional(ufl.gt(r, tol), u[0] / r, ufl.grad(u)[0, 0])
+
+
+def strain(u: ufl.core.expr.Expr, model: Model, at_nodes: bool = True) -> ufl.core.expr.Expr:
+    """The 3 x 3 strain of the displacement u: in-plane sym(grad u), eps_zz in (2, 2).
+
+    eps_zz is 0 in plane strain, the hoop strain u_r / r in axisymmetric (`hoop_strain`); in
+    plane stress it is not a kinematic quantity (sigma_zz = 0 fixes it) and is left 0
+    (`stress` ignores it).
+    """
+    e = ufl.sym(ufl.grad(u))
+    msh = u.ufl_function_space().mesh
+    ezz = hoop_strain(u, msh, at_nodes) if model is Model.AXISYMMETRIC else 0.0
+    return ufl.as_matrix([[e[0, 0], e[0, 1], 0.0], [e[1, 0], e[1, 1], 0.0], [0.0, 0.0, ezz]])
+
+
+def stress(
+    eps: ufl.core.expr.Expr, E: ufl.core.expr.Expr, nu: ufl.core.expr.Expr, model: Model
+) -> ufl.core.expr.Expr:
+    """Cauchy stress of a strain tensor under the 2D model: THE constitutive law.
+
+    A stable entry point: its name and signature stay, so that eigenstrains (thermal
+    strain, interference) enter as `stress(eps - eps0, E, nu, model)`.
+
+    `eps` is either 3 x 3 (in-plane block, out-of-plane zero, eps_zz in (2, 2): the hoop
+    strain in axisymmetric, the out-of-plane strain in plane strain, ignored in plane
+    stress), giving the 3 x 3 stress with sigma_zz (sigma_theta in axisymmetric; 0 in
+    plane stress); or 2 x 2 in-plane (eps_zz = 0), giving the in-plane 2 x 2 stress.
+    Plane strain and axisymmetric use the 3D law; plane stress the in-plane law with
+    lambda* = 2 lambda mu / (lambda + 2 mu).
+    """
+    lmbda, mu = lame(E, nu, model)
+    dim = eps.ufl_shape[0]
+    if dim == 2 or model is not Model.PLANE_STRESS:
+        return 2 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(dim)
+    tr2 = eps[0, 0] + eps[1, 1]
+    s = [[2 * mu * eps[i, j] + (lmbda * tr2 if i == j else 0.0) for j in (0, 1)] for i in (0, 1)]
+    return ufl.as_matrix([[s[0][0], s[0][1], 0.0], [s[1][0], s[1][1], 0.0], [0.0, 0.0, 0.0]])
+
+
+def in_plane(t: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """The in-plane 2 x 2 block of a 3 x 3 tensor."""
+    return ufl.as_matrix([[t[0, 0], t[0, 1]], [t[1, 0], t[1, 1]]])
+
+
+def sigma(
+    u: ufl.core.expr.Expr,
+    E: fem.Function,
+    nu: fem.Function,
+    model: Model = Model.PLANE_STRAIN,
+) -> ufl.core.expr.Expr:
+    """The in-plane (2 x 2) Cauchy stress of the displacement u under the model."""
+    if model is Model.AXISYMMETRIC:
+        return in_plane(stress(strain(u, model), E, nu, model))
+    return stress(ufl.sym(ufl.grad(u)), E, nu, model)
+
+
+def sigma_zz(
+    u: ufl.core.expr.Expr, E: fem.Function, nu: fem.Function, model: Model
+) -> ufl.core.expr.Expr:
+    """The out-of-plane stress: nu (sxx + syy) in plane strain, 0 in plane stress, sigma_theta."""
+    return stress(strain(u, model), E, nu, model)[2, 2]
+
+
+def measure(msh: mesh.Mesh, model: Model) -> ufl.core.expr.Expr | float:
+    """The factor of every integral: 2 pi r in axisymmetric (a revolved body), else 1."""
+    return 2 * math.pi * radius(msh) if model is Model.AXISYMMETRIC else 1.0
+
+
+def energy_form(
+    u: ufl.core.expr.Expr, v: ufl.core.expr.Expr, E: fem.Function, nu: fem.Function, model: Model
+) -> ufl.Form:
+    """The bilinear form a(u, v) = int sigma(u) : eps(v) (times 2 pi r in axisymmetric)."""
+    if model is Model.AXISYMMETRIC:
+        msh = v.ufl_function_space().mesh
+        w = measure(msh, model)
+        eps_u, eps_v = strain(u, model, at_nodes=False), strain(v, model, at_nodes=False)
+        return ufl.inner(stress(eps_u, E, nu, model), eps_v) * w * ufl.dx
+    return ufl.inner(sigma(u, E, nu, model), ufl.sym(ufl.grad(v))) * ufl.dx
 
 
 def check_quadrilateral(msh: mesh.Mesh) -> None:
@@ -82,13 +188,17 @@ def load_form(scene: Scene, v: ufl.Argument) -> ufl.Form:
     n = ufl.FacetNormal(msh)
     zero = fem.Constant(msh, np.zeros(2, dtype=PETSc.ScalarType))
     L = ufl.inner(zero, v) * ufl.dx
+    # Axisymmetric: the loads act on the revolved surface (2 pi r ds): totals over the turn.
+    axi = scene.model is Model.AXISYMMETRIC
+    w = measure(msh, scene.model)
     for load in scene.loads:
         dsg = ds(scene.curve_tag(load.group, "load"))
+        v_w = v * w if axi else v
         if isinstance(load, Pressure):
-            L += -fem.Constant(msh, PETSc.ScalarType(load.p)) * ufl.dot(n, v) * dsg  # type: ignore[operator]
+            L += -fem.Constant(msh, PETSc.ScalarType(load.p)) * ufl.dot(n, v_w) * dsg  # type: ignore[operator]
         else:
             t = fem.Constant(msh, np.asarray(load.t, dtype=PETSc.ScalarType))
-            L += ufl.dot(t, v) * dsg
+            L += ufl.dot(t, v_w) * dsg
     return L
 
 
@@ -99,7 +209,7 @@ def assemble_elasticity(scene: Scene) -> Elasticity:
     V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
     E, nu = material_fields(scene)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    a = fem.form(ufl.inner(sigma(u, E, nu), ufl.sym(ufl.grad(v))) * ufl.dx)
+    a = fem.form(energy_form(u, v, E, nu, scene.model))
     L = fem.form(load_form(scene, v))
     bcs = dirichlet_conditions(scene, V)
 

@@ -98,6 +98,7 @@ def union_surface(parts: list[GatheredSurface]) -> GatheredSurface:
         segments=np.vstack([p.surface.segments + o for p, o in zip(parts, offsets, strict=True)]),
         normals=np.vstack([p.surface.normals for p in parts]),
         dofs=np.vstack([p.surface.dofs for p in parts]),
+        axisymmetric=any(p.surface.axisymmetric for p in parts),
     )
     return GatheredSurface(
         surface, np.concatenate([p.owner for p in parts]), np.concatenate([p.gblock for p in parts])

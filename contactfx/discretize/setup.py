@@ -13,7 +13,7 @@ from petsc4py import PETSc
 from ..contact import ContactOperator, Kernel
 from ..errors import GeometryError, SingularSystemError
 from ..options import Basis
-from ..scenes import Body, Scene
+from ..scenes import Body, Model, Scene
 from ..timers import Timers
 from .coupling import (
     Multipliers,
@@ -266,7 +266,7 @@ def prepare_contact(
         # for overlap with the standard, positive weights (geometry, not the multipliers).
         std = stack(all_pairs(gathered, obstacles, kernel, ndofs))[1]
         g_all = (std.gap[order] + shift[order]) / std.weights[order]
-    h = float(np.median(w_all))
+    h = contact_size(w_all, layout.x, scene.model)
     for p in pairs:
         rows = np.flatnonzero(layout.pair == p.index)
         j = rows[int(np.argmin(g_all[rows]))]
@@ -299,3 +299,15 @@ def prepare_contact(
         hold,
         paths.rows,
     )
+
+
+def contact_size(w: np.ndarray, x: np.ndarray, model: Model) -> float:
+    """The median contact weight: about the contact element size (a length).
+
+    Axisymmetric weights are int N_j 2 pi r ds: divided by 2 pi r_j (rows off the axis).
+    """
+    if model is Model.AXISYMMETRIC:
+        off = x[:, 0] > 0
+        if off.any():
+            return float(np.median(w[off] / (2 * np.pi * x[off, 0])))
+    return float(np.median(w))

@@ -1,6 +1,8 @@
 """Which rigid motions the supports and the contact pairs leave free, body by body.
 
-Each body has three rigid modes (two translations, a rotation about its centroid). A
+Each body has three rigid modes (two translations, a rotation about its centroid); in an
+axisymmetric model only the axial translation (along y) is rigid: a radial translation or a
+rotation strains the revolved body (hoop strain), so each body gets two more fixed rows. A
 Dirichlet dof of the body and a contact-surface normal of a pair (taken as bilateral, the
 most the contact can hold) each give one linear condition on the modes; the modes in the
 null space of all these conditions make K + contact singular, whatever the load. A rigid
@@ -19,7 +21,7 @@ from petsc4py import PETSc
 from ..contact.geometry import nodal_normals
 from ..errors import SingularSystemError
 from ..linalg.nullspace import orthonormalize
-from ..scenes import Body, Scene
+from ..scenes import Body, Model, Scene
 from .surfaces import GatheredSurface
 
 # A contact pair as the check needs it: (active body, passive body or None for a rigid
@@ -34,6 +36,8 @@ def body_blocks(V: fem.FunctionSpace, cells: np.ndarray) -> np.ndarray:
 
 def rigid_body_modes(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Vec]:
     """The three rigid modes of all bodies together (x, y translation, rotation), orthonormal.
+
+    Axisymmetric: the translation along y (the axis) only.
 
     What aggregation multigrid wants as near-nullspace: an aggregate lies in one body (or
     straddles a contact the condensation couples), so per-body copies of the modes would only
@@ -50,8 +54,10 @@ def rigid_body_modes(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Vec]:
     centre = np.array([comm.allreduce(float(x[blocks, d].sum())) for d in (0, 1)])
     centre /= max(comm.allreduce(len(blocks)), 1)
     values = rigid_modes_at(x[blocks], centre, 1.0)  # (n, 2, 3)
+    # Axisymmetric: the axial translation is the only rigid mode.
+    kept = (1,) if scene.model is Model.AXISYMMETRIC else (0, 1, 2)
     modes: list[PETSc.Vec] = []
-    for k in range(3):
+    for k in kept:
         v = PETSc.Vec().createMPI((nloc * bs, PETSc.DETERMINE), bsize=bs, comm=comm)
         v.set(0.0)
         v.array[bs * blocks] = values[:, 0, k]
@@ -221,6 +227,10 @@ def holding(scene: Scene, V: fem.FunctionSpace, bc_dofs: np.ndarray) -> Holding:
     """The rigid frames of the scene's bodies and the rows of their Dirichlet conditions."""
     owned, centres, sizes = _body_frames(scene, V)
     rows_d = _dirichlet_rows(scene, V, bc_dofs, owned, centres, sizes)
+    if scene.model is Model.AXISYMMETRIC:
+        nb = len(scene.bodies)
+        fixed = np.eye(3 * nb)[[3 * k + m for k in range(nb) for m in (0, 2)]]
+        rows_d = np.vstack([rows_d, fixed])
     return Holding(tuple(scene.bodies), centres, sizes, rows_d)
 
 

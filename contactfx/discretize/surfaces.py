@@ -10,7 +10,7 @@ from dolfinx import fem
 from ..contact import ContactOperator, Surface
 from ..contact.geometry import nodal_normals, project, segment_lengths
 from ..errors import GeometryError, MeshError
-from ..scenes import Scene
+from ..scenes import Model, Scene
 from .mesh_utils import owned_facets, vertex_coordinates, vertex_to_block
 
 
@@ -68,6 +68,7 @@ def gather_surface(scene: Scene, V: fem.FunctionSpace, name: str) -> GatheredSur
         segments=segments.astype(np.int64),
         normals=allrows[:, 4:6].copy(),
         dofs=np.column_stack([2 * uniq, 2 * uniq + 1]).astype(np.int64),
+        axisymmetric=scene.model is Model.AXISYMMETRIC,
     )
     return GatheredSurface(surface, own[first], uniq)
 

@@ -16,7 +16,7 @@ from ..scenes import Obstacle
 from .interface import INTERFACE_FIELDS
 from .obstacles import outline
 from .records import RunSummary
-from .stress import sigma_field
+from .stress import sigma_field, sigma_zz_field
 
 
 def write_json(path: Path, data: dict[str, Any]) -> None:
@@ -34,7 +34,8 @@ def field_grid(sol: Solution, cell_fields: tuple[fem.Function, ...] = ()) -> Any
     `cell_fields`: more scalar DG0 functions written as cell data under their names (the
     error indicators `eta`).
 
-    u is padded to 3 components and sigma to the 3 x 3 tensor (9 components, z zero),
+    u is padded to 3 components and sigma to the 3 x 3 tensor (9 components; sigma_zz is
+    nu (sxx + syy) in plane strain, 0 in plane stress, sigma_theta in axisymmetric),
     which is how ParaView reads vectors and tensors. The points are this rank's dofs (Q1:
     the vertices), ghosts included where an owned cell needs them.
     """
@@ -55,6 +56,8 @@ def field_grid(sol: Solution, cell_fields: tuple[fem.Function, ...] = ()) -> Any
     s = sig.x.array.reshape(-1, 4)[sig.function_space.dofmap.list[:ncells, 0]]
     tensor = np.zeros((ncells, 9))
     tensor[:, [0, 1, 3, 4]] = s
+    szz = sigma_zz_field(sol)
+    tensor[:, 8] = szz.x.array[szz.function_space.dofmap.list[:ncells, 0]]
     grid.cell_data["sigma"] = tensor
     E = sol.fields.E
     grid.cell_data["E"] = E.x.array[E.function_space.dofmap.list[:ncells, 0]]

@@ -1,4 +1,9 @@
-"""Analytic references: plane-strain Hertz line contact, and the patch test's uniform stress.
+"""Analytic references: Hertz contact, and the patch test's uniform stress.
+
+Hertz is the plane line contact (a cylinder, force per unit thickness) in plane strain and
+plane stress (E* from the model's effective moduli: E/(1 - nu^2) in plane strain, E in plane
+stress), and the point contact of a sphere (3D, total force) in an axisymmetric model, whose
+L2 error weights the pressure by r (the integral over the contact disc).
 
 Hertz, for one pair: half-width, peak and the L2 error of the pressure. The distance r from
 the contact centre is measured along the active surface's tangent at the centre (the
@@ -15,7 +20,7 @@ import numpy as np
 from mpi4py import MPI
 
 from ..methods.solution import Solution
-from ..scenes import HertzReference, Scene, UniformStress
+from ..scenes import HertzReference, Material, Model, Scene, UniformStress
 from .interface import pair_forces, pair_interface, resolve
 from .records import HertzErrors, PatchErrors
 from .stress import body_vertex_stress
@@ -55,38 +60,62 @@ def l2_error(
     p0: float,
     samples: int = 40001,
     both_sides: bool = False,
+    radial: bool = False,
 ) -> float:
-    """Relative L2 error over [0, 1.5 a] (or [-1.5 a, 1.5 a]) of the piecewise-linear pressure."""
+    """Relative L2 error over [0, 1.5 a] (or [-1.5 a, 1.5 a]) of the piecewise-linear pressure.
+
+    `radial`: weighted by |x| (axisymmetric: the integral over the contact disc, r dr).
+    """
     xs = np.linspace(-1.5 * a if both_sides else 0.0, 1.5 * a, samples)
     ph = np.interp(xs, x, p, left=0.0, right=0.0)
     pe = exact_pressure(xs, a, p0)
-    return float(np.sqrt(np.trapezoid((ph - pe) ** 2, xs) / np.trapezoid(pe**2, xs)))
+    w = np.abs(xs) if radial else 1.0
+    return float(np.sqrt(np.trapezoid(w * (ph - pe) ** 2, xs) / np.trapezoid(w * pe**2, xs)))
+
+
+def effective_modulus(mats: list[Material], model: Model) -> float:
+    """E* = 1 / sum (1 - nu^2)/E (plane strain, axisymmetric); 1 / sum 1/E in plane stress."""
+    if model is Model.PLANE_STRESS:
+        return 1.0 / sum(1.0 / m.E for m in mats)
+    return 1.0 / sum((1 - m.nu**2) / m.E for m in mats)
+
+
+def hertz_values(e_star: float, R: float, P: float, model: Model) -> dict[str, float]:
+    """E*, a and p0 of Hertz's contact under the load P.
+
+    Cylinder (plane models, P per unit thickness): a = sqrt(4 P R/(pi E*)), p0 = 2 P/(pi a).
+    Sphere (axisymmetric, P the total force): a = (3 P R/(4 E*))^(1/3), p0 = 3 P/(2 pi a^2).
+    """
+    if model is Model.AXISYMMETRIC:
+        a = (3 * P * R / (4 * e_star)) ** (1.0 / 3.0)
+        return {"E_star": e_star, "a": a, "p0": 3 * P / (2 * math.pi * a * a)}
+    a = math.sqrt(4 * P * R / (math.pi * e_star))
+    return {"E_star": e_star, "a": a, "p0": 2 * P / (math.pi * a)}
 
 
 def reference_values(scene: Scene, ref: HertzReference, P: float) -> dict[str, float]:
-    """E*, a and p0 of the pair's materials under the line load P.
+    """E*, a and p0 of the pair's materials under the load P (`hertz_values`).
 
-    1/E* = sum (1 - nu^2)/E, a = sqrt(4 P R/(pi E*)), p0 = 2 P / (pi a). A rigid obstacle
-    (pair index len(contacts) + i) is infinitely stiff: it adds nothing.
+    A rigid obstacle (pair index len(contacts) + i) is infinitely stiff: it adds nothing.
     """
     if ref.pair >= len(scene.contacts):
         groups = [scene.obstacles[ref.pair - len(scene.contacts)].surface]
     else:
         groups = [scene.contacts[ref.pair].active, scene.contacts[ref.pair].passive]
     mats = [scene.body_of_curve(g).material for g in groups]
-    e_star = 1.0 / sum((1 - m.nu**2) / m.E for m in mats)
-    a = math.sqrt(4 * P * ref.R / (math.pi * e_star))
-    return {"E_star": e_star, "a": a, "p0": 2 * P / (math.pi * a)}
+    return hertz_values(effective_modulus(mats, scene.model), ref.R, P, scene.model)
 
 
 def computed_load(sol: Solution, ref: HertzReference, tangent: np.ndarray) -> float:
-    """The pair's line load: its contact force along the normal at the centre (x2 if halved).
+    """The pair's load: its contact force along the normal at the centre (x2 if halved).
 
-    `tangent` is the active surface's tangent at the contact centre.
+    `tangent` is the active surface's tangent at the contact centre. Axisymmetric: the force
+    is already the total over the turn (the half section is the whole body).
     """
     force = pair_forces(sol, ref.pair)[0]
     normal = np.array([-tangent[1], tangent[0]])
-    return float(abs(force @ normal) * (2.0 if ref.symmetric else 1.0))
+    halved = ref.symmetric and sol.scene.model is not Model.AXISYMMETRIC
+    return float(abs(force @ normal) * (2.0 if halved else 1.0))
 
 
 def centre_distance(
@@ -143,7 +172,14 @@ def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> HertzErro
         E_star=exact["E_star"],
         P=load,
         P_source="given" if ref.P is not None else "computed (the pair's contact force)",
-        l2_error=l2_error(r, p, exact["a"], exact["p0"], both_sides=not ref.symmetric),
+        l2_error=l2_error(
+            r,
+            p,
+            exact["a"],
+            exact["p0"],
+            both_sides=not ref.symmetric,
+            radial=sol.scene.model is Model.AXISYMMETRIC,
+        ),
     )
 
 

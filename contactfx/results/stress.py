@@ -10,9 +10,10 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from ..discretize.elasticity import sigma
+from ..discretize.elasticity import sigma, sigma_zz
 from ..discretize.mesh_utils import owned_facets, vertex_coordinates, vertex_to_block
 from ..methods.solution import Solution
+from ..scenes import Model
 
 REF_VERTICES = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
 
@@ -32,7 +33,7 @@ def _nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np
     msh = scene.mesh
     tdim = msh.topology.dim
     el = sol.fields
-    expr = fem.Expression(sigma(sol.u, el.E, el.nu), REF_VERTICES)
+    expr = fem.Expression(sigma(sol.u, el.E, el.nu, sol.scene.model), REF_VERTICES)
     facets = owned_facets(scene, group)
     msh.topology.create_connectivity(tdim - 1, tdim)
     msh.topology.create_connectivity(tdim - 1, 0)
@@ -80,7 +81,24 @@ def sigma_field(sol: Solution) -> fem.Function:
     Q = fem.functionspace(msh, ("DG", 0, (2, 2)))
     s = fem.Function(Q, name="sigma")
     el = sol.fields
-    s.interpolate(fem.Expression(sigma(sol.u, el.E, el.nu), Q.element.interpolation_points))
+    expr = sigma(sol.u, el.E, el.nu, sol.scene.model)
+    s.interpolate(fem.Expression(expr, Q.element.interpolation_points))
+    return s
+
+
+def sigma_zz_field(sol: Solution) -> fem.Function:
+    """Cellwise (DG0) out-of-plane stress sigma_zz.
+
+    nu (sxx + syy) in plane strain, 0 in plane stress, the hoop stress in axisymmetric.
+    """
+    msh = sol.scene.mesh
+    Q = fem.functionspace(msh, ("DG", 0))
+    s = fem.Function(Q, name="sigma_zz")
+    el = sol.fields
+    if sol.scene.model is Model.PLANE_STRESS:
+        return s  # zero (a constant expression has no mesh to interpolate on)
+    expr = sigma_zz(sol.u, el.E, el.nu, sol.scene.model)
+    s.interpolate(fem.Expression(expr, Q.element.interpolation_points))
     return s
 
 
@@ -89,7 +107,7 @@ def body_vertex_stress(sol: Solution) -> dict[str, np.ndarray]:
     scene = sol.scene
     msh = scene.mesh
     el = sol.fields
-    expr = fem.Expression(sigma(sol.u, el.E, el.nu), REF_VERTICES)
+    expr = fem.Expression(sigma(sol.u, el.E, el.nu, sol.scene.model), REF_VERTICES)
     nloc = msh.topology.index_map(msh.topology.dim).size_local
     out = {}
     for body in scene.bodies:

@@ -21,6 +21,7 @@ from .model import (
     Groups,
     HertzReference,
     Material,
+    Model,
     Pressure,
     Reference,
     Scene,
@@ -48,6 +49,7 @@ class BlockParams:
     size2: float = 0.125
     grading1: float = 1.0
     grading2: float = 1.0
+    model: Model = Model.PLANE_STRAIN  # axisymmetric: two stacked cylinders (x = r)
 
 
 @dataclass(frozen=True)
@@ -68,6 +70,8 @@ class HertzParams:
     height: float = 60.0
     mesh: str = "gmsh"  # "gmsh" (graded unstructured quads) or "structured" (large runs)
     h_far: float = 0.0  # largest element size (cm); 0 = R / 6
+    # Axisymmetric: a (hemi)sphere on a cylindrical block, P the total force (MPa*cm^2).
+    model: Model = Model.PLANE_STRAIN
 
 
 MESHERS = ("gmsh", "structured")
@@ -81,15 +85,26 @@ BLOCK_SCENES: dict[str, BlockParams] = {
 
 
 def hertz_exact(params: HertzParams) -> dict[str, float]:
-    """Plane-strain line contact (Johnson sec. 4.2): E*, half-width a and peak pressure p0."""
-    inv = (1 - params.nu1**2) / params.E1 + (1 - params.nu2**2) / params.E2
+    """Hertz (Johnson sec. 4.2, 3.2): E*, half-width (radius) a and peak pressure p0.
+
+    Line contact in plane strain and plane stress (E* with E instead of E/(1 - nu^2));
+    a sphere's point contact in axisymmetric (P the total force).
+    """
+    if params.model is Model.PLANE_STRESS:
+        inv = 1.0 / params.E1 + 1.0 / params.E2
+    else:
+        inv = (1 - params.nu1**2) / params.E1 + (1 - params.nu2**2) / params.E2
     e_star = 1.0 / inv
+    if params.model is Model.AXISYMMETRIC:
+        a = (3 * params.P * params.R / (4 * e_star)) ** (1.0 / 3.0)
+        return {"E_star": e_star, "a": a, "p0": 3 * params.P / (2 * math.pi * a * a)}
     a = math.sqrt(4 * params.P * params.R / (math.pi * e_star))
     return {"E_star": e_star, "a": a, "p0": 2 * params.P / (math.pi * a)}
 
 
 def validate(params: BlockParams | HertzParams) -> None:
     """Raise InputError naming the first parameter out of its range."""
+    Model.parse(params.model)
     Material(params.E1, params.nu1).check("body 1")
     Material(params.E2, params.nu2).check("body 2")
     positive = {
@@ -201,9 +216,10 @@ def _two_body_scene(
         (Pressure("load", load),),
         references,
         name=name,
-        params={**asdict(params), "active": active, **extra},
+        params={**asdict(params), "model": params.model.value, "active": active, **extra},
         recipe=BuiltinRecipe(params, active, size_field),
         units=Units("cm", "MPa"),  # the paper's
+        model=params.model,
     )
     return check_scene(scene)
 
@@ -224,7 +240,7 @@ def blocks(
     `size_field`: unstructured quads with these sizes instead of the transfinite mesh.
     """
     validate(params)
-    p = params
+    p = params = replace(params, model=Model.parse(params.model))
     build = partial(
         build_blocks,
         p.l1,
@@ -256,6 +272,7 @@ def hertz(
     `size_field`: the gmsh geometry meshed with these sizes instead of the graded field.
     """
     validate(params)
+    params = replace(params, model=Model.parse(params.model))
     exact = hertz_exact(params)
     if params.r_refine == 0.0:
         # Refine where the contact zone will be: Hertz's a, with margin for the active set.
@@ -285,7 +302,9 @@ def hertz(
         data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
     ref = (HertzReference(pair=0, R=h.R, P=h.P, symmetric=True),)
     extra: dict[str, Any] = {"hertz_exact": exact}
-    return _two_body_scene(data, h, h.P / (2 * h.R), active, "hertz", ref, extra, size_field)
+    # The load on the flat face: P over its width 2 R (a cylinder), or its disc pi R^2 (a sphere).
+    load = h.P / (math.pi * h.R**2) if h.model is Model.AXISYMMETRIC else h.P / (2 * h.R)
+    return _two_body_scene(data, h, load, active, "hertz", ref, extra, size_field)
 
 
 def build_scene(

@@ -9,9 +9,10 @@ import math
 from dataclasses import replace
 
 import numpy as np
+from mpi4py import MPI
 
 from ..errors import InputError, MeshError
-from .model import Body, Scene
+from .model import Body, Model, Scene
 
 
 def _global_count(scene: Scene, local: int) -> int:
@@ -132,6 +133,21 @@ def _check_conditions(scene: Scene) -> None:
             )
 
 
+def _check_axis(scene: Scene) -> None:
+    """Axisymmetric: x is the radius; a cell with a node at x < 0 (beyond round-off) is refused."""
+    if scene.model is not Model.AXISYMMETRIC:
+        return
+    x = scene.mesh.geometry.x[:, :2]
+    comm = scene.comm
+    lo = comm.allreduce(float(x[:, 0].min(initial=np.inf)), op=MPI.MIN)
+    extent = comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
+    if lo < -1e-9 * extent:
+        raise InputError(
+            f"model axisymmetric: x is the radius, but the mesh has a cell at x = {lo:.4g} < 0 "
+            "(put the axis at x = 0 and the bodies on its right)"
+        )
+
+
 def check_scene(scene: Scene) -> Scene:
     """The scene with its contact curves' bodies found, once checked against its mesh.
 
@@ -140,6 +156,7 @@ def check_scene(scene: Scene) -> Scene:
     for body in scene.bodies:
         body.material.check(f"body '{body.name}'")
     _check_bodies(scene)
+    _check_axis(scene)
     curve_bodies = _check_pairs(scene)
     curve_bodies.update(_check_obstacles(scene, curve_bodies))
     _check_conditions(scene)

@@ -354,6 +354,7 @@ def from_gmsh(
     comm: MPI.Comm = MPI.COMM_WORLD,
     name: str | None = None,
     obstacles: list[Obstacle] | None = None,
+    model: Model | str = Model.PLANE_STRAIN,
 ) -> Scene:
     """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path.
 
@@ -368,6 +369,7 @@ def from_gmsh(
         comm: The communicator the mesh is distributed over.
         name: The scene's label (default: the file's stem, or "gmsh-model").
         obstacles: Rigid obstacles (Obstacle), each against one curve group of a body.
+        model: plane_strain (default), plane_stress or axisymmetric (x = r >= 0, y the axis).
 
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
@@ -387,5 +389,6 @@ def from_gmsh(
         tuple(references or ()),
         label,
         tuple(obstacles or ()),
+        Model.parse(model),
     )
     return scene_from_gmsh(model_or_path, parts, comm)

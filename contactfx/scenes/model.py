@@ -193,7 +193,10 @@ Load = Pressure | Traction
 
 @dataclass(frozen=True)
 class HertzReference:
-    """Plane-strain Hertz line contact on one pair: effective radius R, full line load P.
+    """Hertz contact on one pair: effective radius R, full load P.
+
+    The line contact of a cylinder (P per unit thickness) in plane strain and plane stress;
+    the point contact of a sphere (P the total force) in an axisymmetric scene.
 
     `P` None (omitted): the load is the pair's computed contact force (twice it for a half
     model), which is what a displacement-controlled scene knows. `symmetric`: the model is a

@@ -190,6 +190,23 @@ for _name, _path, _method, _basis in (
     CASES[f"obstacle-{_name}"] = Case(obstacle(_path, _method, _basis), OBSTACLE_CHECKS)
 
 
+def axisymmetric_sphere() -> tuple[Solution, Arrays]:
+    """The axisymmetric sphere on a block (2 pi r in every integral): u, pressure, force."""
+    sol, data = run_scene(load_scene_file(SCENES / "axi_sphere.toml"), "mortar")
+    data = data.to_json()
+    c = data["contacts"][0]
+    return sol, {
+        **u_split(sol),
+        "x": np.asarray(c["interface"]["x"]),
+        "p": np.asarray(c["interface"]["pressure"]),
+        "f": np.asarray(c["force"]),
+        "a": np.asarray(data["hertz"]["a"]),
+    }
+
+
+CASES["axisymmetric-sphere-mortar"] = Case(axisymmetric_sphere, {**OBSTACLE_CHECKS, "a": Rel(1e-8)})
+
+
 def stacked_blocks() -> tuple[Solution, Arrays]:
     """`contactfx solve stacked_blocks.toml`: every pair's force (the floating checks pass)."""
     sol, data = cli_json(["solve", str(SCENES / "stacked_blocks.toml")])

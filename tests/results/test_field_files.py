@@ -95,7 +95,10 @@ def check_fields(f: dict[str, np.ndarray], data: dict) -> None:
     tensor = sig.reshape(-1, 3, 3)
     np.testing.assert_allclose(tensor[:, 1, 1], -P, atol=1e-8 * P)
     np.testing.assert_allclose(tensor[:, :2, :2].reshape(-1, 4)[:, :3], 0.0, atol=1e-8 * P)
-    np.testing.assert_array_equal(tensor[:, 2, :], 0.0)
+    # Plane strain: sigma_zz = nu (sxx + syy) = -nu P (it was written 0 before).
+    nus = np.array([m[1] for m in MATERIALS])[block]
+    np.testing.assert_allclose(tensor[:, 2, 2], -nus * P, atol=1e-8 * P)
+    np.testing.assert_array_equal(tensor[:, 2, :2], 0.0)
     used = np.isfinite(f["point_cell_y"])  # (a piece may hold a ghost point no cell uses)
     assert used.sum() >= f["n_points"] - 200
     ue = exact_u(f["points"][used, :2], f["point_cell_y"][used])

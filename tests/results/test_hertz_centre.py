@@ -21,7 +21,7 @@ from conftest import ROOT
 from contactfx import load_scene_file, run_scene
 from contactfx.options import Method
 from contactfx.results.references import exact_pressure, hertz_summary
-from contactfx.scenes import HertzReference, Units
+from contactfx.scenes import HertzReference, Model, Units
 
 SCENES = ROOT / "tests" / "scenes"
 
@@ -54,6 +54,7 @@ def straight_pair(s: np.ndarray, p: np.ndarray, E: float, nu: float) -> SimpleNa
         contacts=[SimpleNamespace(active="a", passive="b")],
         obstacles=[],
         body_of_curve=lambda _: body,
+        model=Model.PLANE_STRAIN,
     )
     return SimpleNamespace(pairs=[pair], pressure=p, active=p > 0, scene=scene)
 
