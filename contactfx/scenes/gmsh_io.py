@@ -340,6 +340,16 @@ def scene_from_gmsh(
     return check_scene(scene)
 
 
+def _material(name: str, values: Mapping[str, float]) -> Material:
+    """A Material from {"E": ..., "nu": ...} (and "alpha", "dT"); InputError on other keys."""
+    unknown = sorted(set(values) - {"E", "nu", "alpha", "dT"})
+    if unknown or not {"E", "nu"} <= set(values):
+        what = f"unknown key '{unknown[0]}'" if unknown else "E and nu are required"
+        raise InputError(f"body '{name}': {what} (keys: E, nu, alpha, dT)")
+    thermal = {k: float(values[k]) for k in ("alpha", "dT") if k in values}
+    return Material(float(values["E"]), float(values["nu"]), **thermal)
+
+
 def from_gmsh(
     model_or_path: Any,
     *,
@@ -357,8 +367,10 @@ def from_gmsh(
     Args:
         model_or_path: A .msh or .geo path, or anything else for gmsh's current model
             (meshed in 2D here if it has no 2D elements yet).
-        bodies: Material (or {"E": ..., "nu": ...}) per physical surface group.
-        contacts: (active, passive) curve groups of every contact pair.
+        bodies: Material (or {"E": ..., "nu": ...}, with "alpha" and "dT" for a thermal
+            strain) per physical surface group.
+        contacts: (active, passive) curve groups of every contact pair, or ContactPairs
+            (with `interference` for a fit).
         dirichlet: Prescribed displacement components on curve or point groups.
         loads: Pressures and tractions on curve groups.
         references: Analytic references (HertzReference, UniformStress) to report.
@@ -369,10 +381,7 @@ def from_gmsh(
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
     """
-    mats = {
-        k: v if isinstance(v, Material) else Material(float(v["E"]), float(v["nu"]))
-        for k, v in bodies.items()
-    }
+    mats = {k: v if isinstance(v, Material) else _material(k, v) for k, v in bodies.items()}
     label = name or (
         Path(model_or_path).stem if isinstance(model_or_path, str | Path) else "gmsh-model"
     )

@@ -20,6 +20,7 @@ from mpi4py import MPI
 
 from ..contact.rigid import Circle, Plane, Polyline, RigidShape
 from ..errors import InputError, MeshError
+from .fits import LameReference, check_interference, check_thermal
 
 
 class Model(StrEnum):
@@ -44,17 +45,29 @@ class Model(StrEnum):
 
 @dataclass(frozen=True)
 class Material:
-    """Isotropic linear elasticity: Young's modulus and Poisson ratio."""
+    """Isotropic linear elasticity: Young's modulus and Poisson ratio.
+
+    `alpha` (thermal expansion coefficient) and `dT` (a uniform temperature change) give the
+    body the eigenstrain alpha dT I (discretize/thermal.py); both or neither.
+    """
 
     E: float
     nu: float
+    alpha: float | None = None
+    dT: float | None = None
+
+    @property
+    def thermal_strain(self) -> float:
+        """The eigenstrain alpha dT (0 without a thermal load)."""
+        return 0.0 if self.alpha is None or self.dT is None else self.alpha * self.dT
 
     def check(self, where: str) -> None:
-        """Raise InputError unless E > 0 and -1 < nu < 0.5 (finite)."""
+        """Raise InputError unless E > 0, -1 < nu < 0.5, and alpha and dT come together."""
         if not (math.isfinite(self.E) and self.E > 0):
             raise InputError(f"{where}: Young's modulus must be > 0 (got E = {self.E})")
         if not (math.isfinite(self.nu) and -1.0 < self.nu < 0.5):
             raise InputError(f"{where}: Poisson ratio must lie in (-1, 0.5) (got nu = {self.nu})")
+        check_thermal(self.alpha, self.dT, where)
 
 
 @dataclass(frozen=True)
@@ -67,10 +80,27 @@ class Body:
 
 @dataclass(frozen=True)
 class ContactPair:
-    """One contact pair: curve groups on the active (slave) and the passive (master) body."""
+    """One contact pair: curve groups on the active (slave) and the passive (master) body.
+
+    `interference`: False (the default) for bodies that must not overlap as drawn; True for
+    an interference fit drawn overlapping (the overlap is the fit, the solve resolves it);
+    a number D > 0 for bodies drawn touching, with the overlap D prescribed along the normal
+    (the gap g becomes g - D).
+    """
 
     active: str
     passive: str
+    interference: bool | float = False
+
+    def __post_init__(self) -> None:
+        where = f"contact '{self.active}' on '{self.passive}'"
+        object.__setattr__(self, "interference", check_interference(self.interference, where))
+
+    @property
+    def prescribed_overlap(self) -> float:
+        """D of `interference = D` (0 for true or false: the gap is the drawn one)."""
+        d = self.interference
+        return 0.0 if isinstance(d, bool) else d
 
 
 # The parameters each obstacle shape takes (besides name, shape, surface and displacement).
@@ -204,7 +234,7 @@ class UniformStress:
     sigma: tuple[tuple[float, float], tuple[float, float]]
 
 
-Reference = HertzReference | UniformStress
+Reference = HertzReference | UniformStress | LameReference
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,129 @@
+"""Thermal strain and interference fits in whole solves, against closed forms.
+
+- A block heated by dT between two rigid walls (tests/scenes/heated_block.toml), free in y:
+  eps_xx = 0, sigma_yy = 0, and in plane strain eps_zz = 0, so (by hand, 3D Hooke with
+  eps0 = alpha dT): sigma_zz = nu sigma_xx - E alpha dT, and eps_xx = 0 gives
+  sigma_xx (1 - nu^2) = -E alpha dT (1 + nu), the wall pressure E alpha dT / (1 - nu); in
+  plane stress (sigma_zz = 0) it is E alpha dT. The displacement is linear: a patch test,
+  exact to round-off on the unstructured mesh.
+- A shrink fit of two rings (tests/scenes/shrink_fit.toml, quarter model): Lame's pressure
+  (docs/models.md) to 1 %, every node of the pair active.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from contactfx import load_scene_file, run_scene
+from contactfx.discretize import elasticity
+from contactfx.discretize.thermal import plane_strain_szz, thermal_stress
+from contactfx.results.references import lame_pressure
+from contactfx.scenes import Model
+
+SCENES = ROOT / "tests" / "scenes"
+E, NU, ALPHA, DT = 1000.0, 0.3, 1e-5, 100.0
+
+
+def test_thermal_stress_by_hand() -> None:
+    """sigma0 = C alpha dT I per model, and the walls' closed forms from it (plane strain)."""
+    eps0 = ALPHA * DT
+    ps = thermal_stress(E, NU, ALPHA, DT, Model.PLANE_STRAIN)
+    assert ps.in_plane == pytest.approx(E * eps0 / (1 - 2 * NU), rel=1e-14)
+    pst = thermal_stress(E, NU, ALPHA, DT, Model.PLANE_STRESS)
+    assert (pst.in_plane, pst.out_of_plane) == (pytest.approx(E * eps0 / (1 - NU)), 0.0)
+    axi = thermal_stress(E, NU, ALPHA, DT, Model.AXISYMMETRIC)
+    assert axi.in_plane == axi.out_of_plane == pytest.approx(E * eps0 / (1 - 2 * NU))
+    # Plane strain between walls: eps_xx = 0, sigma_yy = 0 fixes eps_yy; then sigma_xx.
+    lam, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
+    eps_yy = ps.in_plane / (lam + 2 * mu)
+    sxx = lam * eps_yy - ps.in_plane
+    assert sxx == pytest.approx(-E * eps0 / (1 - NU), rel=1e-13)
+    # ... and 3D Hooke agrees: eps_zz = (szz - nu sxx) / E + eps0 = 0.
+    szz = plane_strain_szz(sxx, 0.0, E, NU, eps0)
+    assert (szz - NU * sxx) / E + eps0 == pytest.approx(0.0, abs=1e-16)
+
+
+def _walls(path: Path, method: str) -> tuple[dict, np.ndarray]:
+    sol, run = run_scene(load_scene_file(path), method)
+    data = run.to_json()
+    p = np.concatenate([sol.pressure[pv.rows] for pv in sol.pairs])
+    return data, p
+
+
+@pytest.mark.parametrize("method", ["mortar", "nts"])
+def test_heated_block_between_walls_plane_strain(method: str) -> None:
+    """Wall pressure E alpha dT / (1 - nu) at every node to 1e-8 (measured ~1e-14), the
+    stress sigma_xx = -E alpha dT / (1 - nu), sigma_yy = 0 everywhere (the thermal part
+    subtracted), forces balanced, nothing overlapping before the solve."""
+    exact = E * ALPHA * DT / (1 - NU)
+    data, p = _walls(SCENES / "heated_block.toml", method)
+    assert np.max(np.abs(p / exact - 1.0)) < 1e-8, p
+    assert data["patch"]["max"] < 1e-8, data["patch"]
+    left, right = data["contacts"]
+    assert left["force"][0] == pytest.approx(exact * 1.0, rel=1e-10)  # height H = 1
+    assert right["force"][0] == pytest.approx(-exact * 1.0, rel=1e-10)
+    assert left["initial_overlap"] == right["initial_overlap"] == 0.0
+
+
+@pytest.mark.skipif(
+    not hasattr(elasticity, "stress"),
+    reason="needs the plane-stress law (elasticity.stress(eps, E, nu, model), branch models)",
+)
+def test_heated_block_between_walls_plane_stress(tmp_path: Path) -> None:
+    """Plane stress: the wall pressure is E alpha dT (runs once sigma knows the model)."""
+    text = (SCENES / "heated_block.toml").read_text()
+    text = text.replace('mesh = "heated_block.geo"', f'mesh = "{SCENES / "heated_block.geo"}"')
+    text = 'model = "plane_stress"\n' + text.replace("-1.4285714285714286", "-1.0")
+    path = tmp_path / "heated_block_plane_stress.toml"
+    path.write_text(text)
+    data, p = _walls(path, "mortar")
+    assert np.max(np.abs(p / (E * ALPHA * DT) - 1.0)) < 1e-8, p
+    assert data["patch"]["max"] < 1e-8, data["patch"]
+
+
+def test_shrink_fit_drawn_overlapping_matches_lame() -> None:
+    """interference = true: the drawn overlap resolved, every node active, the mean
+    pressure within 1 % of Lame (measured +0.034 %), the initial overlap the drawn delta."""
+    sol, run = run_scene(load_scene_file(SCENES / "shrink_fit.toml"), "mortar")
+    data = run.to_json()
+    (lame,) = data["lame"]
+    assert (lame["inner"], lame["outer"], lame["model"]) == ("shaft", "hub", "plane_strain")
+    assert lame["p_exact"] == pytest.approx(51.510989010989015, rel=1e-12)
+    assert lame["error"] < 0.01, lame
+    assert sol.active[sol.pairs[0].rows].all()
+    assert lame["active_fraction"] == 1.0
+    c = data["contacts"][0]
+    assert c["active_nodes"] == c["multipliers"] == 41
+    assert c["initial_overlap"] == pytest.approx(0.002, rel=1e-3)
+
+
+def test_shrink_fit_prescribed_interference_matches_lame() -> None:
+    """interference = D on rings drawn touching: the same fit, to 1 % (measured +0.11 %)."""
+    sol, run = run_scene(load_scene_file(SCENES / "shrink_fit_touching.toml"), "mortar")
+    (lame,) = run.to_json()["lame"]
+    assert lame["delta"] == 0.002 and lame["error"] < 0.01, lame
+    assert sol.active[sol.pairs[0].rows].all()
+    assert run.contacts[0].initial_overlap == pytest.approx(0.002, rel=1e-6)
+
+
+def test_lame_formula_plane_strain_substitution() -> None:
+    """Plane strain is plane stress with E -> E/(1 - nu^2), nu -> nu/(1 - nu); a solid shaft
+    (a = 0) of one material has p = E delta (c^2 - b^2) / (2 b c^2) in plane stress."""
+    E1, nu1, E2, nu2 = 200e3, 0.3, 70e3, 0.33
+    pe = lame_pressure(1.0, 2.0, 3.0, 0.002, (E1, nu1), (E2, nu2), Model.PLANE_STRAIN)
+    ps = lame_pressure(
+        1.0,
+        2.0,
+        3.0,
+        0.002,
+        (E1 / (1 - nu1**2), nu1 / (1 - nu1)),
+        (E2 / (1 - nu2**2), nu2 / (1 - nu2)),
+        Model.PLANE_STRESS,
+    )
+    assert pe == pytest.approx(ps, rel=1e-14)
+    solid = lame_pressure(0.0, 2.0, 3.0, 0.002, (E1, nu1), (E1, nu1), Model.PLANE_STRESS)
+    assert solid == pytest.approx(E1 * 0.002 * (9 - 4) / (2 * 2 * 9), rel=1e-14)
