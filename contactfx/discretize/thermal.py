@@ -18,11 +18,12 @@ load assembles exactly what it did before.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import ufl
-from dolfinx import fem
+from dolfinx import fem, mesh
 
 from ..errors import InputError
 from ..scenes import Model, Scene
@@ -82,10 +83,25 @@ def thermal_strain_field(scene: Scene) -> fem.Function:
     return eps0
 
 
+def axisymmetric_thermal_load(
+    msh: mesh.Mesh, v: ufl.Argument, E: fem.Function, nu: fem.Function, eps0: fem.Function
+) -> ufl.Form:
+    """The axisymmetric load int sigma0 : eps(v) 2 pi r dx, x = r (the 3D law's eigenstress).
+
+    eps(v) has eps_rr + eps_zz = tr(sym grad v) in plane and the hoop strain v_r / r, so
+    sigma0 : eps(v) r = s0 (r tr(grad v) + v_r), s0 = E eps0 / (1 - 2 nu) (no 1/r left).
+    Not called until the axisymmetric elasticity is there (branch `models`): then
+    `thermal_load` returns it, and `thermal_correction` adds s0 to the hoop stress too.
+    """
+    s0 = thermal_stress(E, nu, eps0, 1.0, Model.AXISYMMETRIC).in_plane
+    r = ufl.SpatialCoordinate(msh)[0]
+    return 2 * math.pi * s0 * (r * ufl.tr(ufl.grad(v)) + v[0]) * ufl.dx
+
+
 def _check_model(scene: Scene) -> None:
     if scene.model is Model.AXISYMMETRIC:
-        # The formula is thermal_stress(..., AXISYMMETRIC); the r dx measure and the hoop
-        # strain u_r / r come with the axisymmetric elasticity (branch `models`).
+        # The formula is axisymmetric_thermal_load; the stiffness with the r dx measure and
+        # the hoop strain u_r / r comes with the axisymmetric elasticity (branch `models`).
         raise InputError(
             "a thermal strain (alpha, dT) in the axisymmetric model needs the axisymmetric "
             "elasticity, which this build does not have yet"

@@ -205,10 +205,12 @@ def lame_pressure(
 ) -> float:
     """Lame's shrink-fit contact pressure of rings a..b (inner) and b..c (outer).
 
-    Plane stress (Shigley, Mechanical Engineering Design, eq. 3-57; Timoshenko & Goodier,
-    Theory of Elasticity, sec. 30): p = delta / (b [(1/E_o)((c^2 + b^2)/(c^2 - b^2) + nu_o)
-    + (1/E_i)((b^2 + a^2)/(b^2 - a^2) - nu_i)]), `inner` and `outer` the (E, nu) of the
-    rings; plane strain by E -> E/(1 - nu^2), nu -> nu/(1 - nu).
+    Plane stress (Shigley's Mechanical Engineering Design, sec. 3-16, "Press and Shrink
+    Fits"; Lame's thick cylinder, Timoshenko & Goodier, ch. 4):
+    p = delta / (b [(1/E_o)((c^2 + b^2)/(c^2 - b^2) + nu_o)
+                    + (1/E_i)((b^2 + a^2)/(b^2 - a^2) - nu_i)]),
+    `inner` and `outer` the (E, nu) of the rings; plane strain by E -> E/(1 - nu^2),
+    nu -> nu/(1 - nu).
     """
     if model is Model.AXISYMMETRIC:
         raise InputError("lame reference: the shrink fit of rings is plane strain or plane stress")

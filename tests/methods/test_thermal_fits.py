@@ -12,15 +12,24 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+import dolfinx.fem.petsc
 import numpy as np
 import pytest
+import ufl
 from conftest import ROOT
+from dolfinx import fem, mesh
+from mpi4py import MPI
 
 from contactfx import load_scene_file, run_scene
 from contactfx.discretize import elasticity
-from contactfx.discretize.thermal import plane_strain_szz, thermal_stress
+from contactfx.discretize.thermal import (
+    axisymmetric_thermal_load,
+    plane_strain_szz,
+    thermal_stress,
+)
 from contactfx.results.references import lame_pressure
 from contactfx.scenes import Model
 
@@ -127,3 +136,38 @@ def test_lame_formula_plane_strain_substitution() -> None:
     assert pe == pytest.approx(ps, rel=1e-14)
     solid = lame_pressure(0.0, 2.0, 3.0, 0.002, (E1, nu1), (E1, nu1), Model.PLANE_STRESS)
     assert solid == pytest.approx(E1 * 0.002 * (9 - 4) / (2 * 2 * 9), rel=1e-14)
+
+
+def test_axisymmetric_thermal_load_is_a_free_expansion() -> None:
+    """The axisymmetric thermal load (used once the axisymmetric elasticity is there) is
+    K u for the free expansion u = eps0 (r, z), whose strain is eps0 in rr, zz and the hoop:
+    K assembled here from the 3D law with 2 pi r dx (measured 2e-15)."""
+    msh = mesh.create_rectangle(
+        MPI.COMM_SELF, [[0.5, 0.0], [2.0, 1.0]], [6, 5], mesh.CellType.quadrilateral
+    )
+    V = fem.functionspace(msh, ("Lagrange", 1, (2,)))
+    Q = fem.functionspace(msh, ("DG", 0))
+    Ef, nuf, e0 = fem.Function(Q), fem.Function(Q), fem.Function(Q)
+    Ef.x.array[:], nuf.x.array[:], e0.x.array[:] = E, NU, ALPHA * DT
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    r = ufl.SpatialCoordinate(msh)[0]
+
+    def eps3(w: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        e = ufl.sym(ufl.grad(w))
+        return ufl.as_matrix([[e[0, 0], e[0, 1], 0], [e[1, 0], e[1, 1], 0], [0, 0, w[0] / r]])
+
+    lam, mu = Ef * nuf / ((1 + nuf) * (1 - 2 * nuf)), Ef / (2 * (1 + nuf))
+
+    def sig(e: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+        return 2 * mu * e + lam * ufl.tr(e) * ufl.Identity(3)
+
+    a = fem.form(ufl.inner(sig(eps3(u)), eps3(v)) * 2 * math.pi * r * ufl.dx)
+    K = dolfinx.fem.petsc.assemble_matrix(a)
+    K.assemble()
+    free = fem.Function(V)
+    free.interpolate(lambda x: np.vstack([ALPHA * DT * x[0], ALPHA * DT * x[1]]))
+    Ku = K.createVecLeft()
+    K.mult(free.x.petsc_vec, Ku)
+    form = fem.form(axisymmetric_thermal_load(msh, v, Ef, nuf, e0))
+    L = dolfinx.fem.petsc.assemble_vector(form)
+    assert np.max(np.abs(Ku.array - L.array)) < 1e-12 * np.max(np.abs(L.array))

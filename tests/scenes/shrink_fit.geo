@@ -3,8 +3,10 @@
 // Inner ring (the shaft): a <= r <= b + delta, drawn overlapping the outer ring (the hub):
 // b <= r <= c, by the radial interference delta; the scene file says interference = true,
 // so the drawn overlap is the fit. Symmetry supports: ux = 0 on x = 0, uy = 0 on y = 0.
-// All quads, structured (transfinite) in each ring; the two rings' arcs have different
-// node counts (non-matching interface).
+// All quads, structured (transfinite) in each ring, the same number of elements along both
+// quarter arcs: the nodes of the two arcs lie on the same rays, at radii b + delta and b.
+// (With different counts the chords of the two polygons sag by b dtheta^2 / 8, which must
+// stay far below delta: 6e-4 against delta = 2e-3 gave +8.6 % with 40 and 31 elements.)
 
 DefineConstant[
   a = {1, Name "Parameters/a inner radius of the shaft"},
