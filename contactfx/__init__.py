@@ -32,7 +32,10 @@ from .options import (
 )
 from .request import SchwarzOptions, SolveRequest
 from .scenes import (
+    ContactPair,
     HertzReference,
+    LameReference,
+    Material,
     Obstacle,
     Scene,
     UniformStress,
@@ -47,12 +50,15 @@ __all__ = [
     "ActiveSetError",
     "Basis",
     "ContactFxError",
+    "ContactPair",
     "ConvergenceError",
     "Discretization",
     "Enforcement",
     "GeometryError",
     "HertzReference",
     "InputError",
+    "LameReference",
+    "Material",
     "MeshError",
     "Method",
     "Obstacle",

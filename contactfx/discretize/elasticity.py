@@ -21,6 +21,7 @@ from petsc4py import PETSc
 
 from ..errors import MeshError
 from ..scenes import Model, Pressure, Scene
+from .thermal import thermal_load
 
 
 @dataclass(frozen=True)
@@ -210,7 +211,8 @@ def assemble_elasticity(scene: Scene) -> Elasticity:
     E, nu = material_fields(scene)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     a = fem.form(energy_form(u, v, E, nu, scene.model))
-    L = fem.form(load_form(scene, v))
+    thermal = thermal_load(scene, v, E, nu)
+    L = fem.form(load_form(scene, v) if thermal is None else load_form(scene, v) + thermal)
     bcs = dirichlet_conditions(scene, V)
 
     K = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs)

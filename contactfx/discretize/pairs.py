@@ -41,6 +41,7 @@ class PairData:
     first_row: int  # first row of this pair in the stacked operator
     obstacle: Obstacle | None = None
     motion: sp.csr_matrix | None = None
+    initial_overlap: float = 0.0  # max over the rows of -gap before the solve (>= 0)
 
     @property
     def label(self) -> str:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -11,7 +11,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..contact import ContactOperator, Kernel
-from ..errors import GeometryError, SingularSystemError
+from ..errors import GeometryError, InputError, SingularSystemError
 from ..options import Basis
 from ..scenes import Body, Model, Scene
 from ..timers import Timers
@@ -267,15 +267,13 @@ def prepare_contact(
         std = stack(all_pairs(gathered, obstacles, kernel, ndofs))[1]
         g_all = (std.gap[order] + shift[order]) / std.weights[order]
     h = contact_size(w_all, layout.x, scene.model)
-    for p in pairs:
-        rows = np.flatnonzero(layout.pair == p.index)
-        j = rows[int(np.argmin(g_all[rows]))]
-        if g_all[j] < -penetration_tol * h:
-            raise GeometryError(
-                f"{p.overlap_text}: initial penetration {-g_all[j]:.3e} at ("
-                f"{layout.x[j, 0]:.4g}, {layout.x[j, 1]:.4g}) exceeds the "
-                f"tolerance {penetration_tol * h:.1e}"
-            )
+    pairs = check_overlaps(pairs, layout, g_all, penetration_tol * h)
+    fit = np.concatenate(
+        [np.full(p.active.surface.n_nodes, p.pair.prescribed_overlap) for p in pairs]
+    )
+    if np.any(fit):
+        # interference = D: the gap g becomes g - D (weighted: g_w - D w).
+        op = ContactOperator(op.B, op.gap - fit * op.weights, op.weights)
     # Checked at their reference positions, the obstacles now take their prescribed motion.
     op = moved(op, pairs)
     hold = holding(scene, V, el.bc_dofs)
@@ -311,3 +309,44 @@ def contact_size(w: np.ndarray, x: np.ndarray, model: Model) -> float:
         if off.any():
             return float(np.median(w[off] / (2 * np.pi * x[off, 0])))
     return float(np.median(w))
+
+
+def check_overlaps(
+    pairs: list[PairData], layout: Multipliers, g_all: np.ndarray, tol: float
+) -> list[PairData]:
+    """The pairs with their initial overlaps, once the drawn gaps `g_all` are checked.
+
+    A pair drawn overlapping beyond `tol` is a GeometryError, unless it is an interference
+    fit drawn so (`interference = true`), which must overlap beyond `tol` (InputError if
+    not). The initial overlap is max(0, max -g) over the pair's rows before the solve, with
+    the prescribed overlap D of `interference = D` included.
+    """
+    out = []
+    for p in pairs:
+        rows = np.flatnonzero(layout.pair == p.index)
+        j = rows[int(np.argmin(g_all[rows]))]
+        drawn = -float(g_all[j])
+        if p.pair.interference is True:
+            if drawn <= tol:
+                raise InputError(
+                    f"contact pair {p.index} ({p.pair.active} on {p.pair.passive}) has "
+                    f"interference = true but its bodies do not overlap as drawn (largest "
+                    f"overlap {max(drawn, 0.0):.3e}, tolerance {tol:.1e}): draw the fit "
+                    "overlapping, or give interference = D (a number > 0) for bodies drawn "
+                    "touching"
+                )
+        elif drawn > tol:
+            raise GeometryError(
+                f"{p.overlap_text}: initial penetration {drawn:.3e} at ("
+                f"{layout.x[j, 0]:.4g}, {layout.x[j, 1]:.4g}) exceeds the "
+                f"tolerance {tol:.1e}"
+                + (
+                    " (interference = D prescribes an overlap of bodies drawn touching; "
+                    "for a fit drawn overlapping give interference = true)"
+                    if p.pair.prescribed_overlap
+                    else ""
+                )
+            )
+        overlap = max(0.0, drawn + p.pair.prescribed_overlap)
+        out.append(replace(p, initial_overlap=overlap))
+    return out

@@ -139,6 +139,11 @@ def solve_schwarz(scene: Scene, request: SolveRequest, timers: Timers | None = N
             f"{len(scene.bodies)} bodies and {len(scene.contacts)} pairs): use "
             "nts, sts or mortar"
         )
+    if any(p.interference is not False for p in scene.contacts):
+        raise InputError(
+            "schwarz does not take interference fits (interference on a [[contact]]): "
+            "use nts, sts, mortar or penalty"
+        )
     timers = timers or Timers()
     el, ndofs, gathered = assemble_and_gather(scene, timers)
     roles = _roles(scene, el, gathered)

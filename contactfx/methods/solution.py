@@ -55,6 +55,7 @@ class PairView:
     B: sp.csr_matrix
     obstacle: Obstacle | None = None
     motion: sp.csr_matrix | None = None
+    initial_overlap: float = 0.0  # max over the pair's rows of -gap before the solve
 
     @property
     def label(self) -> str:
@@ -197,6 +198,7 @@ def pair_views(
             B[order[rows]].tocsr(),
             p.obstacle,
             None if p.motion is None else p.motion[order[rows] - p.first_row].tocsr(),
+            p.initial_overlap,
         )
         out.append(view)
     return out

@@ -114,6 +114,7 @@ def contacts_summary(sol: Solution) -> tuple[ContactSummary, ...]:
                 active_nodes=int(sol.active[pv.rows].sum()),
                 interface=pair_interface(sol, k),
                 obstacle=pv.obstacle,
+                initial_overlap=pv.initial_overlap,
             )
         )
     return tuple(out)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..contact import Plane
 from ..scenes import Obstacle
-from ..scenes.model import OBSTACLE_SHAPES
+from ..scenes.obstacle import OBSTACLE_SHAPES
 
 
 def outline(ob: Obstacle, near: np.ndarray) -> np.ndarray:

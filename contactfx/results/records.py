@@ -40,6 +40,7 @@ class ContactSummary:
     # INTERFACE_FIELDS columns (None where not finite) and `active`, sorted by s.
     interface: dict[str, list[Any]]
     obstacle: Obstacle | None = None
+    initial_overlap: float = 0.0  # max over the pair's nodes of -gap before the solve
 
     def to_json(self) -> dict[str, Any]:
         """The pair's entry of the JSON's `contacts` list."""
@@ -53,6 +54,7 @@ class ContactSummary:
             "balance": self.balance,
             "multipliers": self.multipliers,
             "active_nodes": self.active_nodes,
+            "initial_overlap": self.initial_overlap,
             "interface": self.interface,
         }
         if self.obstacle is not None:
@@ -90,6 +92,35 @@ class HertzErrors:
             "P": self.P,
             "P_source": self.P_source,
             "l2_error": self.l2_error,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class LameErrors:
+    """One pair against Lame's shrink-fit pressure (docs/models.md, "Lame")."""
+
+    pair: int
+    model: str
+    inner: str  # the inner ring's body
+    outer: str
+    delta: float
+    p_mean: float  # the pair's mean contact pressure: sum p_j w_j / sum w_j
+    p_exact: float
+    error: float  # |p_mean / p_exact - 1|
+    active_fraction: float  # active rows / rows of the pair
+
+    def to_json(self) -> dict[str, Any]:
+        """One entry of the JSON's `lame` list."""
+        return {
+            "pair": self.pair,
+            "model": self.model,
+            "inner": self.inner,
+            "outer": self.outer,
+            "delta": self.delta,
+            "p_mean": self.p_mean,
+            "p_exact": self.p_exact,
+            "error": self.error,
+            "active_fraction": self.active_fraction,
         }
 
 
@@ -197,6 +228,7 @@ class RunSummary:
     hertz: tuple[HertzErrors, ...] = ()  # one per Hertz reference
     patch: PatchErrors | None = None
     estimate: EstimateSummary | None = None
+    lame: tuple[LameErrors, ...] = ()  # one per Lame reference
 
     @property
     def contact_force(self) -> float:
@@ -238,6 +270,8 @@ class RunSummary:
                 out["hertz_pairs"] = [h.to_json() for h in self.hertz]
         if self.patch is not None:
             out["patch"] = self.patch.to_json()
+        if self.lame:
+            out["lame"] = [r.to_json() for r in self.lame]
         out["solver"] = self.solver
         out["discretization"] = self.discretization.value
         out["enforcement"] = self.enforcement.value

@@ -1,4 +1,4 @@
-"""Analytic references: Hertz contact, and the patch test's uniform stress.
+"""Analytic references: Hertz contact, the patch test's uniform stress, Lame's shrink fit.
 
 Hertz is the plane line contact (a cylinder, force per unit thickness) in plane strain and
 plane stress (E* from the model's effective moduli: E/(1 - nu^2) in plane strain, E in plane
@@ -19,10 +19,11 @@ import math
 import numpy as np
 from mpi4py import MPI
 
+from ..errors import InputError
 from ..methods.solution import Solution
-from ..scenes import HertzReference, Material, Model, Scene, UniformStress
+from ..scenes import HertzReference, LameReference, Material, Model, Scene, UniformStress
 from .interface import pair_forces, pair_interface, resolve
-from .records import HertzErrors, PatchErrors
+from .records import HertzErrors, LameErrors, PatchErrors
 from .stress import body_vertex_stress
 
 
@@ -226,4 +227,76 @@ def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
         bodies=bodies,
         pairs=tuple(pairs),
         max=max([*bodies.values(), *(v for p in pairs for v in p.values())]),
+    )
+
+
+def lame_pressure(
+    a: float,
+    b: float,
+    c: float,
+    delta: float,
+    inner: tuple[float, float],
+    outer: tuple[float, float],
+    model: Model,
+) -> float:
+    """Lame's shrink-fit contact pressure of rings a..b (inner) and b..c (outer).
+
+    Plane stress (Shigley's Mechanical Engineering Design, sec. 3-16, "Press and Shrink
+    Fits"; Lame's thick cylinder, Timoshenko & Goodier, ch. 4):
+    p = delta / (b [(1/E_o)((c^2 + b^2)/(c^2 - b^2) + nu_o)
+                    + (1/E_i)((b^2 + a^2)/(b^2 - a^2) - nu_i)]),
+    `inner` and `outer` the (E, nu) of the rings; plane strain by E -> E/(1 - nu^2),
+    nu -> nu/(1 - nu).
+    """
+    if model is Model.AXISYMMETRIC:
+        raise InputError("lame reference: the shrink fit of rings is plane strain or plane stress")
+
+    def plane(E: float, nu: float) -> tuple[float, float]:
+        return (E / (1 - nu**2), nu / (1 - nu)) if model is Model.PLANE_STRAIN else (E, nu)
+
+    (Ei, nui), (Eo, nuo) = plane(*inner), plane(*outer)
+    compliance = ((c**2 + b**2) / (c**2 - b**2) + nuo) / Eo
+    compliance += ((b**2 + a**2) / (b**2 - a**2) - nui) / Ei
+    return delta / (b * compliance)
+
+
+def lame_summary(sol: Solution, ref: LameReference) -> LameErrors:
+    """The pair's mean contact pressure against Lame's (InputError if the pair is no fit)."""
+    scene = sol.scene
+    if ref.pair >= len(scene.contacts):
+        raise InputError(f"lame reference: pair {ref.pair} is not a [[contact]] pair")
+    pair = scene.contacts[ref.pair]
+    delta = ref.delta if ref.delta is not None else pair.prescribed_overlap
+    if not delta > 0:
+        raise InputError(
+            f"lame reference: give delta (pair {ref.pair} has no interference = D to take it from)"
+        )
+    pv = sol.pairs[ref.pair]
+    # The active surface's outward normal points away from the centre on the inner ring.
+    radial = float(np.mean(np.einsum("kd,kd->k", pv.n, pv.x - np.asarray(ref.center))))
+    assert pv.passive_body is not None  # a [[contact]] pair joins two bodies
+    inner, outer = (
+        (pv.active_body, pv.passive_body) if radial > 0 else (pv.passive_body, pv.active_body)
+    )
+    w = sol.layout.weights[pv.rows]
+    p_mean = float(np.sum(sol.pressure[pv.rows] * w) / np.sum(w))
+    exact = lame_pressure(
+        ref.a,
+        ref.b,
+        ref.c,
+        delta,
+        (inner.material.E, inner.material.nu),
+        (outer.material.E, outer.material.nu),
+        scene.model,
+    )
+    return LameErrors(
+        pair=ref.pair,
+        model=scene.model.value,
+        inner=inner.name,
+        outer=outer.name,
+        delta=delta,
+        p_mean=p_mean,
+        p_exact=exact,
+        error=abs(p_mean / exact - 1.0),
+        active_fraction=float(np.mean(sol.active[pv.rows])) if len(pv.rows) else 0.0,
     )

@@ -7,17 +7,27 @@ cells (every rank computes its own facets; the values are gathered).
 from __future__ import annotations
 
 import numpy as np
+import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
 from ..discretize.elasticity import sigma, sigma_zz
 from ..discretize.mesh_utils import owned_facets, vertex_coordinates, vertex_to_block
+from ..discretize.thermal import thermal_correction, thermal_zz
 from ..methods.solution import Solution
 from ..scenes import Model
 
 REF_VERTICES = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
 
 NodalStress = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def stress_of(sol: Solution) -> ufl.core.expr.Expr:
+    """The physical stress of the solution: C eps(u), less a thermal strain's sigma0."""
+    el = sol.fields
+    thermal = thermal_correction(sol.scene, el.E, el.nu)
+    elastic = sigma(sol.u, el.E, el.nu, sol.scene.model)
+    return elastic if thermal is None else elastic - thermal
 
 
 def nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -33,7 +43,7 @@ def _nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np
     msh = scene.mesh
     tdim = msh.topology.dim
     el = sol.fields
-    expr = fem.Expression(sigma(sol.u, el.E, el.nu, sol.scene.model), REF_VERTICES)
+    expr = fem.Expression(stress_of(sol), REF_VERTICES)
     facets = owned_facets(scene, group)
     msh.topology.create_connectivity(tdim - 1, tdim)
     msh.topology.create_connectivity(tdim - 1, 0)
@@ -80,9 +90,7 @@ def sigma_field(sol: Solution) -> fem.Function:
     msh = sol.scene.mesh
     Q = fem.functionspace(msh, ("DG", 0, (2, 2)))
     s = fem.Function(Q, name="sigma")
-    el = sol.fields
-    expr = sigma(sol.u, el.E, el.nu, sol.scene.model)
-    s.interpolate(fem.Expression(expr, Q.element.interpolation_points))
+    s.interpolate(fem.Expression(stress_of(sol), Q.element.interpolation_points))
     return s
 
 
@@ -98,6 +106,9 @@ def sigma_zz_field(sol: Solution) -> fem.Function:
     if sol.scene.model is Model.PLANE_STRESS:
         return s  # zero (a constant expression has no mesh to interpolate on)
     expr = sigma_zz(sol.u, el.E, el.nu, sol.scene.model)
+    thermal = thermal_zz(sol.scene, el.E, el.nu)
+    if thermal is not None:
+        expr = expr - thermal
     s.interpolate(fem.Expression(expr, Q.element.interpolation_points))
     return s
 
@@ -106,8 +117,7 @@ def body_vertex_stress(sol: Solution) -> dict[str, np.ndarray]:
     """The stress sigma (k, 2, 2) at every owned cell vertex of each body."""
     scene = sol.scene
     msh = scene.mesh
-    el = sol.fields
-    expr = fem.Expression(sigma(sol.u, el.E, el.nu, sol.scene.model), REF_VERTICES)
+    expr = fem.Expression(stress_of(sol), REF_VERTICES)
     nloc = msh.topology.index_map(msh.topology.dim).size_local
     out = {}
     for body in scene.bodies:

@@ -9,22 +9,24 @@ from __future__ import annotations
 from ..methods.solution import Solution
 from ..options import Method, SolverSpec
 from ..request import SolveRequest
-from ..scenes import HertzReference, UniformStress
+from ..scenes import HertzReference, LameReference, UniformStress
 from .interface import cartesian_interface, contacts_summary
 from .records import (
     ContactSummary,
     EstimateSummary,
     HertzErrors,
+    LameErrors,
     MethodExtras,
     PatchErrors,
     RunSummary,
 )
-from .references import hertz_summary, uniform_stress_errors
+from .references import hertz_summary, lame_summary, uniform_stress_errors
 
 __all__ = [
     "ContactSummary",
     "EstimateSummary",
     "HertzErrors",
+    "LameErrors",
     "MethodExtras",
     "PatchErrors",
     "RunSummary",
@@ -105,4 +107,5 @@ def summary(
         hertz=tuple(hertz_summary(sol, r) for r in refs if isinstance(r, HertzReference)),
         # The last uniform stress wins, as one `patch` block holds one.
         patch=patch[-1] if patch else None,
+        lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
     )

@@ -12,7 +12,7 @@ import numpy as np
 from mpi4py import MPI
 
 from ..errors import InputError, MeshError
-from .model import Body, Model, Scene
+from .model import Body, LameReference, Model, Scene
 
 
 def _global_count(scene: Scene, local: int) -> int:
@@ -107,6 +107,20 @@ def _check_obstacles(scene: Scene, known: dict[str, str]) -> dict[str, str]:
     return found
 
 
+def _check_lame(scene: Scene, ref: LameReference) -> None:
+    if not 0 <= ref.pair < len(scene.contacts):
+        raise InputError(
+            f"lame reference: pair {ref.pair} is not one of the {len(scene.contacts)} "
+            "[[contact]] pairs (a shrink fit joins two bodies)"
+        )
+    if ref.delta is None and not scene.contacts[ref.pair].prescribed_overlap:
+        raise InputError(
+            f"lame reference: give delta (pair {ref.pair} has no interference = D to take it from)"
+        )
+    if scene.model is Model.AXISYMMETRIC:
+        raise InputError("lame reference: the shrink fit of rings is plane strain or plane stress")
+
+
 def _check_conditions(scene: Scene) -> None:
     for bc in scene.dirichlet:
         if bc.group not in scene.groups.by_name:
@@ -126,6 +140,8 @@ def _check_conditions(scene: Scene) -> None:
             raise InputError(f"load on '{load.group}': values must be finite")
     for ref in scene.references:
         pair = getattr(ref, "pair", 0)
+        if isinstance(ref, LameReference):
+            _check_lame(scene, ref)
         if not 0 <= pair < len(scene.contacts) + len(scene.obstacles):
             raise InputError(
                 f"reference: pair {pair} does not exist (the scene has "

@@ -22,9 +22,9 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import ContactFxError, InputError, MeshError, error_type
-from ..meshes import QUAD4
 from ..meshes.size_field import apply_size_view, restore_options
 from .checks import check_scene
+from .gmsh_checks import check_quadrilaterals, check_separate_bodies
 from .model import (
     Body,
     ContactPair,
@@ -39,14 +39,6 @@ from .model import (
     SizeField,
     Units,
 )
-
-# The other 2D element types of gmsh, named for the error message.
-_GMSH_2D_NAMES = {
-    2: "3-node triangles",
-    9: "6-node triangles",
-    10: "9-node quadrangles",
-    16: "8-node quadrangles",
-}
 
 
 def _gmsh_node_coordinates() -> np.ndarray:
@@ -91,47 +83,6 @@ def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[...,
         return adjacencylist(dest)._cpp_object
 
     return partition
-
-
-def check_quadrilaterals() -> None:
-    """Raise MeshError unless the current gmsh model's 2D elements are all 4-node quads."""
-    types, tags, _ = gmsh.model.mesh.getElements(2)
-    if not len(types):
-        raise MeshError("the gmsh model has no 2D elements (mesh it in 2D, or give a .geo)")
-    other = [(int(t), len(e)) for t, e in zip(types, tags, strict=True) if t != QUAD4]
-    if other:
-        what = ", ".join(f"{n} {_GMSH_2D_NAMES.get(t, f'type-{t} elements')}" for t, n in other)
-        raise MeshError(
-            f"contactfx needs an all-quadrilateral mesh (Q1 only), the mesh has "
-            f"{what}: recombine it (Mesh.RecombineAll = 1, Mesh.Algorithm = 8)"
-        )
-
-
-def check_separate_bodies() -> None:
-    """Raise MeshError if two physical surface groups (bodies) share mesh nodes.
-
-    Contact needs the interface nodes duplicated: a single conforming mesh (shared points or
-    curves, BooleanFragments, Coherence, or gmsh's automatic coherence after a geometry
-    transformation such as Rotate) glues the bodies together where they touch.
-    """
-    groups = gmsh.model.getPhysicalGroups(2)
-    nodes = [gmsh.model.mesh.getNodesForPhysicalGroup(d, t)[0].astype(np.int64) for d, t in groups]
-    top = max((int(n.max()) for n in nodes if n.size), default=0)
-    owner = np.full(top + 1, -1, dtype=np.int64)
-    for k, tags in enumerate(nodes):
-        shared = tags[owner[tags] >= 0]
-        if shared.size:
-            names = [gmsh.model.getPhysicalName(*g) or f"surface group {g[1]}" for g in groups]
-            x = gmsh.model.mesh.getNode(int(shared[0]))[0]
-            raise MeshError(
-                f"bodies '{names[owner[shared[0]]]}' and '{names[k]}' share {shared.size} mesh "
-                f"node{'s' * (shared.size > 1)} (e.g. at ({x[0]:.4g}, {x[1]:.4g})): a single "
-                "conforming mesh glues them together; contact needs each body built from its "
-                "own points and curves, so that the interface nodes are duplicated (no shared "
-                "points or curves, no BooleanFragments or Coherence; in a .geo with Rotate, "
-                "Translate or other transformations set Geometry.AutoCoherence = 0)"
-            )
-        owner[tags] = k
 
 
 def _run_on_root(
@@ -343,6 +294,16 @@ def scene_from_gmsh(
     return check_scene(scene)
 
 
+def _material(name: str, values: Mapping[str, float]) -> Material:
+    """A Material from {"E": ..., "nu": ...} (and "alpha", "dT"); InputError on other keys."""
+    unknown = sorted(set(values) - {"E", "nu", "alpha", "dT"})
+    if unknown or not {"E", "nu"} <= set(values):
+        what = f"unknown key '{unknown[0]}'" if unknown else "E and nu are required"
+        raise InputError(f"body '{name}': {what} (keys: E, nu, alpha, dT)")
+    thermal = {k: float(values[k]) for k in ("alpha", "dT") if k in values}
+    return Material(float(values["E"]), float(values["nu"]), **thermal)
+
+
 def from_gmsh(
     model_or_path: Any,
     *,
@@ -361,8 +322,10 @@ def from_gmsh(
     Args:
         model_or_path: A .msh or .geo path, or anything else for gmsh's current model
             (meshed in 2D here if it has no 2D elements yet).
-        bodies: Material (or {"E": ..., "nu": ...}) per physical surface group.
-        contacts: (active, passive) curve groups of every contact pair.
+        bodies: Material (or {"E": ..., "nu": ...}, with "alpha" and "dT" for a thermal
+            strain) per physical surface group.
+        contacts: (active, passive) curve groups of every contact pair, or ContactPairs
+            (with `interference` for a fit).
         dirichlet: Prescribed displacement components on curve or point groups.
         loads: Pressures and tractions on curve groups.
         references: Analytic references (HertzReference, UniformStress) to report.
@@ -374,10 +337,7 @@ def from_gmsh(
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
     """
-    mats = {
-        k: v if isinstance(v, Material) else Material(float(v["E"]), float(v["nu"]))
-        for k, v in bodies.items()
-    }
+    mats = {k: v if isinstance(v, Material) else _material(k, v) for k, v in bodies.items()}
     label = name or (
         Path(model_or_path).stem if isinstance(model_or_path, str | Path) else "gmsh-model"
     )

@@ -10,7 +10,6 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
-from functools import cached_property
 from typing import Any, Protocol
 
 import dolfinx
@@ -18,8 +17,9 @@ import numpy as np
 from dolfinx.io.gmsh import PhysicalGroup
 from mpi4py import MPI
 
-from ..contact.rigid import Circle, Plane, Polyline, RigidShape
 from ..errors import InputError, MeshError
+from .fits import LameReference, check_interference, check_thermal
+from .obstacle import Obstacle
 
 
 class Model(StrEnum):
@@ -55,17 +55,29 @@ class Units:
 
 @dataclass(frozen=True)
 class Material:
-    """Isotropic linear elasticity: Young's modulus and Poisson ratio."""
+    """Isotropic linear elasticity: Young's modulus and Poisson ratio.
+
+    `alpha` (thermal expansion coefficient) and `dT` (a uniform temperature change) give the
+    body the eigenstrain alpha dT I (discretize/thermal.py); both or neither.
+    """
 
     E: float
     nu: float
+    alpha: float | None = None
+    dT: float | None = None
+
+    @property
+    def thermal_strain(self) -> float:
+        """The eigenstrain alpha dT (0 without a thermal load)."""
+        return 0.0 if self.alpha is None or self.dT is None else self.alpha * self.dT
 
     def check(self, where: str) -> None:
-        """Raise InputError unless E > 0 and -1 < nu < 0.5 (finite)."""
+        """Raise InputError unless E > 0, -1 < nu < 0.5, and alpha and dT come together."""
         if not (math.isfinite(self.E) and self.E > 0):
             raise InputError(f"{where}: Young's modulus must be > 0 (got E = {self.E})")
         if not (math.isfinite(self.nu) and -1.0 < self.nu < 0.5):
             raise InputError(f"{where}: Poisson ratio must lie in (-1, 0.5) (got nu = {self.nu})")
+        check_thermal(self.alpha, self.dT, where)
 
 
 @dataclass(frozen=True)
@@ -78,85 +90,27 @@ class Body:
 
 @dataclass(frozen=True)
 class ContactPair:
-    """One contact pair: curve groups on the active (slave) and the passive (master) body."""
+    """One contact pair: curve groups on the active (slave) and the passive (master) body.
+
+    `interference`: False (the default) for bodies that must not overlap as drawn; True for
+    an interference fit drawn overlapping (the overlap is the fit, the solve resolves it);
+    a number D > 0 for bodies drawn touching, with the overlap D prescribed along the normal
+    (the gap g becomes g - D).
+    """
 
     active: str
     passive: str
-
-
-# The parameters each obstacle shape takes (besides name, shape, surface and displacement).
-OBSTACLE_SHAPES: dict[str, tuple[str, ...]] = {
-    "circle": ("center", "radius"),
-    "plane": ("point", "normal"),
-    "polyline": ("points",),
-}
-
-
-@dataclass(frozen=True)
-class Obstacle:
-    """A rigid obstacle: an analytic curve that the body's curve group `surface` may touch.
-
-    `shape` "circle" (`center`, `radius`; the body outside), "plane" (`point`, `normal` from
-    the obstacle towards the body) or "polyline" (`points` in order, the obstacle on the left,
-    the body on the right; closed if the last point repeats the first). `displacement` is the
-    obstacle's prescribed rigid motion. InputError at once for a bad shape or parameter.
-    """
-
-    name: str
-    shape: str
-    surface: str
-    center: tuple[float, float] | None = None
-    radius: float | None = None
-    point: tuple[float, float] | None = None
-    normal: tuple[float, float] | None = None
-    points: tuple[tuple[float, float], ...] | None = None
-    displacement: tuple[float, float] = (0.0, 0.0)
+    interference: bool | float = False
 
     def __post_init__(self) -> None:
-        where = f"obstacle '{self.name}'"
-        if not isinstance(self.name, str) or not self.name:
-            raise InputError("obstacle: name must be a non-empty string")
-        if self.shape not in OBSTACLE_SHAPES:
-            raise InputError(
-                f"{where}: unknown shape {self.shape!r} (choose {', '.join(OBSTACLE_SHAPES)})"
-            )
-        takes = OBSTACLE_SHAPES[self.shape]
-        for key in ("center", "radius", "point", "normal", "points"):
-            given = getattr(self, key) is not None
-            if given != (key in takes):
-                need = " and ".join(takes)
-                raise InputError(
-                    f"{where}: a {self.shape} takes {need}"
-                    + (f", not {key}" if given else f" (missing {key})")
-                )
-        try:
-            # Plain numbers in tuples: the obstacle stays hashable and prints as given.
-            for key in ("center", "point", "normal", "displacement"):
-                value = getattr(self, key)
-                if value is not None:
-                    object.__setattr__(self, key, tuple(float(v) for v in value))
-            if self.points is not None:
-                points = tuple(tuple(float(v) for v in p) for p in self.points)
-                object.__setattr__(self, "points", points)
-            if self.radius is not None:
-                object.__setattr__(self, "radius", float(self.radius))
-            if len(self.displacement) != 2 or not all(map(math.isfinite, self.displacement)):
-                raise ValueError("displacement must be two finite numbers [ux, uy]")
-            self.geometry  # noqa: B018  (builds and checks the shape once)
-        except (ValueError, TypeError) as exc:
-            raise InputError(f"{where}: {exc}") from None
+        where = f"contact '{self.active}' on '{self.passive}'"
+        object.__setattr__(self, "interference", check_interference(self.interference, where))
 
-    @cached_property
-    def geometry(self) -> RigidShape:
-        """The exact shape (contact.rigid) at the obstacle's reference position."""
-        if self.shape == "circle":
-            assert self.center is not None and self.radius is not None  # checked above
-            return Circle(self.center, self.radius)
-        if self.shape == "plane":
-            assert self.point is not None and self.normal is not None
-            return Plane(self.point, self.normal)
-        assert self.points is not None
-        return Polyline(self.points)
+    @property
+    def prescribed_overlap(self) -> float:
+        """D of `interference = D` (0 for true or false: the gap is the drawn one)."""
+        d = self.interference
+        return 0.0 if isinstance(d, bool) else d
 
 
 @dataclass(frozen=True)
@@ -218,7 +172,7 @@ class UniformStress:
     sigma: tuple[tuple[float, float], tuple[float, float]]
 
 
-Reference = HertzReference | UniformStress
+Reference = HertzReference | UniformStress | LameReference
 
 
 @dataclass(frozen=True)

@@ -16,10 +16,10 @@ from mpi4py import MPI
 from ..errors import InputError
 from .gmsh_io import SceneParts, scene_from_gmsh
 from .model import (
-    OBSTACLE_SHAPES,
     ContactPair,
     Dirichlet,
     HertzReference,
+    LameReference,
     Load,
     Material,
     Model,
@@ -31,6 +31,7 @@ from .model import (
     UniformStress,
     Units,
 )
+from .obstacle import OBSTACLE_SHAPES
 
 TOP_KEYS = {
     "mesh",
@@ -46,13 +47,14 @@ TOP_KEYS = {
     "reference",
 }
 SECTION_KEYS = {
-    "bodies": {"E", "nu"},
-    "contact": {"active", "passive"},
+    "bodies": {"E", "nu", "alpha", "dT"},
+    "contact": {"active", "passive", "interference"},
     "dirichlet": {"group", "ux", "uy"},
     "pressure": {"group", "p"},
     "traction": {"group", "t"},
     "reference.hertz": {"type", "pair", "R", "P", "symmetric"},
     "reference.uniform_stress": {"type", "sigma"},
+    "reference.lame": {"type", "pair", "a", "b", "c", "delta", "center"},
     "obstacle": {"name", "shape", "surface", "displacement"},
 }
 
@@ -126,11 +128,46 @@ def _obstacle(k: int, entry: Any) -> Obstacle:
     return Obstacle(name, shape, _string(f"{where}.surface", e["surface"]), **values)
 
 
+def _lame(where: str, entry: Any) -> LameReference:
+    e = _keys(where, entry, SECTION_KEYS["reference.lame"], {"type", "a", "b", "c"})
+    pair = e.get("pair", 0)
+    if isinstance(pair, bool) or not isinstance(pair, int):
+        raise InputError(f"{where}: pair must be an integer index into [[contact]]")
+    radii = [_number(f"{where}.{key}", e[key]) for key in ("a", "b", "c")]
+    delta = _number(f"{where}.delta", e["delta"]) if "delta" in e else None
+    center = _vector(f"{where}.center", e["center"]) if "center" in e else (0.0, 0.0)
+    a, b, c = radii
+    return LameReference(a, b, c, delta=delta, pair=pair, center=center)
+
+
+def _interference(where: str, value: Any) -> bool | float:
+    if isinstance(value, bool):
+        return value
+    d = _number(where, value)
+    if d <= 0:
+        raise InputError(f"{where}: must be true, false or a number > 0 (got {value!r})")
+    return d
+
+
+def _material(body: str, table: Any) -> Material:
+    e = _keys(f"bodies.{body}", table, SECTION_KEYS["bodies"], {"E", "nu"})
+    thermal = {k: _number(f"bodies.{body}.{k}", e[k]) for k in ("alpha", "dT") if k in e}
+    mat = Material(
+        _number(f"bodies.{body}.E", e["E"]), _number(f"bodies.{body}.nu", e["nu"]), **thermal
+    )
+    mat.check(f"bodies.{body}")
+    return mat
+
+
 def _reference(k: int, entry: Any) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
-    if kind not in ("hertz", "uniform_stress"):
-        raise InputError(f"reference {k}: type must be 'hertz' or 'uniform_stress' (got {kind!r})")
+    if kind not in ("hertz", "uniform_stress", "lame"):
+        raise InputError(
+            f"reference {k}: type must be 'hertz', 'uniform_stress' or 'lame' (got {kind!r})"
+        )
     where = f"reference {k} ({kind})"
+    if kind == "lame":
+        return _lame(where, entry)
     if kind == "hertz":
         e = _keys(where, entry, SECTION_KEYS["reference.hertz"], {"type", "R"})
         pair = e.get("pair", 0)
@@ -187,17 +224,16 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         raise InputError("bodies: expected [bodies.NAME] tables with E and nu")
     bodies = {}
     for body, table in doc["bodies"].items():
-        e = _keys(f"bodies.{body}", table, SECTION_KEYS["bodies"], {"E", "nu"})
-        mat = Material(_number(f"bodies.{body}.E", e["E"]), _number(f"bodies.{body}.nu", e["nu"]))
-        mat.check(f"bodies.{body}")
-        bodies[body] = mat
+        bodies[body] = _material(body, table)
     pairs = []
     for k, entry in enumerate(_entries(doc, "contact")):
         e = _keys(f"contact {k}", entry, SECTION_KEYS["contact"], {"active", "passive"})
+        fit = _interference(f"contact {k}.interference", e.get("interference", False))
         pairs.append(
             ContactPair(
                 _string(f"contact {k}.active", e["active"]),
                 _string(f"contact {k}.passive", e["passive"]),
+                fit,
             )
         )
     bcs = []
