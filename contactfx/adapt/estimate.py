@@ -32,11 +32,13 @@ from dolfinx import fem, la, mesh
 from mpi4py import MPI
 
 from ..contact.geometry import nodal_normals, project
-from ..discretize.elasticity import sigma
+from ..discretize.elasticity import energy_form, measure, radius, sigma_zz
 from ..discretize.mesh_utils import vertex_to_block
+from ..discretize.thermal import thermal_zz
 from ..methods.solution import Solution
 from ..results.records import EstimateSummary
-from ..scenes import Pressure
+from ..results.stress import stress_of
+from ..scenes import Model, Pressure
 from .facet_jumps import JUMP_DEGREE, FacetTraction, process_boundary_jumps, two_cell_facets
 from .pressure_estimate import PressureEstimate, pressure_estimate
 
@@ -215,6 +217,26 @@ def _boundary_tags(sol: Solution) -> tuple[mesh.MeshTags, list[tuple[int, Any, A
     return mt, classes, contact_tags
 
 
+def equilibrium_residual(sol: Solution, sig: Any) -> Any:
+    """Div sigma of the in-plane stress `sig`; in axisymmetric the cylindrical divergence.
+
+    Axisymmetric (x = r): (d_r s_rr + d_z s_rz + (s_rr - s_tt) / r, d_r s_rz + d_z s_zz + s_rz / r),
+    s_tt the hoop stress (a thermal strain's own part taken off, as in `sig`).
+    """
+    div = ufl.div(sig)
+    if sol.scene.model is not Model.AXISYMMETRIC:
+        return div
+    el = sol.fields
+    hoop = sigma_zz(sol.u, el.E, el.nu, Model.AXISYMMETRIC)
+    thermal = thermal_zz(sol.scene, el.E, el.nu)
+    if thermal is not None:
+        hoop = hoop - thermal
+    r = radius(sol.scene.mesh)
+    # Off the axis only: at r = 0 the terms are 0/0 (their limits are the gradients'); the
+    # quadrature points of a cell never lie on the axis.
+    return div + ufl.as_vector([(sig[0, 0] - hoop) / r, sig[0, 1] / r])
+
+
 def estimate(sol: Solution) -> Estimate:
     """The residual estimate of a multiplier-method (or penalty) solution (collective)."""
     scene = sol.scene
@@ -226,8 +248,11 @@ def estimate(sol: Solution) -> Estimate:
     hK = ufl.CellDiameter(msh)
     # A Q1 facet is straight and its reference edge has length 1: |J_f| is its length.
     he: Any = abs(ufl.geometry.FacetJacobianDeterminant(msh))
-    sig = sigma(u, E, nu)
+    sig = stress_of(sol)
     tn = ufl.dot(sig, n)
+    # Every integral of the model: 2 pi r in axisymmetric (a revolved body), else 1.
+    m = measure(msh, scene.model)
+    res = equilibrium_residual(sol, sig)
     mt, classes, contact_tags = _boundary_tags(sol)
     ds = ufl.Measure("ds", domain=msh, subdomain_data=mt)
     cf = _ContactFields(sol)
@@ -235,11 +260,12 @@ def estimate(sol: Solution) -> Estimate:
     N = ufl.as_vector([cf.N[0], cf.N[1]])
     N = N / ufl.sqrt(ufl.dot(N, N) + 1e-300)
     forms: dict[str, Any] = {
-        "element": hK**2 * ufl.inner(ufl.div(sig), ufl.div(sig)) / E * w * ufl.dx,
+        "element": hK**2 * ufl.inner(res, res) / E * m * w * ufl.dx,
         "jump": 0.5
         * ufl.avg(he)
         * ufl.inner(ufl.jump(sig, n), ufl.jump(sig, n))
         / ufl.avg(E)
+        * (ufl.avg(m) if scene.model is Model.AXISYMMETRIC else 1.0)
         * (w("+") + w("-"))
         * ufl.dS(
             1, subdomain_data=two_cell_facets(msh), metadata={"quadrature_degree": JUMP_DEGREE}
@@ -254,18 +280,18 @@ def estimate(sol: Solution) -> Estimate:
         else:
             t = ufl.as_vector(list(load.t))
         r = tn - t
-        neumann += he * (mx * r[0] ** 2 + my * r[1] ** 2) / E * w * ds(tag)
+        neumann += he * (mx * r[0] ** 2 + my * r[1] ** 2) / E * m * w * ds(tag)
     forms["neumann"] = neumann
     dsc = ds(tuple(contact_tags)) if contact_tags else ds(_CONTACT_TAG0)
     tnn = ufl.dot(tn, N)
     tt = tn - tnn * N
-    forms["normal"] = he * (tnn + cf.p) ** 2 / E * w * dsc
-    forms["tangential"] = he * ufl.dot(tt, tt) / E * w * dsc
+    forms["normal"] = he * (tnn + cf.p) ** 2 / E * m * w * dsc
+    forms["tangential"] = he * ufl.dot(tt, tt) / E * m * w * dsc
     # The interpolants' product, not the nodal one: p_h g_h^+ vanishes at every node of a
     # converged set but not in the cell across the zone's edge, where p_h falls from its
     # last active node and g_h rises to its first inactive one.
-    forms["complementarity"] = cf.p * ufl.max_value(cf.g, 0.0) * w * dsc
-    forms["gap"] = E * cf.pen / he * w * dsc
+    forms["complementarity"] = cf.p * ufl.max_value(cf.g, 0.0) * m * w * dsc
+    forms["gap"] = E * cf.pen / he * m * w * dsc
     nloc = msh.topology.index_map(msh.topology.dim).size_local
     cell_dof = Q.dofmap.list[:nloc, 0]
     total, contact = np.zeros(nloc), np.zeros(nloc)
@@ -284,6 +310,7 @@ def estimate(sol: Solution) -> Estimate:
     eta = fem.Function(Q, name="eta")
     eta.x.array[cell_dof] = np.sqrt(total)
     eta.x.scatter_forward()
-    energy_form = fem.form(ufl.inner(sig, ufl.sym(ufl.grad(u))) * ufl.dx)
-    energy = float(np.sqrt(msh.comm.allreduce(fem.assemble_scalar(energy_form), op=MPI.SUM)))
+    # ||u_h||_E^2 = a(u_h, u_h), the model's own bilinear form.
+    a_uu = fem.form(energy_form(u, u, E, nu, scene.model))
+    energy = float(np.sqrt(msh.comm.allreduce(fem.assemble_scalar(a_uu), op=MPI.SUM)))
     return Estimate(eta, terms, energy, contact, pressure_estimate(sol))

@@ -15,8 +15,9 @@ import numpy as np
 import ufl
 from dolfinx import fem, la, mesh
 
-from ..discretize.elasticity import sigma
+from ..discretize.elasticity import measure
 from ..methods.solution import Solution
+from ..results.stress import stress_of
 
 # The jumps' quadrature degree: UFL's own estimate for the integrand (so the serial numbers
 # are those of the estimated rule), fixed because the facets on process boundaries are
@@ -47,8 +48,11 @@ class FacetTraction:
         ends = _QUAD_VERTICES[_QUAD_FACETS]  # (4 facets, 2 ends, 2)
         X = ends[:, :1] + s[None, :, None] * (ends[:, 1:] - ends[:, :1])
         self.nq = len(s)
-        sig = sigma(sol.u, sol.fields.E, sol.fields.nu)
-        values = ufl.as_vector([sig[0, 0], sig[0, 1], sig[1, 0], sig[1, 1], sol.fields.E])
+        sig = stress_of(sol)
+        # The model's measure (2 pi r in axisymmetric) at the points: the tractions carry its
+        # square root, so that |[sigma n]|^2 is weighted as the dS form weights it.
+        m = measure(msh, sol.scene.model)
+        values = ufl.as_vector([sig[0, 0], sig[0, 1], sig[1, 0], sig[1, 1], sol.fields.E, m])
         self.expr = fem.Expression(values, X.reshape(-1, 2))
 
     def __call__(
@@ -57,8 +61,8 @@ class FacetTraction:
         """Tractions (n, nq, 2), E (n,) and lengths (n,) of facet `local_facets` of each cell."""
         msh, nq = self.msh, self.nq
         n = len(cells)
-        vals = self.expr.eval(msh, cells.astype(np.int32)).reshape(n, 4, nq, 5)
-        vals = vals[np.arange(n), local_facets]  # (n, nq, 5)
+        vals = self.expr.eval(msh, cells.astype(np.int32)).reshape(n, 4, nq, 6)
+        vals = vals[np.arange(n), local_facets]  # (n, nq, 6)
         msh.topology.create_connectivity(2, 0)
         c2v = msh.topology.connectivity(2, 0).array.reshape(-1, 4)[cells]
         x = msh.geometry.x[msh.geometry.dofmaps[0][cells], :2]  # Q1: nodes are the vertices
@@ -71,7 +75,7 @@ class FacetTraction:
         outward = np.einsum("ij,ij->i", normal, 0.5 * (xa + xb) - x.mean(axis=1))
         normal[outward < 0] *= -1.0
         sig = vals[:, :, :4].reshape(n, nq, 2, 2)
-        trac = np.einsum("nqij,nj->nqi", sig, normal)
+        trac = np.einsum("nqij,nj->nqi", sig, normal) * np.sqrt(vals[:, :, 5:6])
         gv = msh.topology.index_map(0).local_to_global(c2v[rows, ab].ravel().astype(np.int32))
         flip = gv.reshape(n, 2)[:, 0] > gv.reshape(n, 2)[:, 1]
         trac[flip] = trac[flip, ::-1]
