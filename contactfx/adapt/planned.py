@@ -42,6 +42,7 @@ BUDGET_FILL = 0.9  # gmsh meets a size field only within ~10 %
 PRESSURE_AIM = 0.5  # the pressure indicator sized for half the error wanted (docs/adapt.md)
 ENERGY_REFINED = 4.0  # the energy goal's refined solve has ~4-5.5 x the level's DOFs
 AIM_FLOOR = 0.1  # but not below this fraction of the level's own estimate
+OVERSHOOT = 1.15  # a remeshed level with more DOFs than this x planned is planned again
 NO_TOL = 1e-12  # the residual sizing's own tolerance: the planned budget decides
 
 
@@ -154,18 +155,20 @@ def adapt_to_goal(
             break
         s = observed_slope(history, goal)
         aim = PRESSURE_AIM * max(opts.tol, rec.relative * AIM_FLOOR)
-        ratio = level.dofs / max(level.summary.elements, 1)
         cells = g * level.summary.elements
         t0 = time.perf_counter()
         nxt = scene.remeshed_to(_plan(level, goal, opts.rule, cells, aim).field)
         dofs = count_dofs(nxt)
+        target = min(g * level.dofs, BUDGET_FILL * opts.max_dofs)
         for _ in range(REPLANS):
-            if dofs <= opts.max_dofs:
+            if dofs <= opts.max_dofs and dofs <= OVERSHOOT * target:
                 break
-            # gmsh made more than the budget: plan again for what fits, rather than stop.
-            shrink = BUDGET_FILL * opts.max_dofs / dofs
-            cells *= 0.95 * shrink
-            aim /= 0.95 * shrink
+            # gmsh made more than planned (vertex sizes are the smallest of the cells
+            # around: x 1.4 on the coarse levels) or than the budget: plan again for the
+            # growth planned, rather than stop or take a level off the plan.
+            cells *= target / dofs
+            if dofs > opts.max_dofs:
+                aim *= dofs / target
             nxt = scene.remeshed_to(_plan(level, goal, opts.rule, cells, aim).field)
             dofs = count_dofs(nxt)
         mesh_time = time.perf_counter() - t0
@@ -174,7 +177,7 @@ def adapt_to_goal(
             break
         say(
             f"  remeshed: {dofs} DOFs (x {dofs / level.dofs:.2f}; planned x {g:.2f} from the "
-            f"observed rate N^{s:.2f}, {ratio * cells:.0f} DOFs; {mesh_time:.2f} s)"
+            f"observed rate N^{s:.2f}; {mesh_time:.2f} s)"
         )
         scene = nxt
     say(f"stopped: {stop}")
