@@ -226,8 +226,9 @@ def _solve_parser(sub: Any) -> None:
 def _adapt_parser(sub: Any) -> None:
     s = sub.add_parser(
         "adapt",
-        help="adaptive meshing: solve, estimate, remesh with gmsh until the estimate is small",
-        description="Adapt the mesh of one scene: each level solves, estimates the error "
+        help="adaptive meshing: solve, estimate, remesh with gmsh until --tol is met",
+        description="Adapt the mesh of one scene until the relative error of --goal is "
+        "estimated to be at most --tol (docs/adapt.md). Each level solves, estimates the error "
         "(residual estimator, docs/adapt.md), sizes the next mesh from the indicators and "
         "remeshes the geometry with gmsh. Stops at --tol, --max-levels, or when the next "
         "mesh would exceed --max-dofs. Writes adapt.json, mesh.msh, fields.pvtu (with the "
@@ -241,6 +242,12 @@ def _adapt_parser(sub: Any) -> None:
         default=Method.MORTAR.value,
         choices=[v.value for v in Method if v is not Method.SCHWARZ],
         help="contact discretization (default mortar; penalty: mortar with penalty)",
+    )
+    m.add_argument(
+        "--basis",
+        choices=[b.value for b in Basis],
+        default=Basis.STANDARD.value,
+        help="mortar multiplier basis: standard (N_j) or dual (biorthogonal)",
     )
     m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
     _solver_options(s)
