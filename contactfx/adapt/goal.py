@@ -25,10 +25,11 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..api import solve
+from ..api import solve, solve_request
 from ..errors import InputError
 from ..methods.solution import PairView, Solution
 from ..options import SolverSpec
+from ..request import SolveRequest
 from ..results.interface import pair_forces
 from ..scenes import SizeField
 from .estimate import estimate
@@ -80,6 +81,38 @@ class GoalEstimate:
     dofs: int  # DOFs of the refined solve
     seconds: float  # remesh + refined solve + comparison
     reference: Solution  # the refined solution (a better answer than the level's own)
+
+    def record(self) -> GoalRecord:
+        """The estimate without the refined solution."""
+        return GoalRecord(self.goal, self.relative, dict(self.parts), self.dofs, self.seconds)
+
+
+GOAL_MEANING = {
+    Goal.PRESSURE: "the relative L2 error of the contact pressure (worst pair)",
+    Goal.ENERGY: "the relative energy-norm error of the displacement",
+    Goal.FORCE: "the relative error of each pair's contact force (worst pair)",
+}
+
+
+@dataclass(frozen=True)
+class GoalRecord:
+    """A level's goal estimate as recorded: the number, its parts, how it was had."""
+
+    goal: Goal
+    relative: float
+    parts: dict[str, float]
+    dofs: int  # DOFs of the refined solve (0: none, the residual estimate calibrated)
+    seconds: float
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON fields `goal`, `goal_estimate`, `goal_parts`, `goal_refined_dofs`."""
+        return {
+            "goal": self.goal.value,
+            "goal_estimate": self.relative,
+            "goal_parts": dict(self.parts),
+            "goal_refined_dofs": self.dofs,
+            "goal_seconds": self.seconds,
+        }
 
 
 def refined_field(
@@ -182,10 +215,18 @@ def _check_bounded(sol: Solution, ref: Solution) -> None:
 
 
 def _refined(
-    sol: Solution, field: SizeField, solver: SolverSpec | str, options: dict[str, Any]
+    sol: Solution,
+    field: SizeField,
+    solver: SolverSpec | str | SolveRequest,
+    options: dict[str, Any],
 ) -> Solution:
-    """The same scene solved on the mesh of `field`, the level's active set as first guess."""
+    """The same scene solved on the mesh of `field`, the level's active set as first guess.
+
+    `solver` a SolveRequest: the level's own request (its enforcement, basis and solver).
+    """
     scene = sol.scene.remeshed_to(field)
+    if isinstance(solver, SolveRequest):
+        return solve_request(scene, solver, initial=sol)
     return solve(scene, sol.method, solver=solver, initial=sol, **options)
 
 
@@ -193,7 +234,7 @@ def goal_estimate(
     sol: Solution,
     goal: Goal | str,
     *,
-    solver: SolverSpec | str = "mumps",
+    solver: SolverSpec | str | SolveRequest = "mumps",
     options: dict[str, Any] | None = None,
     rate: float | None = None,
     reach: float = REACH,
@@ -203,7 +244,8 @@ def goal_estimate(
     Args:
         sol: A multiplier-method solution of a scene that can be remeshed.
         goal: pressure (contact cells halved), energy or force (every cell halved).
-        solver: The refined solve's solver (the level's own, normally).
+        solver: The refined solve's solver (the level's own, normally), or the level's
+            whole SolveRequest (penalty, mortar's basis: the refined solve is the same).
         options: Further `api.solve` options of the level's solve (not `initial`).
         rate: r of the extrapolation; if None, RATES[goal] (pressure, force) or the
             residual estimate's observed rate between the two meshes (energy).

@@ -23,6 +23,7 @@ from ..results.records import RunSummary
 from ..scenes import Scene
 from ..timers import Timers
 from .estimate import Estimate, estimate
+from .goal import Goal, GoalRecord
 from .sizing import Plan, SizingRule, plan_mesh
 
 # On a full budget, the pressure sizing goes on while its estimate falls below this fraction
@@ -39,6 +40,9 @@ class AdaptOptions:
     max_levels: int = 8
     rule: SizingRule = field(default_factory=SizingRule)
     pressure_tol: float | None = None  # relative L2 pressure estimate to reach too
+    # The quantity `tol` bounds (adapt/planned.py: the goal loop); None: the residual
+    # estimate's loop below (the expert flags' loop, `--goal residual`).
+    goal: Goal | None = None
 
     def pressure_met(self, est: Estimate) -> bool:
         """Whether the pressure estimate needs nothing more (always, without pressure_tol)."""
@@ -101,7 +105,8 @@ class AdaptLevel:
     summary: RunSummary
     solution: Solution
     est: Estimate
-    time: float  # seconds: meshing (remesh) + solve + estimate
+    time: float  # seconds: meshing (remesh) + solve + estimate (+ the goal's refined solve)
+    goal: GoalRecord | None = None  # the goal estimate (the goal loop, adapt/planned.py)
 
     @property
     def dofs(self) -> int:
@@ -115,7 +120,21 @@ class AdaptLevel:
         out["estimate_parts"] = self.est.summary().to_json()
         out["level"] = self.index
         out["time"] = self.time
+        if self.goal is not None:
+            out.update(self.goal.to_json())
+            out["estimate"] = self.goal.relative
+            exact = self.exact_error
+            if exact is not None:
+                out["exact_error"] = exact
+                out["effectivity"] = self.goal.relative / exact if exact > 0 else None
         return out
+
+    @property
+    def exact_error(self) -> float | None:
+        """The goal's exact relative error where the scene has one (pressure on Hertz)."""
+        if self.goal is None or self.goal.goal is not Goal.PRESSURE or not self.summary.hertz:
+            return None
+        return max(h.l2_error for h in self.summary.hertz)
 
 
 @dataclass
@@ -142,6 +161,7 @@ class AdaptResult:
                 "growth": opts.rule.growth,
                 "weight_contact": opts.rule.contact_weight,
                 "pressure_tol": opts.pressure_tol,
+                "goal": opts.goal.value if opts.goal is not None else "residual",
                 "solver": solver,
             },
             "stop": self.stop,
@@ -295,6 +315,15 @@ def level_line(level: AdaptLevel) -> str:
     elif run.patch is not None:
         ref = f", patch max {run.patch.max:.2e}"
     pressure = f", pressure {100 * e.pressure:.3g} %" if e.pressure else ""
+    if level.goal is not None:
+        g = level.goal
+        eff = level.exact_error
+        eff_s = f", effectivity {g.relative / eff:.2f}" if eff else ""
+        return (
+            f"level {level.index}: {run.dofs} DOFs, {g.goal.value} estimate "
+            f"{100 * g.relative:.3g} %{ref}{eff_s} (residual {100 * e.total:.3g} %), "
+            f"{level.time:.2f} s"
+        )
     return (
         f"level {level.index}: {run.dofs} DOFs, estimate {100 * e.total:.3g} % "
         f"(contact {100 * e.contact:.3g} %, bulk {100 * e.bulk:.3g} %{pressure}){ref}, "

@@ -124,7 +124,7 @@ def _budget_target(
     while cells(hi) > budget and hi < 1e300:
         hi *= 4.0
     for _ in range(60):
-        mid = np.sqrt(lo * hi)
+        mid = float(np.exp(0.5 * (np.log(lo) + np.log(hi))))  # sqrt(lo hi) would overflow
         lo, hi = (mid, hi) if cells(mid) > budget else (lo, mid)
     return float(hi)
 

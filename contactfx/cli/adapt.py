@@ -10,14 +10,21 @@ from pathlib import Path
 from mpi4py import MPI
 
 from ..adapt.charts import chart_title, plot_adapt
-from ..adapt.loop import AdaptOptions, adapt, uniform_levels
+from ..adapt.goal import Goal
+from ..adapt.loop import AdaptOptions, uniform_levels
 from ..adapt.mesh_file import write_msh
+from ..adapt.planned import run_loop
 from ..adapt.sizing import SizingRule, default_contact_weight
 from ..errors import InputError
 from ..methods.predictor import scene_dofs
 from ..results.files import write_fields, write_json
 from ..scenes import parse_scene_file
 from .params import build_from_args, is_scene_file, reject_structured_adapt, request_from_args
+
+# --tol's defaults: the goal's relative error, and the residual estimate's (--goal residual).
+GOAL_TOL = 0.01
+RESIDUAL_TOL = 0.05
+RESIDUAL_GROWTH = 4.0  # --goal residual's --growth default
 
 
 def check_remeshable(args: argparse.Namespace) -> None:
@@ -33,10 +40,27 @@ def check_remeshable(args: argparse.Namespace) -> None:
 
 
 def contact_weight(args: argparse.Namespace) -> float:
-    """--weight-contact, or its default (10, or 1 with --pressure-tol)."""
+    """--weight-contact, or its default (1; --goal residual: 10, or 1 with --pressure-tol)."""
     if args.weight_contact is not None:
         return float(args.weight_contact)
+    if args.goal != "residual":
+        return 1.0
     return default_contact_weight(args.pressure_tol)
+
+
+def adapt_options(args: argparse.Namespace) -> AdaptOptions:
+    """The loop's options: the goal loop's defaults, or --goal residual's (the old loop)."""
+    residual = args.goal == "residual"
+    tol = args.tol if args.tol is not None else (RESIDUAL_TOL if residual else GOAL_TOL)
+    growth = args.growth if args.growth is not None else RESIDUAL_GROWTH
+    return AdaptOptions(
+        tol,
+        args.max_dofs,
+        args.max_levels,
+        SizingRule(growth=growth, contact_weight=contact_weight(args)),
+        args.pressure_tol,
+        None if residual else Goal(args.goal),
+    )
 
 
 def run_adapt(args: argparse.Namespace) -> int:
@@ -44,13 +68,7 @@ def run_adapt(args: argparse.Namespace) -> int:
     comm = MPI.COMM_WORLD
     if not args.verbose:
         logging.getLogger("contactfx").setLevel(logging.WARNING)
-    opts = AdaptOptions(
-        args.tol,
-        args.max_dofs,
-        args.max_levels,
-        SizingRule(growth=args.growth, contact_weight=contact_weight(args)),
-        args.pressure_tol,
-    )
+    opts = adapt_options(args)
     opts.check()
     check_remeshable(args)
     request = request_from_args(args)
@@ -71,13 +89,14 @@ def run_adapt(args: argparse.Namespace) -> int:
         f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
         f"{comm.size} rank{'s' * (comm.size > 1)}"
     )
-    result = adapt(
+    result = run_loop(
         scene,
         request,
         opts,
         paper_interface=paper,
         say=say,
         mesh_time=mesh_time,
+        growth_cap=args.growth,
     )
     if args.compare_uniform:
         result.uniform = uniform_levels(

@@ -10,6 +10,9 @@ from ..options import SOLVERS, Basis, Enforcement, Method, Predictor
 from ..scenes import BLOCK_SCENES, MESHERS, Model
 from .params import BLOCK_KEYS, HERTZ_KEYS, PARAM_HELP
 
+# adapt/goal.py's Goal values (named here so that the parser imports no solver).
+GOALS = ("pressure", "energy", "force")
+
 
 def _builtin_scene_options(p: argparse.ArgumentParser) -> None:
     """The options of the built-in scenes (blocks, hertz), shared by solve and study."""
@@ -93,8 +96,15 @@ def _study_parser(sub: Any) -> None:
         type=float,
         default=None,
         metavar="P",
-        help="with --adaptive: also size the contact cells for a relative L2 pressure "
-        "estimate of P (as adapt's --pressure-tol)",
+        help="with --adaptive --goal residual: also size the contact cells for a relative "
+        "L2 pressure indicator of P (as adapt's --pressure-tol)",
+    )
+    s.add_argument(
+        "--goal",
+        default="pressure",
+        choices=[*GOALS, "residual"],
+        help="with --adaptive: the goal loop's quantity (as adapt's --goal; the loop runs to "
+        "the finest uniform level's DOFs)",
     )
     _solver_options(s)
     o = s.add_argument_group("output")
@@ -200,8 +210,15 @@ def _solve_parser(sub: Any) -> None:
     o.add_argument(
         "--estimate",
         action="store_true",
-        help="estimate the error (residual estimator, docs/adapt.md): `estimate` in the "
-        "JSON, the indicators eta in the fields of --out",
+        help="estimate the error (residual estimator and the --goal's two-level estimate, "
+        "docs/adapt.md): `estimate` in the JSON, the indicators eta in the fields of --out",
+    )
+    o.add_argument(
+        "--goal",
+        default="pressure",
+        choices=GOALS,
+        help="with --estimate: the quantity whose relative error is estimated by a second "
+        "solve on a refined mesh (default pressure; energy, force)",
     )
     o.add_argument("--json", type=Path, help="write the JSON summary here")
     o.add_argument(
@@ -216,8 +233,9 @@ def _solve_parser(sub: Any) -> None:
 def _adapt_parser(sub: Any) -> None:
     s = sub.add_parser(
         "adapt",
-        help="adaptive meshing: solve, estimate, remesh with gmsh until the estimate is small",
-        description="Adapt the mesh of one scene: each level solves, estimates the error "
+        help="adaptive meshing: solve, estimate, remesh with gmsh until --tol is met",
+        description="Adapt the mesh of one scene until the relative error of --goal is "
+        "estimated to be at most --tol (docs/adapt.md). Each level solves, estimates the error "
         "(residual estimator, docs/adapt.md), sizes the next mesh from the indicators and "
         "remeshes the geometry with gmsh. Stops at --tol, --max-levels, or when the next "
         "mesh would exceed --max-dofs. Writes adapt.json, mesh.msh, fields.pvtu (with the "
@@ -232,11 +250,30 @@ def _adapt_parser(sub: Any) -> None:
         choices=[v.value for v in Method if v is not Method.SCHWARZ],
         help="contact discretization (default mortar; penalty: mortar with penalty)",
     )
+    m.add_argument(
+        "--basis",
+        choices=[b.value for b in Basis],
+        default=Basis.STANDARD.value,
+        help="mortar multiplier basis: standard (N_j) or dual (biorthogonal)",
+    )
     m.add_argument("--max-iterations", type=int, default=50, help="active-set iteration limit")
     _solver_options(s)
     a = s.add_argument_group("adaptivity")
     a.add_argument(
-        "--tol", type=float, default=0.05, help="relative estimate to reach (default 0.05)"
+        "--goal",
+        default="pressure",
+        choices=[*GOALS, "residual"],
+        help="the quantity --tol bounds: pressure (relative L2 error of the contact "
+        "pressure, default), energy (energy-norm error), force (each pair's contact force); "
+        "each level's estimate is a second solve on a refined mesh (docs/adapt.md). "
+        "residual: the residual estimate's loop (uncalibrated; the expert flags' loop)",
+    )
+    a.add_argument(
+        "--tol",
+        type=float,
+        default=None,
+        help="relative error of the goal to reach (default 0.01; with --goal residual the "
+        "relative residual estimate, default 0.05)",
     )
     a.add_argument(
         "--max-dofs",
@@ -248,26 +285,27 @@ def _adapt_parser(sub: Any) -> None:
     a.add_argument(
         "--growth",
         type=float,
-        default=4.0,
-        help="most cells of a level relative to the previous one, > 1 (default 4)",
+        default=None,
+        help="expert: most cells of a level relative to the previous one, > 1 (default: planned "
+        "from the goal estimate's observed rate and the budget left; 4 with --goal residual)",
     )
     a.add_argument(
         "--weight-contact",
         type=float,
         default=None,
         metavar="W",
-        help="size the next mesh with each cell's contact terms times W (the estimate "
-        "itself is unweighted; docs/adapt.md: W > 1 resolves the contact zone for the "
-        "pressure; default 10, or 1 with --pressure-tol, whose sizing does that better)",
+        help="expert: size the next mesh with each cell's contact terms times W (the "
+        "estimate itself is unweighted; default 1; with --goal residual 10, or 1 with "
+        "--pressure-tol, whose sizing does that better)",
     )
     a.add_argument(
         "--pressure-tol",
         type=float,
         default=None,
         metavar="P",
-        help="also size the cells along the contact surfaces for a relative L2 pressure "
-        "estimate of P, and stop only when it is met too (docs/adapt.md; default: "
-        "the energy estimate alone)",
+        help="expert, --goal residual: also size the cells along the contact surfaces for "
+        "a relative L2 pressure indicator of P, and stop only when it is met too "
+        "(docs/adapt.md; the goal loop aims it at half the error it plans for)",
     )
     a.add_argument(
         "--compare-uniform",

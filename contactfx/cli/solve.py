@@ -5,14 +5,18 @@ from __future__ import annotations
 import argparse
 import logging
 import time
+from dataclasses import replace
 from typing import Any
 
 from mpi4py import MPI
 
 from ..adapt.estimate import estimate
+from ..adapt.goal import GOAL_MEANING, Goal, goal_estimate
 from ..api import run_scene
 from ..errors import InputError
+from ..methods.solution import Solution
 from ..options import Enforcement
+from ..request import SolveRequest
 from ..results.figures import contact_window, deformed_fields, plot_interface, plot_pair
 from ..results.files import write_contact_surfaces, write_fields, write_json
 from ..results.records import RunSummary
@@ -72,7 +76,26 @@ def terminal_summary(run: RunSummary) -> list[str]:
         )
         if e.pressure:
             lines.append(f"pressure estimate (relative L2): {100 * e.pressure:.3g} %")
+        g = e.goal or {}
+        if g.get("goal_estimate") is not None:
+            lines.append(
+                f"{g['goal']} goal estimate: {100 * g['goal_estimate']:.3g} % "
+                f"({GOAL_MEANING[Goal(g['goal'])]}; refined solve {g['goal_refined_dofs']} DOFs)"
+            )
     return lines
+
+
+def goal_block(args: argparse.Namespace, request: SolveRequest, sol: Solution) -> dict[str, Any]:
+    """The `estimate` block's goal fields: the --goal's two-level estimate (collective).
+
+    A scene without a geometry to remesh has none (`goal_estimate` null, `goal_note` why);
+    GoalUnbounded (an InputError: one line, exit 2) where the goal has no finite value.
+    """
+    goal = Goal(args.goal)
+    if sol.scene.recipe is None or getattr(args, "mesh", None) == "structured":
+        note = "no geometry to remesh: the goal estimate needs a refined solve"
+        return {"goal": goal.value, "goal_estimate": None, "goal_note": note}
+    return goal_estimate(sol, goal, solver=request).record().to_json()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -96,7 +119,8 @@ def run(args: argparse.Namespace) -> int:
     cells: tuple[Any, ...] = ()
     if args.estimate:
         est = estimate(sol)
-        record = record.with_estimate(est.summary())
+        summary = replace(est.summary(), goal=goal_block(args, request, sol))
+        record = record.with_estimate(summary)
         cells = (est.eta,)
     if args.out is not None:
         write_fields(sol, args.out, cells)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+from ..adapt.goal import Goal
 from ..errors import InputError
 from ..options import Method
 from ..request import SolveRequest
@@ -99,6 +100,7 @@ def run_command(args: argparse.Namespace) -> int:
             paper_interface=levels[0].paper_interface,
             max_levels=3 * len(levels),
             pressure_tol=args.pressure_tol,
+            goal=None if args.goal == "residual" else Goal(args.goal),
             say=lambda line: say(line, flush=True),
         )
     if comm.rank == 0:

@@ -154,6 +154,9 @@ class EstimateSummary:
     absolute: float
     energy_norm: float
     pressure: float | None
+    # The goal's two-level estimate (adapt/goal.py GoalRecord.to_json: goal, goal_estimate,
+    # goal_parts, ...), or None if none was asked for.
+    goal: dict[str, Any] | None = None
 
     def to_json(self) -> dict[str, Any]:
         """The JSON's `estimate` block."""
@@ -166,6 +169,7 @@ class EstimateSummary:
             "energy_norm": self.energy_norm,
             "pressure": self.pressure,
             "norm": ESTIMATE_NORM,
+            **(self.goal or {}),
         }
 
 

@@ -14,7 +14,9 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from ..adapt.loop import AdaptLevel, AdaptOptions, adapt
+from ..adapt.goal import Goal
+from ..adapt.loop import AdaptLevel, AdaptOptions
+from ..adapt.planned import run_loop
 from ..adapt.sizing import SizingRule, default_contact_weight
 from ..options import Enforcement
 from ..request import SolveRequest
@@ -75,16 +77,20 @@ def adaptive_runs(
     max_levels: int = 12,
     growth: float = GROWTH,
     pressure_tol: float | None = None,
+    goal: Goal | None = Goal.PRESSURE,
     say: Callable[[str], None] | None = None,
 ) -> list[AdaptiveRun]:
     """Run the adaptive loop of every request from `scene` (level 0) and measure its levels.
 
     `requests` are the study's (those it ran, by label; schwarz's are skipped).
 
-    With `pressure_tol` the contact cells are sized for the pressure too, and the contact
-    terms are not weighted (as adapt's defaults).
+    `goal`: the goal loop (adapt/planned.py: its estimate per level, its planned growth up
+    to the budget); None the residual estimate's loop (growth `growth`). With
+    `pressure_tol` (residual loop) the contact cells are sized for the pressure too, and
+    the contact terms are not weighted (as adapt's defaults).
     """
-    rule = SizingRule(growth=growth, contact_weight=default_contact_weight(pressure_tol))
+    weight = default_contact_weight(pressure_tol) if goal is None else 1.0
+    rule = SizingRule(growth=growth, contact_weight=weight)
     ref = self_reference(study.runs, study.methods) if study.reference["kind"] == "self" else None
     out: list[AdaptiveRun] = []
     for request in adaptive_requests(requests):
@@ -92,10 +98,10 @@ def adaptive_runs(
         cap = budget(study, m) if m in study.methods else None
         if cap is None:
             continue
-        result = adapt(
+        result = run_loop(
             scene,
             request,
-            AdaptOptions(NO_TOL, cap, max_levels, rule, pressure_tol),
+            AdaptOptions(NO_TOL, cap, max_levels, rule, pressure_tol, goal),
             paper_interface=paper_interface,
             say=_prefixed(say, f"adaptive {m}: "),
             mesh_time=level0_mesh(study),
@@ -115,7 +121,7 @@ def adaptive_runs(
                     float(run.times["total"]),
                     lv.time,
                     cumulative,
-                    float(lv.est.relative),
+                    float(lv.est.relative if lv.goal is None else lv.goal.relative),
                     _errors(study, lv, ref),
                     result.stop,
                 )

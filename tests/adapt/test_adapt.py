@@ -21,7 +21,10 @@ def _adapt(tmp: Path, *args: str, ranks: int = 1) -> dict:
 @pytest.fixture(scope="module")
 def hertz_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     out = tmp_path_factory.mktemp("adapt_hertz")
-    return _adapt(out, *COARSE_HERTZ, "--max-dofs", "12000", "--compare-uniform"), out
+    # The residual estimate's loop (the default before the goal loop; tests/adapt/
+    # test_goal_loop.py has the goal loop's).
+    args = (*COARSE_HERTZ, "--goal", "residual", "--max-dofs", "12000", "--compare-uniform")
+    return _adapt(out, *args), out
 
 
 def test_hertz_levels(hertz_run: tuple[dict, Path]) -> None:
@@ -63,7 +66,9 @@ def test_final_mesh_loads_back(hertz_run: tuple[dict, Path], tmp_path: Path) -> 
 
 
 def test_blocks(tmp_path: Path) -> None:
-    data = _adapt(tmp_path, "blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2")
+    # --goal residual: the patch-test pressure is exact, so the goal loop stops at level 0.
+    args = ("blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2")
+    data = _adapt(tmp_path, *args, "--goal", "residual")
     levels = data["levels"]
     assert len(levels) == 2 and levels[1]["estimate"] < levels[0]["estimate"]
     assert all(abs(lv["contact_force"] - 150.0) < 1e-8 for lv in levels)
@@ -71,7 +76,8 @@ def test_blocks(tmp_path: Path) -> None:
 
 def test_geo_scene(tmp_path: Path) -> None:
     scene = ROOT / "tests" / "scenes" / "two_cylinders.toml"
-    data = _adapt(tmp_path, str(scene), "--max-levels", "2", "--max-dofs", "60000")
+    args = ("--max-levels", "2", "--max-dofs", "60000", "--goal", "residual")
+    data = _adapt(tmp_path, str(scene), *args)
     assert len(data["levels"]) == 2
     assert data["levels"][1]["estimate"] < data["levels"][0]["estimate"]
     assert "hertz" in data["levels"][0]
@@ -96,7 +102,8 @@ def test_two_ranks_print_once_and_match_serial(tmp_path: Path) -> None:
 
     tests/ranks/rank_cases.py (cli-adapt-hertz) compares a Hertz run number by number.
     """
-    args = ("blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2")
+    args = ("blocks", "--size1", "0.5", "--size2", "0.5", "--max-levels", "2", "--goal")
+    args += ("residual",)
     serial = _adapt(tmp_path / "one", *args)
     cmd = ("adapt", *args, "--out", str(tmp_path / "two"))
     proc = run_cli(*cmd, ranks=2)

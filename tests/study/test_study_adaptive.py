@@ -16,7 +16,9 @@ HERTZ = ("study", "hertz", "--levels", "3", "--size-factor", "8", "--methods", "
 @pytest.fixture(scope="module")
 def adaptive_study(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, str, Path]:
     out = tmp_path_factory.mktemp("study_adaptive")
-    proc = cli(*HERTZ, "--adaptive", "--out", str(out))
+    # The residual estimate's loop (--goal residual), whose levels docs/adapt.md gives;
+    # tests/adapt/test_goal_loop.py runs the study's default goal loop.
+    proc = cli(*HERTZ, "--adaptive", "--goal", "residual", "--out", str(out))
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     return json.loads((out / "study.json").read_text()), proc.stdout, out
 
@@ -48,7 +50,8 @@ def test_pressure_tol_sizes_for_the_pressure(
     At this budget (4,180 DOFs) it does not pay: L2 1.05 % at 4,072 DOFs against 0.64 % at
     3,904 without it (docs/adapt.md, the budget sweep).
     """
-    proc = cli(*HERTZ, "--adaptive", "--pressure-tol", "0.0005", "--out", str(tmp_path))
+    args = ("--adaptive", "--goal", "residual", "--pressure-tol", "0.0005")
+    proc = cli(*HERTZ, *args, "--out", str(tmp_path))
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     runs = json.loads((tmp_path / "study.json").read_text())["adaptive"]["runs"]
     plain = adaptive_study[0]["adaptive"]["runs"]
@@ -70,7 +73,8 @@ def test_structured_mesh_refused(tmp_path: Path) -> None:
 def test_two_ranks_match_serial(adaptive_study: tuple[dict, str, Path], tmp_path: Path) -> None:
     """mpirun -n 2: the adaptive levels of the serial study (same DOFs, estimates, errors)."""
     serial = adaptive_study[0]["adaptive"]["runs"]
-    proc = run_cli(*HERTZ, "--adaptive", "--out", str(tmp_path / "o"), ranks=2)
+    args = ("--adaptive", "--goal", "residual", "--out", str(tmp_path / "o"))
+    proc = run_cli(*HERTZ, *args, ranks=2)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     assert proc.stdout.count("adaptive levels") == 1
     runs = json.loads((tmp_path / "o" / "study.json").read_text())["adaptive"]["runs"]

@@ -1,0 +1,115 @@
+"""The goal loop's done-when table: `contactfx adapt` with defaults only (docs/adapt.md).
+
+Each case is one CLI command (run as a user would, serial); per level: DOFs, cumulative
+time (remesh + solve + residual estimate + the goal's refined solve), the goal estimate,
+the exact error where the scene has one (Hertz: the relative L2 pressure error) and the
+effectivity (estimate / exact). The flat punch (pressure unbounded: --goal energy) reports
+the pressure's max error at x <= 0.7 b against Sadowsky's half-plane pressure, relative to
+p(0) (tests/methods/test_obstacles.py `sadowsky_errors`, benchmarks/punch_adapt.py).
+
+Run: python benchmarks/adapt_goal.py [--cases r1,r08,budget,fine,punch] [--json FILE]
+(serial; r1, r08, budget and punch a few minutes together, fine ~10 min).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+UNGRADED = ["hertz", "--refine", "1.0", "--h-far", "10", "--refine-edge", "0"]
+HELD_OUT = ["hertz", "--refine", "0.8", "--h-far", "8", "--refine-edge", "0"]
+PUNCH = [str(ROOT / "demos" / "scenes" / "rigid_punch.toml"), "--method", "nts"]
+# The half model's exact force (benchmarks/punch_adapt.py: Richardson on graded meshes).
+PUNCH_FORCE = 17.890563
+CASES: dict[str, list[str]] = {
+    "r1": [*UNGRADED, "--tol", "0.002", "--max-dofs", "60000"],
+    "r08": [*HELD_OUT, "--tol", "0.002", "--max-dofs", "60000"],
+    "budget": [*UNGRADED, "--tol", "1e-6", "--max-dofs", "60000"],
+    "fine": [*UNGRADED, "--tol", "0.0005", "--max-dofs", "250000"],
+    "punch": [*PUNCH, "--goal", "energy", "--tol", "0.01", "--max-dofs", "100000"],
+}
+
+
+def sadowsky_inner(level: dict[str, Any], b: float = 1.0, reach: float = 0.7) -> float:
+    """Max pressure error at x <= reach b against Sadowsky, relative to p(0) (half model)."""
+    c = level["contacts"][0]
+    x, p = np.asarray(c["interface"]["x"]), np.asarray(c["interface"]["pressure"])
+    P = 2.0 * abs(c["force"][1])
+    inner = x <= reach * b
+    exact = P / (np.pi * np.sqrt(b * b - x[inner] ** 2))
+    return float(np.max(np.abs(p[inner] - exact)) / (P / (np.pi * b)))
+
+
+def run_case(name: str, args: list[str]) -> dict[str, Any]:
+    """One `contactfx adapt` command: its levels and why it stopped."""
+    with tempfile.TemporaryDirectory() as tmp:
+        cmd = [sys.executable, "-m", "contactfx", "adapt", *args, "--out", tmp]
+        proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        if proc.returncode != 0:
+            return {"case": name, "command": args, "error": proc.stderr.strip()}
+        data = json.loads((Path(tmp) / "adapt.json").read_text())
+    rows, cumulative = [], 0.0
+    for lv in data["levels"]:
+        cumulative += lv["time"]
+        row = {
+            "dofs": lv["dofs"],
+            "time": cumulative,
+            "estimate": lv["estimate"],
+            "exact": lv.get("exact_error"),
+            "effectivity": lv.get("effectivity"),
+            "refined_dofs": lv.get("goal_refined_dofs"),
+        }
+        if name == "punch":
+            row["p_sadowsky_07"] = sadowsky_inner(lv)
+            row["p_sadowsky_05"] = sadowsky_inner(lv, reach=0.5)
+            # The energy error from the force (benchmarks/punch_adapt.py: the whole face
+            # active, ||u - u_h||_E^2 / ||u||_E^2 = (F_h - F) / F).
+            force = abs(lv["contacts"][0]["force"][1])
+            row["force"] = force
+            row["exact"] = float(np.sqrt(max(force - PUNCH_FORCE, 0.0) / PUNCH_FORCE))
+            row["effectivity"] = lv["estimate"] / row["exact"]
+        rows.append(row)
+    return {"case": name, "command": args, "stop": data["stop"], "levels": rows}
+
+
+def table(results: list[dict[str, Any]]) -> list[str]:
+    """The README's rows: one per level."""
+    out = ["| case | level | DOFs | time (s, cum.) | estimate | exact | effectivity |"]
+    out.append("|---|---|---|---|---|---|---|")
+    for r in results:
+        for k, lv in enumerate(r.get("levels", [])):
+            exact = lv["exact"]
+            ex = f"{100 * exact:.3g} %" if exact is not None else ""
+            if "p_sadowsky_07" in lv:
+                ex += f" (p, x <= 0.7 b: {100 * lv['p_sadowsky_07']:.3g} %)"
+            eff = f"{lv['effectivity']:.2f}" if lv["effectivity"] is not None else ""
+            out.append(
+                f"| {r['case']} | {k} | {lv['dofs']:,} | {lv['time']:.1f} | "
+                f"{100 * lv['estimate']:.3g} % | {ex} | {eff} |"
+            )
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--cases", default="r1,r08,budget,punch", help="comma-separated names")
+    ap.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "adapt_goal.json")
+    args = ap.parse_args()
+    results = []
+    for name in args.cases.split(","):
+        results.append(run_case(name, CASES[name]))
+        print(json.dumps({k: v for k, v in results[-1].items() if k != "levels"}), flush=True)
+        args.json.write_text(json.dumps(results, indent=1) + "\n")
+    print("\n".join(table(results)))
+
+
+if __name__ == "__main__":
+    main()
