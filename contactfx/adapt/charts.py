@@ -78,18 +78,34 @@ def reference_error(level: AdaptLevel) -> tuple[str, float] | None:
     return None
 
 
-def _panels(levels: list[AdaptLevel]) -> list[tuple[str, str]]:
-    """(key, y label) of the panels: the estimate, and the exact error where there is one."""
-    out = [("estimate", "relative estimate (energy norm)")]
+def _panels(levels: list[AdaptLevel]) -> list[tuple[tuple[str, ...], str]]:
+    """(keys, y label) of the panels.
+
+    The goal loop: its goal's estimate with the exact error beside it (where the scene has
+    one), then the residual estimate. The residual loop: the estimate, then the exact error.
+    """
+    goal = levels[0].goal if levels else None
     ref = reference_error(levels[0]) if levels else None
-    if ref is not None:
-        out.append(("reference", ref[0]))
-    return out
+    residual: tuple[tuple[str, ...], str] = (
+        ("estimate",),
+        "relative residual estimate (energy norm)",
+    )
+    if goal is not None:
+        keys = ("goal", "reference") if ref is not None else ("goal",)
+        return [(keys, f"relative {goal.goal.value} error: estimate and exact"), residual]
+    exact: list[tuple[tuple[str, ...], str]] = [(("reference",), ref[0])] if ref else []
+    return [residual, *exact]
+
+
+# How each quantity is drawn and named in a panel that shows several.
+SERIES = {"goal": ("-o", "estimate"), "estimate": ("-o", ""), "reference": ("--x", "exact")}
 
 
 def _value(level: AdaptLevel, key: str) -> float | None:
     if key == "estimate":
         return float(level.est.relative)
+    if key == "goal":
+        return None if level.goal is None else float(level.goal.relative)
     ref = reference_error(level)
     return None if ref is None else ref[1]
 
@@ -136,14 +152,17 @@ def plot_adapt(
     """
     panels = _panels(adaptive)
     fig, axes = plt.subplots(1, len(panels), figsize=(5.8 * len(panels), 4.8), squeeze=False)
-    for ax, (key, label) in zip(axes[0], panels, strict=True):
-        for name, levels, style, cumulative in (
-            ("adaptive", adaptive, "-o", True),
-            ("uniform", uniform, "--s", False),
-        ):
-            pts = chart_points(levels, key, x, cumulative)
-            if pts:
-                ax.loglog(*zip(*pts, strict=True), style, label=name, lw=1.8, ms=6)
+    for ax, (keys, label) in zip(axes[0], panels, strict=True):
+        for key in keys:
+            style, what = SERIES[key]
+            for name, levels, line, cumulative in (
+                ("adaptive", adaptive, style, True),
+                ("uniform", uniform, "--s", False),
+            ):
+                pts = chart_points(levels, key, x, cumulative)
+                if pts:
+                    tag = f"{name}, {what}" if len(keys) > 1 else name
+                    ax.loglog(*zip(*pts, strict=True), line, label=tag, lw=1.8, ms=6)
         time_label = TIME_LABEL_UNIFORM if uniform else TIME_LABEL
         ax.set_xlabel("displacement DOFs" if x == "dofs" else time_label)
         ax.set_ylabel(label)

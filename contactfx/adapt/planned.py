@@ -141,9 +141,10 @@ def adapt_to_goal(
         levels.append(level)
         history.append((level.dofs, rec.relative))
         say(level_line(level))
-        reached = f"the {goal.value} estimate reached {rec.relative:.3g} (tol {opts.tol:g})"
+        est, tol = f"{100 * rec.relative:.3g} %", f"{100 * opts.tol:g} %"
+        reached = f"the {goal.value} estimate reached {est} (tol {tol})"
         if rec.relative <= opts.tol:
-            stop = f"{goal.value} estimate {rec.relative:.3g} <= tol {opts.tol:g}"
+            stop = f"{goal.value} estimate {est} <= tol {tol}"
             stop += f": it bounds {GOAL_MEANING[goal]}"
             break
         if k + 1 == opts.max_levels:

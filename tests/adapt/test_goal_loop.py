@@ -51,7 +51,7 @@ def test_hertz_tol_is_the_pressure_error(tmp_path: Path) -> None:
     proc = cli("adapt", *UNGRADED, "--tol", "0.002", "--max-dofs", "60000", "--out", str(tmp_path))
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     data = json.loads((tmp_path / "adapt.json").read_text())
-    assert data["settings"]["goal"] == "pressure" and "<= tol 0.002" in data["stop"]
+    assert data["settings"]["goal"] == "pressure" and "<= tol 0.2 %" in data["stop"]
     assert "relative L2 error of the contact pressure" in proc.stdout
     levels = data["levels"]
     assert len(levels) >= 4 and all(lv["dofs"] <= 60_000 for lv in levels)
