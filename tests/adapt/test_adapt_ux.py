@@ -24,7 +24,12 @@ def _level(index: int, dofs: int, time: float, l2: list[float], est: float = 0.1
     hertz = [SimpleNamespace(pair=k, l2_error=e) for k, e in enumerate(l2)]
     summary = SimpleNamespace(hertz=hertz, patch=None)
     return SimpleNamespace(
-        index=index, dofs=dofs, time=time, summary=summary, est=SimpleNamespace(relative=est)
+        index=index,
+        dofs=dofs,
+        time=time,
+        summary=summary,
+        est=SimpleNamespace(relative=est),
+        goal=None,
     )
 
 
