@@ -165,10 +165,13 @@ def advice(pairs: list[PairData], hold: Holding, loose: list[int]) -> str:
     ]
     if any(p.passive_body is not None for p in mine):
         return (
-            "check that each [[contact]] pair names two surfaces that touch, or add a "
-            "[[dirichlet]] support"
+            "check that each contact pair ([[contact]] in a scene file, ContactPair in Python) "
+            "names two surfaces that touch, or add a support ([[dirichlet]], Dirichlet)"
         )
-    return "add a [[dirichlet]] support or an [[obstacle]] that holds it"
+    return (
+        "add a support ([[dirichlet]] in a scene file, Dirichlet in Python) or an obstacle "
+        "([[obstacle]], Obstacle) that holds it"
+    )
 
 
 def floating_message(

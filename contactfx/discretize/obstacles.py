@@ -72,11 +72,17 @@ def check_obstacle_geometry(p: PairData) -> None:
     bad = facing_angle(p.active.surface, ob.geometry, p.operator)
     if bad is not None:
         x, angle = bad
-        hint = " (does its normal point from the obstacle towards the body?)"
+        hints = {
+            "plane": " (does its normal point from the obstacle towards the body?)",
+            # The obstacle lies on the left of its points in order: a polyline walked the
+            # other way has the body on the obstacle's side.
+            "polyline": " (the obstacle lies on the left of its points in order, the body on "
+            "the right: is the polyline walked the wrong way? reverse its points)",
+        }
         raise GeometryError(
             f"the surface '{ob.surface}' does not face obstacle '{ob.name}': at ({x[0]:.4g}, "
             f"{x[1]:.4g}) the outward normals of the body and the obstacle make an angle of "
-            f"{angle:.0f} degrees (180 expected)" + (hint if ob.shape == "plane" else "")
+            f"{angle:.0f} degrees (180 expected)" + hints.get(ob.shape, "")
         )
 
 

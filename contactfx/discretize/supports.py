@@ -260,7 +260,7 @@ def check_held(
         k = hold.loose(free)[0]
         raise SingularSystemError(
             f"body '{scene.bodies[k].name}' can still move freely after its supports and "
-            f"contacts ({_free_motions(free[:, 3 * k : 3 * k + 3])}): add a [[dirichlet]] "
-            "support or a contact pair that holds it"
+            f"contacts ({_free_motions(free[:, 3 * k : 3 * k + 3])}): add a support "
+            "([[dirichlet]] in a scene file, Dirichlet in Python) or a contact pair that holds it"
         )
     return hold.needs_contact()

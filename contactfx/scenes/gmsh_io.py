@@ -162,6 +162,8 @@ def open_mesh_file(
     suffix = path.suffix.lower()
     if suffix not in (".msh", ".geo"):
         raise InputError(f"mesh file {path}: expected a gmsh .msh or .geo file")
+    if path.is_dir():
+        raise InputError(f"mesh file {path} is a directory: give the path of a .msh or .geo file")
     if not path.is_file():
         raise InputError(f"mesh file {path} does not exist")
     if suffix == ".msh" and (size_factor != 1.0 or size_field is not None):
@@ -294,8 +296,15 @@ def scene_from_gmsh(
     return check_scene(scene)
 
 
-def _material(name: str, values: Mapping[str, float]) -> Material:
+def _material(name: str, values: object) -> Material:
     """A Material from {"E": ..., "nu": ...} (and "alpha", "dT"); InputError on other keys."""
+    if isinstance(values, Material):
+        return values
+    if not isinstance(values, Mapping):
+        raise InputError(
+            f"bodies['{name}']: expected a Material or a dict like {{'E': 200e3, 'nu': 0.3}}, "
+            f"got {type(values).__name__}"
+        )
     unknown = sorted(set(values) - {"E", "nu", "alpha", "dT"})
     if unknown or not {"E", "nu"} <= set(values):
         what = f"unknown key '{unknown[0]}'" if unknown else "E and nu are required"
@@ -337,7 +346,12 @@ def from_gmsh(
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
     """
-    mats = {k: v if isinstance(v, Material) else _material(k, v) for k, v in bodies.items()}
+    if not isinstance(bodies, Mapping) or not bodies:
+        raise InputError(
+            "bodies: expected a dict of body names (the mesh's physical surface groups) to "
+            f"materials, e.g. {{'block': {{'E': 200e3, 'nu': 0.3}}}}, got {type(bodies).__name__}"
+        )
+    mats = {str(k): _material(str(k), v) for k, v in bodies.items()}
     label = name or (
         Path(model_or_path).stem if isinstance(model_or_path, str | Path) else "gmsh-model"
     )
