@@ -69,8 +69,10 @@ class HertzParams:
     h_far: float = 0.0  # largest element size (cm); 0 = R / 6
 
 
+#: The Hertz scene's meshers (`--mesh`).
 MESHERS = ("gmsh", "structured")
 
+#: The paper's block scenes S1-S4 (`--preset`): their parameters over the defaults.
 BLOCK_SCENES: dict[str, BlockParams] = {
     "S1": BlockParams(),
     "S2": BlockParams(size1=0.08, size2=0.1),
