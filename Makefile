@@ -11,12 +11,14 @@ PYTHON312 := $(shell python3.12 -c 'import sys' >/dev/null 2>&1 && echo python3.
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: demo test bench bench-scale clean venv lock
+.PHONY: demo test docs bench bench-scale clean venv lock
 
 venv: $(STAMP)
 
-# The venv gets exactly the versions of requirements.lock (every package, pinned); without
-# the file it resolves pyproject.toml's ranges. `make lock` re-resolves the file.
+# The venv gets the versions of requirements.lock (every package pinned, the test and docs
+# extras included); `make demo`/`make test` install the package with its test extra under the
+# lock's constraints, so they need none of the docs packages; without the file the venv
+# resolves pyproject.toml's ranges. `make lock` re-resolves the file.
 LOCK      := requirements.lock
 UV        := uv==0.13.9
 PIP       := pip==26.3
@@ -26,7 +28,7 @@ $(STAMP): pyproject.toml $(wildcard $(LOCK))
 	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
 	$(PY) -m pip install --quiet $(PIP)
 	@if [ -f $(LOCK) ]; then \
-	  $(PY) -m pip install --quiet -r $(LOCK) && $(PY) -m pip install --quiet --no-deps -e . ; \
+	  $(PY) -m pip install --quiet -c $(LOCK) -e ".[test]" ; \
 	else \
 	  $(PY) -m pip install --quiet -e ".[test]" ; \
 	fi
@@ -36,7 +38,7 @@ $(STAMP): pyproject.toml $(wildcard $(LOCK))
 lock:
 	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
 	$(PY) -m pip install --quiet $(UV)
-	$(VENV)/bin/uv pip compile pyproject.toml --extra test --python-version 3.12 --universal \
+	$(VENV)/bin/uv pip compile pyproject.toml --extra test --extra docs --python-version 3.12 --universal \
 	  --no-header --quiet -o $(LOCK)
 
 demo: $(STAMP)
@@ -52,6 +54,21 @@ test: $(STAMP)
 	$(PY) -m pytest -q -n 2 -m serial tests
 	$(PY) -m pytest -q -m mpi tests
 
+# The site in docs/_build/html: the demos executed (CONTACTFX_QUICK=1 make docs: at the test
+# suite's small sizes), the references generated from the code, warnings as errors; -E: a fresh
+# environment, as the generated pages are rewritten on every build anyway.
+DOCS_STAMP := $(VENV)/.docs-installed
+$(DOCS_STAMP): $(STAMP)
+	@if [ -f $(LOCK) ]; then \
+	  $(PY) -m pip install --quiet -c $(LOCK) -e ".[docs]" ; \
+	else \
+	  $(PY) -m pip install --quiet -e ".[docs]" ; \
+	fi
+	@touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	$(PY) -m sphinx -b html -E -W --keep-going docs docs/_build/html
+
 bench: $(STAMP)
 	$(PY) benchmarks/run.py
 
@@ -60,4 +77,4 @@ bench-scale: $(STAMP)
 	$(PY) benchmarks/scale.py
 
 clean:
-	rm -rf results .pytest_cache
+	rm -rf results .pytest_cache docs/_build docs/demos docs/reference/api docs/reference/scene_file.md

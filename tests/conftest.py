@@ -4,10 +4,11 @@ tests/ranks/test_ranks.py), and a solver on a contact setup (solver_for).
 
 The tests are laid out like the package: tests/<stage>/ holds the tests of contactfx/<stage>/
 (contact, scenes, meshes, linalg, methods, results, adapt, study, cli), tests/ranks/ the
-1-rank vs 2-rank comparisons and tests/demos/ the demos and the README's examples. Every
-test file has a unique basename (no __init__.py: pytest puts each file's folder on sys.path,
-and this folder, so `from conftest import ...` works from any of them). Constants shared by
-several test files live here, never in a test module another one imports.
+1-rank vs 2-rank comparisons and tests/demos/ the demos and the examples of the README and
+docs/. Every test file has a unique basename (no __init__.py: pytest puts each file's folder
+on sys.path, and this folder, so `from conftest import ...` works from any of them).
+Constants shared by several test files live here, never in a test module another one
+imports.
 
 The rule for expected values: a deterministic number (same mesh, same solver) is pinned as a
 golden value at rel 1e-3 with its provenance (analytic, an independent computation, or a

@@ -160,7 +160,7 @@ def _solve_parser(sub: Any) -> None:
         "solve",
         help="solve a scene, print a summary, optionally write JSON",
         description="Solve one contact scene. SCENE is blocks (the paper's S1-S4), "
-        "hertz (S5) or a scene file SCENE.toml (see README, 'Your own scene').",
+        "hertz (S5) or a scene file SCENE.toml (see docs/scenes.md).",
     )
     s.add_argument("scene", help="blocks, hertz or a path to a scene .toml file")
     _builtin_scene_options(s)

@@ -39,6 +39,7 @@ class Kernel(StrEnum):
     MORTAR = "mortar"
 
 
+#: The contact operator of each kernel: contact_operator(kernel, ...) dispatches here.
 OPERATORS: dict[Kernel, Callable[..., ContactOperator]] = {
     Kernel.NTS: nts.contact_operator,
     Kernel.STS: sts.contact_operator,

@@ -2,7 +2,7 @@
 
 `RunSummary` is what `run_scene` returns beside the Solution: the CLI, the writers, the
 study and the adaptive loop read its attributes. Its `to_json()` is the schema of
-`contactfx solve --json` (README), the one place that schema is written.
+`contactfx solve --json` (docs/usage.md), the one place that schema is written.
 """
 
 from __future__ import annotations
@@ -248,7 +248,7 @@ class RunSummary:
         return replace(self, times={**self.times, **seconds})
 
     def to_json(self) -> dict[str, Any]:
-        """The JSON summary of `contactfx solve --json` (schema in README)."""
+        """The JSON summary of `contactfx solve --json` (schema in docs/usage.md)."""
         out: dict[str, Any] = {
             "scene": self.scene,
             "method": self.method.value,

@@ -191,7 +191,7 @@ def _max_error(values: list[float | None], exact: np.ndarray, scale: float) -> f
 
 
 def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
-    """Patch test against a uniform stress: max errors relative to the largest |ref_ij|."""
+    """Patch test against a uniform stress: max errors relative to the largest abs(ref_ij)."""
     sigma = np.asarray(ref.sigma, dtype=float)
     comm = sol.scene.comm
     scale = float(np.abs(sigma).max())

@@ -132,7 +132,7 @@ def body_vertex_stress(sol: Solution) -> dict[str, np.ndarray]:
 def body_stress_deviation(
     sol: Solution, target: float, component: tuple[int, int] = (1, 1)
 ) -> dict[str, float]:
-    """Max |sigma_ij / target - 1| over every cell vertex of each body (the patch-test measure)."""
+    """Max abs(sigma_ij / target - 1) over every cell vertex of each body (patch-test measure)."""
     comm = sol.scene.comm
     out = {}
     for name, vals in body_vertex_stress(sol).items():

@@ -67,7 +67,7 @@ def summary(
     memory: dict[str, float],
     paper_interface: bool = False,
 ) -> RunSummary:
-    """The summary record of a run (its JSON schema in README).
+    """The summary record of a run (its JSON schema in docs/usage.md).
 
     Args:
         sol: The solved scene.

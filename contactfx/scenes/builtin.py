@@ -74,8 +74,10 @@ class HertzParams:
     model: Model = Model.PLANE_STRAIN
 
 
+#: The Hertz scene's meshers (`--mesh`).
 MESHERS = ("gmsh", "structured")
 
+#: The paper's block scenes S1-S4 (`--preset`): their parameters over the defaults.
 BLOCK_SCENES: dict[str, BlockParams] = {
     "S1": BlockParams(),
     "S2": BlockParams(size1=0.08, size2=0.1),

@@ -1,7 +1,7 @@
 """Scene files: a TOML description of bodies, pairs, supports and loads next to a gmsh mesh.
 
 Every key is checked: an unknown or misspelled one is an InputError naming it and the keys
-allowed there (the schema is documented in README.md, "Your own scene").
+allowed there (the keys, types and defaults: schema.py, printed in docs/reference/scene_file.md).
 """
 
 from __future__ import annotations
@@ -32,36 +32,16 @@ from .model import (
     Units,
 )
 from .obstacle import OBSTACLE_SHAPES
+from .schema import SECTIONS, TYPE_ERRORS, allowed, required
 
-TOP_KEYS = {
-    "mesh",
-    "name",
-    "model",
-    "units",
-    "bodies",
-    "contact",
-    "obstacle",
-    "dirichlet",
-    "pressure",
-    "traction",
-    "reference",
-}
-SECTION_KEYS = {
-    "bodies": {"E", "nu", "alpha", "dT"},
-    "contact": {"active", "passive", "interference"},
-    "dirichlet": {"group", "ux", "uy"},
-    "pressure": {"group", "p"},
-    "traction": {"group", "t"},
-    "reference.hertz": {"type", "pair", "R", "P", "symmetric"},
-    "reference.uniform_stress": {"type", "sigma"},
-    "reference.lame": {"type", "pair", "a", "b", "c", "delta", "center"},
-    "obstacle": {"name", "shape", "surface", "displacement"},
-}
+# The allowed keys of each section, from the one table the reference page is generated from.
+TOP_KEYS = allowed("")
+SECTION_KEYS = {section: allowed(section) for section in SECTIONS if section}
 
 
 def _keys(where: str, table: Any, allowed: set[str], required: set[str]) -> dict[str, Any]:
     if not isinstance(table, dict):
-        raise InputError(f"{where}: expected a table of keys")
+        raise InputError(f"{where}: {TYPE_ERRORS['table']}")
     unknown = sorted(set(table) - allowed)
     if unknown:
         raise InputError(
@@ -73,9 +53,14 @@ def _keys(where: str, table: Any, allowed: set[str], required: set[str]) -> dict
     return table
 
 
+def _section(where: str, table: Any, section: str) -> dict[str, Any]:
+    """The keys of `table` checked against the schema's section (allowed and required)."""
+    return _keys(where, table, allowed(section), required(section))
+
+
 def _number(where: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InputError(f"{where}: expected a number, got {value!r}")
+        raise InputError(f"{where}: {TYPE_ERRORS['number']}, got {value!r}")
     if not math.isfinite(float(value)):
         raise InputError(f"{where}: expected a finite number, got {value!r}")
     return float(value)
@@ -83,7 +68,7 @@ def _number(where: str, value: Any) -> float:
 
 def _string(where: str, value: Any) -> str:
     if not isinstance(value, str) or not value:
-        raise InputError(f"{where}: expected a group name (a string), got {value!r}")
+        raise InputError(f"{where}: {TYPE_ERRORS['string']}, got {value!r}")
     return value
 
 
@@ -92,13 +77,13 @@ def _entries(doc: dict[str, Any], key: str) -> list[Any]:
     if isinstance(value, dict):
         return [value]
     if not isinstance(value, list):
-        raise InputError(f"{key}: expected one or more [[{key}]] tables")
+        raise InputError(f"{key}: {TYPE_ERRORS['tables'].replace('NAME', key)}")
     return value
 
 
 def _vector(where: str, value: Any) -> tuple[float, float]:
     if not (isinstance(value, list) and len(value) == 2):
-        raise InputError(f"{where}: expected a vector [x, y], got {value!r}")
+        raise InputError(f"{where}: {TYPE_ERRORS['vector']}, got {value!r}")
     return (_number(where, value[0]), _number(where, value[1]))
 
 
@@ -109,7 +94,7 @@ def _obstacle(k: int, entry: Any) -> Obstacle:
         raise InputError(f"obstacle {k}: shape must be one of {choices} (got {shape!r})")
     where = f"obstacle {k} ({shape})"
     takes = set(OBSTACLE_SHAPES[shape])
-    e = _keys(where, entry, SECTION_KEYS["obstacle"] | takes, {"shape", "surface"} | takes)
+    e = _keys(where, entry, SECTION_KEYS["obstacle"] | takes, required("obstacle") | takes)
     name = e.get("name", f"obstacle{k}")
     if not isinstance(name, str) or not name:
         raise InputError(f"{where}: name must be a non-empty string, got {name!r}")
@@ -119,7 +104,7 @@ def _obstacle(k: int, entry: Any) -> Obstacle:
             values[key] = _number(f"{where}.radius", e[key])
         elif key == "points":
             if not isinstance(e[key], list):
-                raise InputError(f"{where}.points: expected a list of points [[x, y], ...]")
+                raise InputError(f"{where}.points: {TYPE_ERRORS['points']}")
             values[key] = tuple(_vector(f"{where}.points", p) for p in e[key])
         else:
             values[key] = _vector(f"{where}.{key}", e[key])
@@ -150,7 +135,7 @@ def _interference(where: str, value: Any) -> bool | float:
 
 
 def _material(body: str, table: Any) -> Material:
-    e = _keys(f"bodies.{body}", table, SECTION_KEYS["bodies"], {"E", "nu"})
+    e = _section(f"bodies.{body}", table, "bodies")
     thermal = {k: _number(f"bodies.{body}.{k}", e[k]) for k in ("alpha", "dT") if k in e}
     mat = Material(
         _number(f"bodies.{body}.E", e["E"]), _number(f"bodies.{body}.nu", e["nu"]), **thermal
@@ -169,28 +154,28 @@ def _reference(k: int, entry: Any) -> Reference:
     if kind == "lame":
         return _lame(where, entry)
     if kind == "hertz":
-        e = _keys(where, entry, SECTION_KEYS["reference.hertz"], {"type", "R"})
+        e = _section(where, entry, "reference.hertz")
         pair = e.get("pair", 0)
         if isinstance(pair, bool) or not isinstance(pair, int):
             raise InputError(
-                f"{where}: pair must be an integer index into [[contact]], then [[obstacle]]"
+                f"{where}: pair: {TYPE_ERRORS['integer']} into [[contact]], then [[obstacle]]"
             )
         # An omitted `symmetric` takes the dataclass's default: one default for both APIs.
         flags = {"symmetric": e["symmetric"]} if "symmetric" in e else {}
         if not all(isinstance(v, bool) for v in flags.values()):
-            raise InputError(f"{where}: symmetric must be true or false")
+            raise InputError(f"{where}: symmetric: {TYPE_ERRORS['bool']}")
         # Without P (a displacement-controlled scene) the pair's computed force is the load.
         R = _number(f"{where}.R", e["R"])
         P = _number(f"{where}.P", e["P"]) if "P" in e else None
         if R <= 0 or (P is not None and P <= 0):
             raise InputError(f"{where}: R and P must be positive")
         return HertzReference(pair, R, P, **flags)
-    e = _keys(where, entry, SECTION_KEYS["reference.uniform_stress"], {"type", "sigma"})
+    e = _section(where, entry, "reference.uniform_stress")
     s = e["sigma"]
     if not (
         isinstance(s, list) and len(s) == 2 and all(isinstance(r, list) and len(r) == 2 for r in s)
     ):
-        raise InputError(f"{where}: sigma must be [[sxx, sxy], [syx, syy]]")
+        raise InputError(f"{where}: {TYPE_ERRORS['tensor']}")
     sig = tuple(tuple(_number(f"{where}.sigma", v) for v in row) for row in s)
     if sig[0][1] != sig[1][0]:
         raise InputError(f"{where}: sigma must be symmetric")
@@ -213,7 +198,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         raise InputError(f"cannot read scene file {path}: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"scene file {path} is not valid TOML: {exc}") from None
-    _keys(str(path.name), doc, TOP_KEYS, {"mesh", "bodies"})
+    _section(str(path.name), doc, "")
     if "contact" not in doc and "obstacle" not in doc:
         raise InputError(f"{path.name}: missing key 'contact' (or 'obstacle')")
     mesh = path.parent / _string("mesh", doc["mesh"])
@@ -227,7 +212,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         bodies[body] = _material(body, table)
     pairs = []
     for k, entry in enumerate(_entries(doc, "contact")):
-        e = _keys(f"contact {k}", entry, SECTION_KEYS["contact"], {"active", "passive"})
+        e = _section(f"contact {k}", entry, "contact")
         fit = _interference(f"contact {k}.interference", e.get("interference", False))
         pairs.append(
             ContactPair(
@@ -238,22 +223,22 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         )
     bcs = []
     for k, entry in enumerate(_entries(doc, "dirichlet")):
-        e = _keys(f"dirichlet {k}", entry, SECTION_KEYS["dirichlet"], {"group"})
+        e = _section(f"dirichlet {k}", entry, "dirichlet")
         comps = {c: _number(f"dirichlet {k}.{c}", e[c]) for c in ("ux", "uy") if c in e}
         if not comps:
             raise InputError(f"dirichlet {k} on '{e['group']}': give ux and/or uy")
         bcs.append(Dirichlet(_string(f"dirichlet {k}.group", e["group"]), **comps))
     loads: list[Load] = []
     for k, entry in enumerate(_entries(doc, "pressure")):
-        e = _keys(f"pressure {k}", entry, SECTION_KEYS["pressure"], {"group", "p"})
+        e = _section(f"pressure {k}", entry, "pressure")
         loads.append(
             Pressure(_string(f"pressure {k}.group", e["group"]), _number(f"pressure {k}.p", e["p"]))
         )
     for k, entry in enumerate(_entries(doc, "traction")):
-        e = _keys(f"traction {k}", entry, SECTION_KEYS["traction"], {"group", "t"})
+        e = _section(f"traction {k}", entry, "traction")
         t = e["t"]
         if not (isinstance(t, list) and len(t) == 2):
-            raise InputError(f"traction {k}: t must be a vector [tx, ty]")
+            raise InputError(f"traction {k}.t: {TYPE_ERRORS['vector']}, got {t!r}")
         loads.append(
             Traction(
                 _string(f"traction {k}.group", e["group"]),

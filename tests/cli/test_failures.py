@@ -64,7 +64,7 @@ def cli(tmp_path: Path, *args: str, mpi: int = 0) -> tuple[int, list[str], Path]
     """Run the CLI; return the exit code, the non-empty stderr lines and the JSON path.
 
     Serially in this process (main() is what turns an error into its line and exit code);
-    with `mpi`, as the README runs it, in fresh processes under mpirun.
+    with `mpi`, as docs/usage.md runs it, in fresh processes under mpirun.
     """
     out = tmp_path / "run.json"
     args = ("solve", *args, "--json", str(out), "-q")
