@@ -18,7 +18,7 @@ from conftest import ROOT
 import contactfx.cli
 from contactfx.cli.parser import parser
 from contactfx.errors import InputError
-from contactfx.scenes.model import OBSTACLE_SHAPES
+from contactfx.scenes.obstacle import OBSTACLE_SHAPES
 from contactfx.scenes.scene_file import SECTION_KEYS, TOP_KEYS, parse_scene_file
 from contactfx.scenes.schema import SECTIONS, SHAPE_KEYS, TYPE_ERRORS, reference_markdown
 
