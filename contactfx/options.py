@@ -276,15 +276,12 @@ _MUMPS_LU: dict[str, object] = {
     "pc_factor_mat_solver_type": "mumps",
     # The ordering (ICNTL(7)) is chosen by size where the solver is made
     # (methods/solvers.py, with_ordering) unless an option names one.
-    # CNTL(1) = 0.1, MUMPS' relative pivot threshold (default 0.01): with AMD the looser one
-    # left the LDL^T of the Hertz saddle point (6,856 DOFs) 2.0e-11 from the LU solution,
-    # against 3.5e-13 (PORD 1.1e-13), at the same cost for LDL^T and LU (44k DOFs: 0.16 and
-    # 0.19-0.20 s either way; docs/scale.md, "The ordering rule").
+    # CNTL(1) = 0.1, MUMPS' relative pivot threshold (default 0.01): the looser one left AMD's
+    # LDL^T visibly less accurate than LU, at no saving (docs/scale.md, "The ordering rule").
     "mat_mumps_cntl_1": 0.1,
 }
 # The saddle point is symmetric (indefinite): MUMPS' LDL^T (SYM=2, PETSc's Cholesky on a
-# matrix not flagged SPD); a fresh one is 0.85-0.88x of a fresh LU at 300k DOFs and
-# 0.93-1.10x at 1.2M-2M here (docs/scale.md, "Symmetric default").
+# matrix not flagged SPD), no slower than LU (docs/scale.md, "Symmetric default").
 _MUMPS_LDLT: dict[str, object] = {**_MUMPS_LU, "pc_type": "cholesky"}
 
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(

@@ -51,13 +51,9 @@ INVERSE_BLOCK: int | None = None
 """MUMPS ICNTL(27) while computing selected-inverse entries (restored afterwards); None:
 `inverse_block`'s rule (benchmarks/inverse_block.py sets it for its A/B)."""
 
-# Right-hand sides per block of the selected inverse, by the system's size. First step
-# (factorization + probes), mortar, alternating in one process: MUMPS' default -32 against
-# 64 on the 86k default-graded gmsh mesh (1,683 candidates) 2.88-2.90 -> 2.51-2.58 s; 64
-# against 256: 45k 0.464-0.472 vs 0.490-0.505 s, 86k 1.62-1.67 vs 1.63-1.66 s, structured
-# default 280k 1.93-2.00 vs 1.87-1.99 s, 584k 4.33-4.49 vs 4.00-4.25 s, 1.23M 12.27-12.55
-# vs 11.48-11.72 s, and on 2 ranks 2.41M (6,075 rows) 41.8-42.1 vs 36.7 s (512-2048:
-# 36.9-38.0 s). So 64 below the size where the ordering turns to PORD, 256 from it.
+# Right-hand sides per block of the selected inverse, by the system's size: larger blocks
+# pay once the factors are large (PORD's sizes); measured in
+# docs/scale.md#measured-constants ("Selected-inverse block").
 SMALL_BLOCK, LARGE_BLOCK, LARGE_FROM = 64, 256, 300_000
 
 

@@ -32,9 +32,9 @@ from .responses import ResponseCache, dense_responses, local_slice, selected_res
 log = logging.getLogger("contactfx")
 
 # A fresh factorization's single back-substitution is accepted at this relative residual,
-# as the reference solve (preonly) is accepted at any: MUMPS' own accuracy on these saddle
-# points is 1e-11 to 4e-8 (every row active, nts, 600k DOFs), where the solution agrees with
-# GMRES's to 1e-11. Above it GMRES (rtol 1e-13) takes over from that solution.
+# as the reference solve (preonly) is accepted at any: it is MUMPS' own accuracy on these
+# saddle points (docs/scale.md#measured-constants, "Back-substitution acceptance"). Above it
+# GMRES (rtol 1e-13) takes over from that solution.
 _APPLY_RTOL = 1e-7
 # GMRES around the factorization: one iteration with a fresh one, a few with a lagged one
 # (the change is low-rank); right preconditioning tests the true residual, modified

@@ -35,9 +35,8 @@ class ActiveSetOptions:
     tolerance: float = 1e-6  # complementarity residual (relative) required at the end
     probes: bool = True  # probe candidate sets with multi-RHS solves (direct solvers)
     # Largest candidate set probed (its dense block: 8 c^2 bytes, 512 MB at 8000). Above it
-    # the loop runs unprobed, a cliff: on the default-graded structured Hertz mesh at 1.23M
-    # DOFs (3,298 candidates) that took 16 steps and 89 s, probing them all 2 steps and 33 s;
-    # at 2.41M DOFs on 2 ranks (6,075 rows) 27 steps and 153 s against 2 steps and 35 s.
+    # the loop runs unprobed, which takes many more steps (docs/scale.md#measured-constants,
+    # "Largest probed set").
     max_probes: int = 8000
     # With cheap probe responses (serial MUMPS: selected entries of the inverse), start from
     # every multiplier row in contact and probe them all: one factorization, the predicted

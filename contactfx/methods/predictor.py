@@ -44,13 +44,8 @@ def scene_dofs(scene: Scene) -> int:
 
 # A direct solver's probes are selected entries of the inverse, whose cost grows with the
 # candidates: up to this many rows the loop starts from every row and probes them all, above
-# it from the coarse solve, probing only its uncertain band (about 20 rows). Contact solve,
-# mortar, serial, auto (all rows) against coarse, two runs each: 10H family, 45-187 rows,
-# the coarse solve costs 0.02-0.17 s more than it saves (gmsh 20k 0.055-0.066 vs 0.13 s,
-# 303k 1.92-1.94 vs 2.04-2.07 s; structured 319k 1.85-1.93 vs 1.91-1.92 s); default
-# grading: gmsh 44k / 871 rows 0.41-0.45 vs 0.35-0.36 s, 84k / 1,683 1.37-1.48 vs 0.65-0.67 s;
-# structured 280k / 869 1.92-2.00 vs 1.64-1.65 s, 584k / 1,681 3.99-4.07 vs 3.56-3.74 s,
-# 1.23M / 3,298 11.6-12.0 vs 8.6-8.8 s; on 2 ranks 2.41M / 6,075 37.8 vs 15.2 s.
+# it from the coarse solve, probing only its uncertain band (about 20 rows); the crossover is
+# measured in docs/scale.md#measured-constants ("Probe every row up to").
 PROBE_ALL_ROWS = 500
 
 
@@ -77,10 +72,10 @@ def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
 
 
 # The condensed loop runs unprobed: on its coarse mesh too it adds a ring of nodes, then
-# releases a few per step, each step CG with a lagged multigrid (10.46M DOFs on 2 ranks, its
-# 654k-DOF predictor: 9 steps and 127 s, 16-171 CG iterations, before it was stopped). The
-# coarse set is only a guess, so it is solved by the direct default (one factorization, all
-# rows probed) up to this many coarse DOFs.
+# releases a few per step, each step CG with a lagged multigrid, which is slow
+# (docs/scale.md#measured-constants, "Direct predictor"). The coarse set is only a guess, so
+# it is solved by the direct default (one factorization, all rows probed) up to this many
+# coarse DOFs.
 DIRECT_PREDICTOR_DOFS = 2_000_000
 
 

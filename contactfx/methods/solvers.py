@@ -18,9 +18,8 @@ from ..linalg.saddle import SaddleSolver
 from ..options import SchurPre, SolverKind, SolverSpec
 
 # MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the ordering below on
-# the host. Parallel analysis with PT-Scotch (ICNTL(28) = 2, ICNTL(29) = 1) orders
-# worse here: 2 ranks, 1.2M DOFs (structured Hertz, h_far 10h), warm LDL^T 21.9 s against
-# 14.6 s sequential (serial: 20.9 s), and at 2M 53.8 s against a serial 37.5 s.
+# the host; parallel analysis with PT-Scotch orders worse on these meshes
+# (docs/scale.md#measured-constants, "Sequential analysis").
 SEQUENTIAL_ANALYSIS: dict[str, object] = {"mat_mumps_icntl_28": 1}
 
 
@@ -31,12 +30,9 @@ def with_sequential_analysis(petsc: Mapping[str, object], ranks: int) -> Mapping
     return {**petsc, **SEQUENTIAL_ANALYSIS}
 
 
-# MUMPS' fill-reducing ordering (ICNTL(7)) by the number of DOFs. benchmarks/orderings.py on
-# the final Hertz saddle point (mortar, fresh LDL^T, medians of 3, both meshers' 10H family):
-# AMD 0.054 / 0.334 / 1.970 s against PORD 0.093 / 0.442 / 2.132 s (gmsh 28k / 102k / 396k),
-# 0.057 / 0.296 / 1.778 s against 0.097 / 0.354 / 1.587 s (structured 29k / 89k / 319k);
-# at 1.2M (structured, one run each) AMD takes 26.1 s, PORD 9.8 s. METIS and SCOTCH lose
-# everywhere (their analysis is slower), QAMD ties with AMD.
+# MUMPS' fill-reducing ordering (ICNTL(7)) by the number of DOFs: AMD's fill grows faster
+# than PORD's, which wins from a few hundred thousand DOFs (benchmarks/orderings.py;
+# docs/scale.md, "The ordering rule").
 AMD, PORD = 0, 4
 PORD_FROM_DOFS = 300_000
 ORDERING_KEY = "mat_mumps_icntl_7"

@@ -81,7 +81,7 @@ def write_fields(
     comm.Barrier()
     grid = field_grid(sol, cell_fields)
     piece = outdir / f"fields_p{comm.rank}.vtu"
-    # lz4: 3x faster than zlib for 1.6x the size (0.3 s against 0.9 s at 400k DOFs).
+    # lz4: faster than zlib for somewhat larger files (docs/scale.md#measured-constants).
     grid.save(str(piece), binary=True, compression="lz4")
     pieces = comm.gather(piece.name)
     main = outdir / "fields.pvtu"
