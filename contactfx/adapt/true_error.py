@@ -16,6 +16,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..methods.solution import Solution
+from ..scenes import Model
 
 _G = np.array([-0.861136311594053, -0.339981043584856, 0.339981043584856, 0.861136311594053])
 _W = np.array([0.347854845137454, 0.652145154862546, 0.652145154862546, 0.347854845137454])
@@ -130,13 +131,25 @@ def _locate(
     return best, np.clip(best_xi, 0.0, 1.0)
 
 
-def _energy_density(g: np.ndarray, E: np.ndarray, nu: np.ndarray) -> np.ndarray:
-    """sigma(g) : eps(g) for displacement gradients g (k, 2, 2), plane strain."""
+def _energy_density(
+    g: np.ndarray, E: np.ndarray, nu: np.ndarray, model: Model, hoop: np.ndarray | None = None
+) -> np.ndarray:
+    """sigma(g) : eps(g) for displacement gradients g (k, 2, 2) in `model`.
+
+    Plane stress takes lambda* = E nu / (1 - nu^2); axisymmetric adds the hoop strain
+    `hoop` (u_r / r at the points) to the strain and its trace.
+    """
     eps = 0.5 * (g + np.transpose(g, (0, 2, 1)))
-    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     mu = E / (2 * (1 + nu))
+    if model is Model.PLANE_STRESS:
+        lam = E * nu / (1 - nu**2)
+    else:
+        lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     tr = eps[:, 0, 0] + eps[:, 1, 1]
-    return 2 * mu * np.einsum("kij,kij->k", eps, eps) + lam * tr**2
+    out = 2 * mu * np.einsum("kij,kij->k", eps, eps)
+    if model is Model.AXISYMMETRIC and hoop is not None:
+        return out + 2 * mu * hoop**2 + lam * (tr + hoop) ** 2
+    return out + lam * tr**2
 
 
 def energy_error(sol: Solution, ref: Solution) -> dict[str, float] | None:
@@ -160,12 +173,22 @@ def energy_error(sol: Solution, ref: Solution) -> dict[str, float] | None:
     weight = np.tile(qw, len(fine.x)) * np.abs(det)
     body = np.repeat(fine.body, nq)
     gh = np.zeros_like(gref)
+    uh = np.zeros((len(pts), 2))
     for b in np.unique(body):
         mine = np.flatnonzero(body == b)
         cells = np.flatnonzero(coarse.body == b)
         c, xi = _locate(coarse, cells, pts[mine])
         gh[mine] = _grad(coarse.x[c], coarse.u[c], xi)[0]
+        uh[mine] = np.einsum("ka,kai->ki", _shape(xi)[0], coarse.u[c])
     E, nu = np.repeat(fine.E, nq), np.repeat(fine.nu, nq)
-    err = float(np.sqrt(np.sum(weight * _energy_density(gref - gh, E, nu))))
-    norm = float(np.sqrt(np.sum(weight * _energy_density(gref, E, nu))))
+    model = sol.scene.model
+    hoop_ref = hoop_err = None
+    if model is Model.AXISYMMETRIC:
+        # u_r / r at the Gauss points (never on the axis) and the 2 pi r of the measure.
+        r = pts[:, 0]
+        uref = np.einsum("ka,kai->ki", N, ur)
+        hoop_ref, hoop_err = uref[:, 0] / r, (uref[:, 0] - uh[:, 0]) / r
+        weight = weight * 2 * np.pi * r
+    err = float(np.sqrt(np.sum(weight * _energy_density(gref - gh, E, nu, model, hoop_err))))
+    norm = float(np.sqrt(np.sum(weight * _energy_density(gref, E, nu, model, hoop_ref))))
     return {"error": err, "norm": norm, "relative": err / norm}

@@ -134,3 +134,26 @@ def test_schwarz_estimate_refused() -> None:
     proc = cli("solve", "blocks", "--method", "schwarz", "--estimate")
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "--estimate" in proc.stderr
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize(("model", "rel"), [("plane_stress", 1e-10), ("axisymmetric", 1e-3)])
+def test_true_error_norm_is_the_models_energy(model: str, rel: float) -> None:
+    """The overkill measure's energy norm (numpy, 4 x 4 Gauss points) equals the model's
+    assembled a(u, u) (UFL): exactly for plane stress (polynomial integrands); to the
+    quadratures' difference in axisymmetric (the hoop term u_r^2 / r is not polynomial)."""
+    from dataclasses import replace
+
+    from dolfinx import fem
+    from mpi4py import MPI
+
+    from contactfx.discretize.elasticity import energy_form
+    from contactfx.scenes import BLOCK_SCENES, Model
+
+    params = replace(BLOCK_SCENES["S1"], model=Model(model), size1=0.5, size2=0.5)
+    sol, _ = contactfx.run_case("blocks", params, "mortar", comm=MPI.COMM_SELF)
+    el = sol.fields
+    a_uu = fem.assemble_scalar(fem.form(energy_form(sol.u, sol.u, el.E, el.nu, Model(model))))
+    got = energy_error(sol, sol)
+    assert got is not None and got["relative"] < 1e-12  # the point location's round-off
+    assert got["norm"] == pytest.approx(float(a_uu) ** 0.5, rel=rel)
