@@ -154,6 +154,14 @@ class SolverKind(StrEnum):
     FIELDSPLIT = "fieldsplit"  # PCFIELDSPLIT Schur on A00 = K + gamma B^T B
     CONDENSED = "condensed"  # active multipliers eliminated (D diagonal), CG + multigrid on u
     CONDENSED_DIRECT = "condensed-direct"  # the same system factorized (Cholesky)
+    # One MUMPS factorization of K + gamma B^T B with every multiplier row as its Schur
+    # variables; each active set a dense solve on that block (serial; linalg/schur.py).
+    DIRECT_SCHUR = "direct-schur"
+
+    @property
+    def factorizes_saddle(self) -> bool:
+        """Whether a MUMPS factorization of the whole saddle point answers (probes exact)."""
+        return self in (SolverKind.DIRECT, SolverKind.DIRECT_SCHUR)
 
     @property
     def augmented(self) -> bool:
@@ -216,6 +224,7 @@ class SolverSpec:
             SolverKind.FIELDSPLIT: pc != "fieldsplit",
             SolverKind.CONDENSED: pc in ("fieldsplit", "lu", "cholesky"),
             SolverKind.CONDENSED_DIRECT: pc not in ("lu", "cholesky"),
+            SolverKind.DIRECT_SCHUR: pc not in ("lu", "cholesky"),
         }[self.kind]
         if bad:
             fix = {
@@ -223,6 +232,7 @@ class SolverSpec:
                 SolverKind.FIELDSPLIT: "a fieldsplit solver needs pc_type fieldsplit",
                 SolverKind.CONDENSED: "it preconditions by multigrid (condensed-direct factorizes)",
                 SolverKind.CONDENSED_DIRECT: "it factorizes (pc_type cholesky or lu)",
+                SolverKind.DIRECT_SCHUR: "it factorizes (pc_type cholesky or lu)",
             }[self.kind]
             raise InputError(
                 f"solver '{self.name}' ({self.kind.value}): PETSc option pc_type={pc} "
@@ -288,6 +298,10 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
     {
         "mumps": SolverSpec(SolverKind.DIRECT, _MUMPS_LDLT, name="mumps"),
         "mumps-lu": SolverSpec(SolverKind.DIRECT, _MUMPS_LU, name="mumps-lu"),
+        # Opt-in (docs/scale.md, "The Schur route, measured"): MUMPS' Schur complement of
+        # every multiplier row, one factorization, each set a dense solve. Serial only: on
+        # several ranks the `mumps` path runs instead.
+        "mumps-schur": SolverSpec(SolverKind.DIRECT_SCHUR, _MUMPS_LDLT, name="mumps-schur"),
         # Schur fieldsplit, A00 = K + gamma B^T B factorized by MUMPS, S by Jacobi-GMRES.
         "fieldsplit": SolverSpec(
             SolverKind.FIELDSPLIT,

@@ -253,10 +253,12 @@ def reference_solve(
     """
     res, seconds = _timed_fresh_solve(setup, spec, scene, active)
     timers.seconds["reference_solve"] = seconds
-    if spec.kind is SolverKind.DIRECT:
+    if spec.kind.factorizes_saddle:
+        # The plain factorizations (a Schur-complement solver's floor too).
         for key, pc in (("reference_lu", "lu"), ("reference_ldlt", "cholesky")):
-            floor = replace(spec, petsc={**spec.petsc, "pc_type": pc}, name=f"{spec.name}:{pc}")
-            same = floor.petsc == spec.petsc
+            petsc = {**spec.petsc, "pc_type": pc}
+            floor = replace(spec, kind=SolverKind.DIRECT, petsc=petsc, name=f"{spec.name}:{pc}")
+            same = floor.petsc == spec.petsc and spec.kind is SolverKind.DIRECT
             timers.seconds[key] = (
                 seconds if same else _timed_fresh_solve(setup, floor, scene, active)[1]
             )

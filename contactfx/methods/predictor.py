@@ -63,7 +63,9 @@ def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
     (no probes at all), above COARSE_PREDICTOR_DOFS otherwise.
     """
     if predictor is Predictor.AUTO:
-        if spec.kind is SolverKind.DIRECT:
+        if spec.kind is SolverKind.DIRECT_SCHUR and scene.comm.size == 1:
+            return False  # every row's responses come from the dense Schur block
+        if spec.kind.factorizes_saddle:
             return scene.can_remesh and contact_facets(scene) > PROBE_ALL_ROWS
         if spec.kind.condensed:
             return True

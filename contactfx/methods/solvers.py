@@ -15,6 +15,7 @@ from ..linalg.nullspace import near_nullspace
 from ..linalg.policy import FactorizationPolicy
 from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
+from ..linalg.schur import SchurSolver, schur_available
 from ..options import SchurPre, SolverKind, SolverSpec
 
 # MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the ordering below on
@@ -94,13 +95,16 @@ def make_solver(
             # the cost rule of the saddle-point solver decides when to refactor.
             policy=FactorizationPolicy(reuse) if factorized else None,
         )
+    direct = spec.kind.factorizes_saddle
+    if spec.kind is SolverKind.DIRECT_SCHUR and schur_available(K.getComm()):
+        # gamma as the fieldsplit's: K + gamma B^T B scales as K; the whole loop on one factor.
+        return SchurSolver(K, B, f, with_ordering(spec.petsc, K.getSize()[0]), e_max / h**2)
     nullspace = None
     if spec.augmented:
         vectors = modes()
         nullspace = near_nullspace(vectors)
         for v in vectors:
             v.destroy()
-    direct = spec.kind is SolverKind.DIRECT
     return SaddleSolver(
         K,
         B,
