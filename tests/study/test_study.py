@@ -106,6 +106,17 @@ def test_hertz_study_rates_per_method(hertz_serial: tuple[dict, str, Path], meth
     assert len(errs) == 3 and errs[0] > errs[1] > errs[2], errs
 
 
+def test_axisymmetric_sphere_converges_as_the_plane_models_do(tmp_path: Path) -> None:
+    """The sphere on a block (axisymmetric, 3D Hertz) on the same three levels: mortar's L2
+    rate within 0.1 of its plane-strain expected rate, the errors fall, the finest < 1 %."""
+    data, _ = study((*HERTZ, "--model", "axisymmetric", "--methods", "mortar"), tmp_path)
+    assert data["levels"] and all(r["status"] == "ok" for r in data["runs"])
+    rate = data["rates"]["mortar"]["l2"]
+    assert abs(rate - EXPECTED_RATE["mortar"]) < RATE_EPS, data["rates"]
+    errs = [r["errors"]["l2"] for r in data["runs"]]
+    assert errs[0] > errs[1] > errs[2] and errs[2] < 0.01, errs
+
+
 def test_mortar_converges_faster_than_nts(hertz_serial: tuple[dict, str, Path]) -> None:
     """NTS's collocated pressure oscillates on non-matching meshes: a slower rate."""
     rates = hertz_serial[0]["rates"]
