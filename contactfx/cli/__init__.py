@@ -11,10 +11,7 @@ import sys
 from mpi4py import MPI
 
 from ..errors import ContactFxError
-from .adapt import run_adapt
 from .parser import parser
-from .solve import run
-from .study import run_command
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -27,9 +24,19 @@ def main(argv: list[str] | None = None) -> int:
         stream=sys.stdout,
     )
     try:
+        # Each subcommand's module is imported when it runs: a plain solve loads neither the
+        # adapt loop's charts (matplotlib) nor the study's tables.
         if args.command == "adapt":
+            from .adapt import run_adapt
+
             return run_adapt(args)
-        return run_command(args) if args.command == "study" else run(args)
+        if args.command == "study":
+            from .study import run_command
+
+            return run_command(args)
+        from .solve import run
+
+        return run(args)
     except ContactFxError as err:
         if rank == 0:
             print(f"contactfx: error: {err}", file=sys.stderr)

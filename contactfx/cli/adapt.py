@@ -9,7 +9,6 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from ..adapt.charts import chart_title, plot_adapt
 from ..adapt.goal import Goal
 from ..adapt.loop import AdaptOptions, uniform_levels
 from ..adapt.mesh_file import write_msh
@@ -112,6 +111,8 @@ def run_adapt(args: argparse.Namespace) -> int:
     written = write_fields(final.solution, out, (final.est.eta,))
     msh = write_msh(final.solution, out / "mesh.msh")
     if comm.rank == 0:
+        from ..adapt.charts import chart_title, plot_adapt  # matplotlib: rank 0, at the end
+
         assert msh is not None
         write_json(out / "adapt.json", result.to_json(args.scene, args.method, opts, args.solver))
         levels, uni = result.levels, result.uniform

@@ -10,15 +10,11 @@ from typing import Any
 
 from mpi4py import MPI
 
-from ..adapt.estimate import estimate
-from ..adapt.goal import GOAL_MEANING, Goal, goal_estimate
 from ..api import run_scene
 from ..errors import InputError
 from ..methods.solution import Solution
 from ..options import Enforcement
 from ..request import SolveRequest
-from ..results.figures import contact_window, deformed_fields, plot_interface, plot_pair
-from ..results.files import write_contact_surfaces, write_fields, write_json
 from ..results.records import RunSummary
 from ..timers import Timers
 from .params import build_from_args, is_scene_file, request_from_args
@@ -78,6 +74,8 @@ def terminal_summary(run: RunSummary) -> list[str]:
             lines.append(f"pressure estimate (relative L2): {100 * e.pressure:.3g} %")
         g = e.goal or {}
         if g.get("goal_estimate") is not None:
+            from ..adapt.goal import GOAL_MEANING, Goal  # the goal loop only with --goal
+
             lines.append(
                 f"{g['goal']} goal estimate: {100 * g['goal_estimate']:.3g} % "
                 f"({GOAL_MEANING[Goal(g['goal'])]}; refined solve {g['goal_refined_dofs']} DOFs)"
@@ -91,6 +89,8 @@ def goal_block(args: argparse.Namespace, request: SolveRequest, sol: Solution) -
     A scene without a geometry to remesh has none (`goal_estimate` null, `goal_note` why);
     GoalUnbounded (an InputError: one line, exit 2) where the goal has no finite value.
     """
+    from ..adapt.goal import Goal, goal_estimate  # the refined solve's machinery, on request
+
     goal = Goal(args.goal)
     if sol.scene.recipe is None or getattr(args, "mesh", None) == "structured":
         note = "no geometry to remesh: the goal estimate needs a refined solve"
@@ -118,10 +118,16 @@ def run(args: argparse.Namespace) -> int:
     )
     cells: tuple[Any, ...] = ()
     if args.estimate:
+        from ..adapt.estimate import estimate  # the estimator's forms only with --estimate
+
         est = estimate(sol)
         summary = replace(est.summary(), goal=goal_block(args, request, sol))
         record = record.with_estimate(summary)
         cells = (est.eta,)
+    if args.out is not None or args.json is not None:
+        # The writers (and through them pyvista and matplotlib) only when a file is asked for.
+        from ..results.figures import contact_window, deformed_fields, plot_interface, plot_pair
+        from ..results.files import write_contact_surfaces, write_fields, write_json
     if args.out is not None:
         write_fields(sol, args.out, cells)
     log = logging.getLogger("contactfx")

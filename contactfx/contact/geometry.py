@@ -7,7 +7,6 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components, depth_first_order
-from scipy.spatial import cKDTree
 
 # Samples fetched per point in the first KD-tree round (twice that per run of grouped points);
 # multiplied by 4 for the points not settled yet.
@@ -119,6 +118,8 @@ class SegmentSearch:
         frac /= np.repeat(pieces, pieces)
         samples = a[self._owner] + frac[:, None] * ab[self._owner]
         self._reach = float((0.5 * length / pieces).max()) if m else 0.0
+        from scipy.spatial import cKDTree  # scipy.spatial (~0.15 s) when a search is built
+
         self._tree = cKDTree(samples) if m else None
         # Distances within this of the minimum count as ties (e.g. a point on a shared vertex).
         self._eps = 1e-12 * max(float(length.max()) if m else 0.0, np.finfo(float).tiny)

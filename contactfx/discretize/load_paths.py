@@ -11,7 +11,8 @@ unconstrained by these equations (elasticity decides them) and count as able to 
 The rows that can carry load come from one linear program (HiGHS): the equilibria form a
 convex cone in (lam, s) (s scales the load), so the rows positive in some equilibrium are
 positive together in one, and maximizing sum min(lam_i, 1) over it finds them all at once
-(each t_i is 1 or 0 at the optimum, far from HiGHS's feasibility tolerance). If no
+(each t_i is 1 or 0 at the optimum, far from HiGHS's feasibility tolerance); a single free
+mode (a body free along one direction, the usual case) is decided in closed form. If no
 nonnegative lam balances the load, a Farkas certificate (a combination of free modes along
 which the load does work and no gap closes) names the bodies that the load pulls away.
 """
@@ -25,7 +26,6 @@ import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
-from scipy.optimize import linprog
 
 from ..contact.geometry import Surface
 from ..errors import SingularSystemError
@@ -114,6 +114,30 @@ def carrying_rows(a: np.ndarray, load: np.ndarray) -> np.ndarray | None:
     j = np.flatnonzero(on)
     if not j.size:
         return out if not load.any() else None
+    if a.shape[1] == 1:
+        return _one_mode(a[:, 0], float(load[0]), out)
+    return _carrying_lp(a, load, j, out)
+
+
+def _one_mode(a: np.ndarray, load: float, out: np.ndarray) -> np.ndarray | None:
+    """carrying_rows with one free mode (a body free along one direction), in closed form.
+
+    sum a_i lam_i = -load, lam >= 0: the rows of the sign of -load can carry it, and then
+    every other nonzero row too (its share is balanced by more on the first); with no load
+    the nonzero rows carry only if both signs are present (the body squeezed). The LP's
+    answer without scipy.optimize (imported only for two or more free modes).
+    """
+    pos, neg = bool((a > 0).any()), bool((a < 0).any())
+    if (load < 0 and not pos) or (load > 0 and not neg):
+        return None
+    out[a != 0] = load != 0 or (pos and neg)
+    return out
+
+
+def _carrying_lp(
+    a: np.ndarray, load: np.ndarray, j: np.ndarray, out: np.ndarray
+) -> np.ndarray | None:
+    """carrying_rows by the linear program (HiGHS), `j` the rows some free mode acts on."""
     # Each lam_i scaled by its row's size: the same signs, a well-scaled program.
     aj = a[j] / np.abs(a[j]).max(axis=1, keepdims=True)
     fl = load / max(float(np.abs(load).max()), 1e-300)
@@ -124,6 +148,8 @@ def carrying_rows(a: np.ndarray, load: np.ndarray) -> np.ndarray | None:
     a_ub = sp.hstack([-eye, sp.csr_matrix((m, 1)), eye])
     c = np.concatenate([np.zeros(m + 1), -np.ones(m)])
     bounds = [(0.0, None)] * m + [(1.0, None)] + [(0.0, 1.0)] * m
+    from scipy.optimize import linprog  # scipy.optimize (~0.15 s) only for 2+ free modes
+
     res = linprog(c, a_ub, np.zeros(m), a_eq, np.zeros(k), bounds=bounds, method="highs")
     if res.status == 2:
         return None
@@ -141,6 +167,8 @@ def pulled_away(a: np.ndarray, load: np.ndarray) -> np.ndarray:
     on = np.abs(a).max(axis=1, initial=0.0) > 0.0
     aj = a[on] / np.abs(a[on]).max(axis=1, keepdims=True)
     fl = load / max(float(np.abs(load).max()), 1e-300)
+    from scipy.optimize import linprog  # scipy.optimize (~0.15 s) only for a refusal
+
     res = linprog(
         np.zeros(k),
         -aj if aj.size else None,

@@ -11,7 +11,6 @@ import logging
 from dataclasses import replace
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..discretize.mesh_utils import owned_facets
 from ..errors import InputError
@@ -110,6 +109,8 @@ def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0)
     inwards: a coarse node-to-segment zone overshoots the fine one by up to two elements).
     The coarse element size is the largest node spacing in the coarse contact zone.
     """
+    from scipy.spatial import cKDTree  # scipy.spatial only when the coarse predictor runs
+
     x = np.asarray(coarse.layout.x)[:, :2]
     act = np.asarray(coarse.active, dtype=bool)
     if not act.any():

@@ -250,11 +250,12 @@ def test_active_set_iteration_limit(method: str, limit: int) -> None:
 def test_cli_turns_every_error_type_into_one_line(err: type, monkeypatch, capsys) -> None:
     """Whatever contactfx error a run raises, main() prints one line and returns 2."""
     from contactfx import cli
+    from contactfx.cli import solve as cli_solve
 
     def fail(args: object) -> int:
         raise err(f"{err.__name__} raised on purpose")
 
-    monkeypatch.setattr(cli, "run", fail)
+    monkeypatch.setattr(cli_solve, "run", fail)
     assert cli.main(["solve", "blocks"]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
     assert lines == [f"contactfx: error: {err.__name__} raised on purpose"]

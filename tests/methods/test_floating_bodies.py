@@ -18,7 +18,7 @@ import pytest
 from conftest import ROOT, cli, run_cli
 
 from contactfx import load_scene_file, run_scene
-from contactfx.discretize.load_paths import carrying_rows, pulled_away
+from contactfx.discretize.load_paths import _carrying_lp, _one_mode, carrying_rows, pulled_away
 from contactfx.discretize.setup import prepare_contact
 from contactfx.errors import SingularSystemError
 from contactfx.methods.active_set import ActiveSetOptions
@@ -73,6 +73,21 @@ def test_rows_that_can_carry_load_by_statics(
     """Which rows are positive in some lam >= 0 with rows^T lam + load = 0 (hand statics)."""
     got = carrying_rows(np.array(rows), np.array(load))
     assert got is not None and got.tolist() == carries
+
+
+@pytest.mark.parametrize("load", [-2.0, 0.0, 3.0])
+def test_one_free_mode_in_closed_form_agrees_with_the_program(load: float) -> None:
+    """Every sign pattern of four rows on one mode: the closed form is the LP's verdict."""
+    for signs in np.ndindex(3, 3, 3, 3):
+        a = (np.array(signs, dtype=float) - 1.0) * np.array([1.0, 2.5, 0.3, 7.0])
+        j = np.flatnonzero(a)
+        if not j.size:
+            continue
+        lp = _carrying_lp(a[:, None], np.array([load]), j, np.ones(4, dtype=bool))
+        closed = _one_mode(a, load, np.ones(4, dtype=bool))
+        assert (lp is None) == (closed is None), (a, load)
+        if lp is not None and closed is not None:
+            assert lp.tolist() == closed.tolist(), (a, load)
 
 
 def test_load_that_pulls_a_block_off_has_no_equilibrium() -> None:

@@ -1,0 +1,61 @@
+"""A plain solve loads no plotting, no pyvista and no scipy piece only some paths need.
+
+Module presence in a fresh interpreter, not a timing: importing the command line, parsing
+`solve hertz` and importing the module that runs it must leave matplotlib (the charts),
+pyvista (the field files), scipy.optimize (the floating-body LP) and scipy.spatial (the
+KD-trees of the search) unloaded; each is imported where it is first used (docs/scale.md,
+"Time to the first answer").
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+DEFERRED = ("matplotlib", "pyvista", "scipy.optimize", "scipy.spatial")
+
+PROBE = f"""
+import json, sys
+from contactfx.cli import parser
+args = parser().parse_args(["solve", "hertz"])
+assert args.command == "solve"
+import contactfx.cli.solve  # what main() imports to run it
+print(json.dumps(sorted(m for m in {DEFERRED!r} if m in sys.modules)))
+"""
+
+
+# A whole solve (coarse Hertz: one free mode, decided without the LP) loads none of them
+# either, but for the search's KD-trees.
+SOLVE = f"""
+import json, sys
+from contactfx.cli import main
+assert main(["solve", "hertz", "--refine", "0.1", "-q"]) == 0
+print(json.dumps(sorted(m for m in {DEFERRED!r} if m in sys.modules)))
+"""
+
+
+def loaded(probe: str, tmp_path: Path) -> list[str]:
+    """The DEFERRED modules present at the end of `probe` in a fresh interpreter."""
+    out = subprocess.run(
+        [sys.executable, "-c", probe],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+        cwd=tmp_path,
+    )
+    return list(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+@pytest.mark.serial
+def test_command_line_imports_no_plotting_and_no_optional_scipy(tmp_path: Path) -> None:
+    assert loaded(PROBE, tmp_path) == []
+
+
+@pytest.mark.serial
+def test_plain_solve_loads_no_plotting_no_pyvista_no_lp(tmp_path: Path) -> None:
+    assert loaded(SOLVE, tmp_path) == ["scipy.spatial"]
