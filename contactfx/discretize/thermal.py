@@ -28,7 +28,7 @@ from dolfinx import fem, mesh
 from ..scenes import Model, Scene
 
 # A number or a UFL expression (the stub types UFL's arithmetic loosely).
-type Coefficient = Any
+Coefficient = Any
 
 
 @dataclass(frozen=True)
