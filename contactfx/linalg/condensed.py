@@ -25,10 +25,14 @@ from .pivots import pivots
 from .policy import Decision, FactorizationPolicy
 from .protocol import SaddleResult
 
-# Pivot changes since the multigrid was built (summed over ranks) below which it is reused.
-REBUILD_CHANGES = 64
-# ... or below this fraction of the pivots.
-REBUILD_FRACTION = 0.2
+# Pivot changes since the multigrid was built (summed over ranks) below which it is reused,
+# or below this fraction of the pivots. Each changed pivot costs the kept cycle about one
+# CG iteration, and a fresh cycle (ICC-smoothed GAMG) takes 15-30, so a few dozen changes
+# already cost more than a new setup: Hertz, 50k DOFs, no predictor, 64 / 20 % gave loose
+# solves of 48-67 iterations on the kept cycle, 8 / 5 % 9-36 (docs/scale.md, "GAMG on
+# stretched cells").
+REBUILD_CHANGES = 8
+REBUILD_FRACTION = 0.05
 
 
 class CondensedSolver:

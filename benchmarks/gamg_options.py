@@ -1,0 +1,208 @@
+"""GAMG's options for the condensed solver on stretched cells: CG iterations per option set.
+
+One process per mesh (`--mesh structured|gmsh`, Hertz, `--refine H --h-far 10H`, gmsh also
+`--refine-edge H/4`: benchmarks/run.py's 10H family), dual mortar, the Hertz zone x < a
+active (a fixed set: no active-set loop). For every option set (`SETS`: each adds PETSc
+options to the `condensed` preset) one fresh condensed solve from zero to the preset's final
+tolerance (the throwaway solver of `--reference-timing`): CG iterations, setup and solve
+seconds (ratios within one process only). `--bonded` also solves the same K with the active
+pivots fixed (the contact rows' coupling terms E^T K + K E + E^T K E left out: a Dirichlet
+version of the same mesh), to see what the contact block costs the cycle.
+
+    python benchmarks/gamg_options.py --mesh structured --dofs 100e3,400e3 --json out.json
+    python benchmarks/gamg_options.py --mesh gmsh --dofs 2e6 --sets base,chosen --mumps
+
+`--mumps`: also the `mumps` saddle-point solve of the same set (analysis + factorization +
+solve), timed in the same process. Appends one record per (size, set) to the JSON file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import json
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, cast
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+# benchmarks/run.py, next to this script: on sys.path as its folder.
+from run import EDGE_RATIO, refine_for
+
+from contactfx.contact import Kernel
+from contactfx.discretize.setup import prepare_contact
+from contactfx.discretize.supports import rigid_body_modes
+from contactfx.linalg.elimination import LocalRows, condensed_matrix, elimination_matrix
+from contactfx.linalg.nullspace import orthonormalize
+from contactfx.linalg.petsc_options import PrefixedOptions
+from contactfx.linalg.pivots import pivots
+from contactfx.methods.multipliers import _timed_fresh_solve
+from contactfx.options import SOLVERS, Basis, SolverSpec
+from contactfx.scenes import HertzParams, hertz
+from contactfx.timers import Timers
+
+# The `condensed` preset before this study: GAMG's own Chebyshev/Jacobi smoother.
+BASE: dict[str, object] = {
+    "ksp_type": "cg",
+    "ksp_norm_type": "unpreconditioned",
+    "ksp_max_it": 5000,
+    "pc_type": "gamg",
+    "pc_gamg_threshold": 0.01,
+    "pc_gamg_aggressive_coarsening": 1,
+}
+ICC = {"mg_levels_pc_type": "bjacobi", "mg_levels_sub_pc_type": "icc"}
+# Each set adds these PETSc options to BASE; "chosen" is the `condensed` preset as it is.
+SETS: dict[str, dict[str, object]] = {
+    "base": {},
+    "chosen": {},
+    "thr0": {"pc_gamg_threshold": 0.0},
+    "thr0.02": {"pc_gamg_threshold": 0.02},
+    "thr0.05": {"pc_gamg_threshold": 0.05},
+    "thr0.1": {"pc_gamg_threshold": 0.1},
+    "thr0.2": {"pc_gamg_threshold": 0.2},
+    "thr0.05s0.5": {"pc_gamg_threshold": 0.05, "pc_gamg_threshold_scale": 0.5},
+    "agg0": {"pc_gamg_aggressive_coarsening": 0},
+    "agg0-thr0.05": {"pc_gamg_aggressive_coarsening": 0, "pc_gamg_threshold": 0.05},
+    "sor": {"mg_levels_pc_type": "sor"},
+    "pbjacobi": {"mg_levels_pc_type": "pbjacobi"},
+    "icc": ICC,
+    "cheby4": {"mg_levels_ksp_max_it": 4},
+    "sa_esteig0": {"pc_gamg_use_sa_esteig": False},
+    "coarse5k": {"pc_gamg_coarse_eq_limit": 5000},
+    "thr0.05-sor": {"pc_gamg_threshold": 0.05, "mg_levels_pc_type": "sor"},
+    "thr0.05-icc": {"pc_gamg_threshold": 0.05, **ICC},
+    "thr0.1-icc": {"pc_gamg_threshold": 0.1, **ICC},
+    "agg0-icc": {"pc_gamg_aggressive_coarsening": 0, **ICC},
+    "thr0.05-pbj": {"pc_gamg_threshold": 0.05, "mg_levels_pc_type": "pbjacobi"},
+    "icc-it1": {"mg_levels_ksp_max_it": 1, **ICC},
+    "icc-coarse5k": {"pc_gamg_coarse_eq_limit": 5000, **ICC},
+    "icc-thr0.02": {"pc_gamg_threshold": 0.02, **ICC},
+    "icc1": {"mg_levels_sub_pc_factor_levels": 1, **ICC},
+    "icc-it3": {"mg_levels_ksp_max_it": 3, **ICC},
+    "thr0.05-icc-it3": {"pc_gamg_threshold": 0.05, "mg_levels_ksp_max_it": 3, **ICC},
+    "thr0.05-icc1-it3": {
+        "pc_gamg_threshold": 0.05,
+        "mg_levels_ksp_max_it": 3,
+        "mg_levels_sub_pc_factor_levels": 1,
+        **ICC,
+    },
+}
+
+
+def spec_for(name: str) -> SolverSpec:
+    """The condensed preset as it is (`chosen`), or its former options with SETS[name]."""
+    preset = SOLVERS["condensed"]
+    if name == "chosen":
+        return preset
+    return replace(preset, petsc={**BASE, **SETS[name]}, name=f"condensed-{name}")
+
+
+def bonded_solve(setup: Any, scene: Any, active: np.ndarray, spec: SolverSpec) -> tuple[int, float]:
+    """The same K with the active pivots fixed (no contact coupling), CG + GAMG from zero."""
+    K, f = setup.elasticity.K, setup.elasticity.f
+    comm = K.getComm()
+    r0, r1 = K.getOwnershipRange()
+    n = K.getSize()[0]
+    pv = pivots(LocalRows.of(setup.B, setup.node_dofs()), active, comm.tompi4py(), r0, n)
+    piv = pv.dofs
+    ip: Any = piv.astype(PETSc.IntType)
+    E = elimination_matrix({}, r0, r1, n, comm, False)  # no coupling: Dirichlet pivots
+    diag = K.getDiagonal()
+    A = condensed_matrix(K, E, piv, diag)
+    modes = rigid_body_modes(setup.elasticity.V, scene)
+    for m in modes:
+        m.setValues(ip, cast(Any, np.zeros(len(piv))))
+        m.assemble()
+    orthonormalize(modes)
+    A.setNearNullSpace(PETSc.NullSpace().create(vectors=modes, comm=comm))
+    b = f.copy()
+    b.setValues(ip, cast(Any, np.zeros(len(piv))))
+    b.assemble()
+    x = b.duplicate()
+    x.set(0.0)
+    opts = PrefixedOptions(spec.petsc)
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOptionsPrefix(opts.prefix)
+    t0 = time.perf_counter()
+    with opts.inserted():
+        ksp.setOperators(A)
+        ksp.setFromOptions()
+        ksp.setTolerances(rtol=spec.rtol)
+        ksp.setUp()
+        ksp.solve(b, x)
+    seconds = time.perf_counter() - t0
+    its = ksp.getIterationNumber()
+    for obj in (ksp, A, E, diag, b, x, *modes):
+        obj.destroy()
+    return its, seconds
+
+
+def main() -> None:
+    """Mesh each size once, then every option set on the same fixed set; append to JSON."""
+    ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    ap.add_argument("--mesh", default="structured", choices=("structured", "gmsh"))
+    ap.add_argument("--dofs", default="100e3,400e3", help="comma list of target DOFs")
+    ap.add_argument("--sets", default=",".join(SETS), help="comma list of SETS names")
+    ap.add_argument("--bonded", action="store_true", help="also the Dirichlet version")
+    ap.add_argument("--mumps", action="store_true", help="also the MUMPS saddle-point solve")
+    ap.add_argument("--json", type=Path, default=Path("gamg_options.json"))
+    args = ap.parse_args()
+    comm = MPI.COMM_WORLD
+    records: list[dict[str, Any]] = []
+    if args.json.exists() and comm.rank == 0:
+        records = json.loads(args.json.read_text())
+    for target in (float(d) for d in args.dofs.split(",")):
+        h = refine_for(target, args.mesh)
+        params = HertzParams(
+            refine=h,
+            h_far=10 * h,
+            mesh=args.mesh,
+            **({"refine_edge": h / EDGE_RATIO} if args.mesh == "gmsh" else {}),
+        )
+        scene = hertz(params, comm=comm)
+        setup = prepare_contact(scene, Kernel.MORTAR, 1e-8, Timers(), Basis.DUAL)
+        layout = setup.layout
+        active = layout.x[layout.mine, 0] < scene.params["hertz_exact"]["a"]
+        dofs = setup.elasticity.K.getSize()[0]
+        common = {"mesh": args.mesh, "h": h, "dofs": dofs, "ranks": comm.size}
+        common["active"] = comm.allreduce(int(active.sum()))
+        if args.mumps:
+            gc.collect()
+            res, sec = _timed_fresh_solve(setup, SOLVERS["mumps"], scene, active)
+            records.append({**common, "set": "mumps", "its": res.iterations, "seconds": sec})
+            say(records[-1], comm)
+        for name in args.sets.split(","):
+            gc.collect()
+            spec = spec_for(name)
+            rec: dict[str, Any] = {**common, "set": name, "options": dict(spec.petsc)}
+            try:
+                res, sec = _timed_fresh_solve(setup, spec, scene, active)
+                rec.update(its=res.iterations, seconds=sec, setup=res.setup, solve=res.solve)
+            except Exception as err:  # one set's failure must not hide the others
+                rec["error"] = f"{type(err).__name__}: {err}"
+            if args.bonded:
+                its, sec = bonded_solve(setup, scene, active, spec)
+                rec.update(bonded_its=its, bonded_seconds=sec)
+            records.append(rec)
+            say(rec, comm)
+            if comm.rank == 0:
+                args.json.write_text(json.dumps(records, indent=1))
+        setup.destroy()
+        del scene
+    if comm.rank == 0:
+        args.json.write_text(json.dumps(records, indent=1))
+
+
+def say(rec: dict[str, Any], comm: MPI.Comm) -> None:
+    """One line per record (rank 0)."""
+    if comm.rank == 0:
+        keep = ("mesh", "dofs", "set", "its", "seconds", "setup", "solve", "bonded_its", "error")
+        print(json.dumps({k: rec[k] for k in keep if k in rec}), flush=True)
+
+
+if __name__ == "__main__":
+    main()
