@@ -359,20 +359,15 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "ksp_norm_type": "unpreconditioned",
                 "ksp_max_it": 5000,
                 "pc_type": "gamg",
-                # 0.05 drops the weak couplings across stretched cells from the aggregation
-                # graph; it matters little beside the smoother (docs/scale.md, "GAMG on
-                # stretched cells").
+                # Why each of these: docs/scale.md, "GAMG on stretched cells". The threshold
+                # drops weak couplings across stretched cells from the aggregation graph;
+                # ICC(0) blocks keep the strong couplings along them that point Jacobi
+                # cannot (iterations independent of cell shape); three Chebyshev steps, not
+                # two, for fewer iterations (each step costs more).
                 "pc_gamg_threshold": 0.05,
                 "pc_gamg_aggressive_coarsening": 1,
-                # Chebyshev smoothing preconditioned by ICC(0) per rank (block Jacobi) instead
-                # of point Jacobi: an incomplete factorization keeps the strong couplings
-                # along stretched cells (aspect up to 10) that a point smoother cannot, so
-                # the iterations no longer depend on cell shape (docs/scale.md, "GAMG on
-                # stretched cells"; benchmarks/gamg_options.py).
                 "mg_levels_pc_type": "bjacobi",
                 "mg_levels_sub_pc_type": "icc",
-                # Three Chebyshev steps per level, not two: fewer iterations at every size
-                # (the choice was by iteration count; each costs more: docs/scale.md).
                 "mg_levels_ksp_max_it": 3,
             },
             rtol=1e-9,
