@@ -284,14 +284,11 @@ _MUMPS_LU: dict[str, object] = {
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
-    # The ordering (ICNTL(7)) is chosen by size where the solver is made
-    # (methods/solvers.py, with_ordering) unless an option names one.
-    # CNTL(1) = 0.1, MUMPS' relative pivot threshold (default 0.01): the looser one left AMD's
-    # LDL^T visibly less accurate than LU, at no saving (docs/scale.md, "The ordering rule").
+    # The ordering (ICNTL(7)) is chosen by size in methods/solvers.py. CNTL(1) = 0.1 (default
+    # 0.01): AMD's LDL^T is as accurate as LU then (docs/scale.md, "The ordering rule").
     "mat_mumps_cntl_1": 0.1,
 }
-# The saddle point is symmetric (indefinite): MUMPS' LDL^T (SYM=2, PETSc's Cholesky on a
-# matrix not flagged SPD), no slower than LU (docs/scale.md, "Symmetric default").
+# The saddle point is symmetric (indefinite): LDL^T (docs/scale.md, "Symmetric default").
 _MUMPS_LDLT: dict[str, object] = {**_MUMPS_LU, "pc_type": "cholesky"}
 
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
@@ -341,8 +338,7 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "fieldsplit_u_pc_type": "gamg",
                 "fieldsplit_u_pc_gamg_threshold": 0.01,
                 "fieldsplit_u_pc_gamg_reuse_interpolation": True,
-                # SOR: stretched cells of graded meshes defeat Chebyshev/Jacobi (docs/scale.md).
-                "fieldsplit_u_mg_levels_pc_type": "sor",
+                "fieldsplit_u_mg_levels_pc_type": "sor",  # stretched cells: docs/scale.md
                 "fieldsplit_lambda_ksp_type": "preonly",
                 "fieldsplit_lambda_pc_type": "jacobi",
             },
