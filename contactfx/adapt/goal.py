@@ -31,7 +31,7 @@ from ..methods.solution import PairView, Solution
 from ..options import SolverSpec
 from ..request import SolveRequest
 from ..results.interface import pair_forces
-from ..scenes import SizeField
+from ..scenes import Model, SizeField
 from .estimate import estimate
 from .sizing import owned_cells, vertex_sizes
 from .true_error import energy_error
@@ -170,35 +170,51 @@ def _surface_points(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(mids), np.concatenate(lengths)
 
 
-def _pressure_curve(pv: PairView, pressure: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(s, p): the pair's multipliers along its active surface's arc length, sorted."""
+def _pressure_curve(
+    pv: PairView, pressure: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(s, p, x): the pair's multipliers along its surface's arc length, sorted, and x.
+
+    x is each node's x coordinate: the radius of an axisymmetric model.
+    """
     s_all = pv.arc[0]
     p = np.zeros(len(s_all))
     p[pv.nodes] = pressure[pv.rows]
     keep = np.isfinite(s_all)
     order = np.argsort(s_all[keep], kind="stable")
-    return s_all[keep][order], p[keep][order]
+    x = pv.active.surface.x[:, 0]
+    return s_all[keep][order], p[keep][order], x[keep][order]
 
 
-def _l2_pl(s: np.ndarray, v: np.ndarray) -> float:
-    """L2 norm of the piecewise-linear function with nodal values v at sorted abscissae s."""
+def _l2_pl(s: np.ndarray, v: np.ndarray, r: np.ndarray | None = None) -> float:
+    """L2 norm of the piecewise-linear v at sorted abscissae s, exactly.
+
+    With r (piecewise linear too: an axisymmetric surface's radius) weighted by r.
+    """
     h = np.diff(s)
     a, b = v[:-1], v[1:]
-    return float(np.sqrt(np.sum(h * (a * a + a * b + b * b) / 3.0)))
+    if r is None:
+        return float(np.sqrt(np.sum(h * (a * a + a * b + b * b) / 3.0)))
+    ra, rb = r[:-1], r[1:]
+    w = a * a * (3 * ra + rb) / 12 + a * b * (ra + rb) / 6 + b * b * (ra + 3 * rb) / 12
+    return float(np.sqrt(np.sum(h * w)))
 
 
 def pressure_difference(
-    coarse: tuple[np.ndarray, np.ndarray], fine: tuple[np.ndarray, np.ndarray]
+    coarse: tuple[np.ndarray, ...], fine: tuple[np.ndarray, ...], radial: bool = False
 ) -> tuple[float, float]:
     """(||p_c - p_f||_L2, ||p_f||_L2) of two piecewise-linear pressures along arc length.
 
     Both are evaluated on the union of their nodes, where the difference is again piecewise
-    linear, so the integral is exact.
+    linear, so the integral is exact. `radial` (an axisymmetric model, curves (s, p, x)):
+    the L2 norm over the revolved surface, weighted by the radius x, as the Hertz
+    reference's error is.
     """
     s = np.union1d(coarse[0], fine[0])
-    pc = np.interp(s, *coarse, left=0.0, right=0.0)
-    pf = np.interp(s, *fine, left=0.0, right=0.0)
-    return _l2_pl(s, pc - pf), _l2_pl(s, pf)
+    pc = np.interp(s, coarse[0], coarse[1], left=0.0, right=0.0)
+    pf = np.interp(s, fine[0], fine[1], left=0.0, right=0.0)
+    r = np.interp(s, fine[0], fine[2]) if radial else None
+    return _l2_pl(s, pc - pf, r), _l2_pl(s, pf, r)
 
 
 def _check_bounded(sol: Solution, ref: Solution) -> None:
@@ -274,7 +290,9 @@ def goal_estimate(
         _check_bounded(sol, ref)
         for pv, pr in zip(sol.pairs, ref.pairs, strict=True):
             d, n = pressure_difference(
-                _pressure_curve(pv, sol.pressure), _pressure_curve(pr, ref.pressure)
+                _pressure_curve(pv, sol.pressure),
+                _pressure_curve(pr, ref.pressure),
+                radial=sol.scene.model is Model.AXISYMMETRIC,
             )
             parts[pv.label] = d / n / (1.0 - q) if n > 0 else 0.0
         relative = max(parts.values(), default=0.0)

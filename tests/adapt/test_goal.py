@@ -38,6 +38,21 @@ def test_pressure_difference_is_exact_for_piecewise_linear() -> None:
     assert n == pytest.approx(np.sqrt(np.trapezoid(pf**2, s)), rel=1e-8)
 
 
+def test_radial_pressure_difference_is_the_revolved_l2_norm() -> None:
+    """Axisymmetric: weighted by the radius x (linear along each segment), exactly."""
+    coarse = (np.array([0.0, 1.0, 2.0]), np.array([2.0, 1.0, 0.0]), np.array([0.0, 1.0, 2.0]))
+    fine = (
+        np.array([0.0, 0.7, 1.3, 2.0]),
+        np.array([2.1, 1.2, 0.8, 0.0]),
+        np.array([0.0, 0.7, 1.3, 2.0]),
+    )
+    d, n = pressure_difference(coarse, fine, radial=True)
+    s = np.linspace(0.0, 2.0, 400001)
+    pc, pf = np.interp(s, *coarse[:2]), np.interp(s, *fine[:2])
+    assert d == pytest.approx(np.sqrt(np.trapezoid((pc - pf) ** 2 * s, s)), rel=1e-8)
+    assert n == pytest.approx(np.sqrt(np.trapezoid(pf**2 * s, s)), rel=1e-8)
+
+
 def test_refined_field_halves_only_near_contact() -> None:
     """Pressure goal: the contact band at half size, the far field untouched."""
     sol = contactfx.solve(hertz(HertzParams(refine=0.2, h_far=10.0, refine_edge=0.0)), "mortar")
