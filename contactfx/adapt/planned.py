@@ -165,7 +165,7 @@ def adapt_to_goal(
             if dofs <= opts.max_dofs and dofs <= OVERSHOOT * target:
                 break
             # gmsh made more than planned (vertex sizes are the smallest of the cells
-            # around: x 1.4 on the coarse levels) or than the budget: plan again for the
+            # around, which overshoots most on coarse levels) or than the budget: plan again for the
             # growth planned, rather than stop or take a level off the plan.
             cells *= target / dofs
             if dofs > opts.max_dofs:

@@ -27,10 +27,8 @@ from .protocol import SaddleResult
 
 # Pivot changes since the multigrid was built (summed over ranks) below which it is reused,
 # or below this fraction of the pivots. Each changed pivot costs the kept cycle about one
-# CG iteration, and a fresh cycle (ICC-smoothed GAMG) takes 15-30, so a few dozen changes
-# already cost more than a new setup: Hertz, 50k DOFs, no predictor, 64 / 20 % gave loose
-# solves of 48-67 iterations on the kept cycle, 8 / 5 % 9-36 (docs/scale.md, "GAMG on
-# stretched cells").
+# CG iteration, while a fresh ICC-smoothed cycle needs few, so a few dozen changes already
+# cost more than a new setup (measured: docs/scale.md, "GAMG on stretched cells").
 REBUILD_CHANGES = 8
 REBUILD_FRACTION = 0.05
 
