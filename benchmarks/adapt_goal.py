@@ -7,14 +7,16 @@ effectivity (estimate / exact). The flat punch (pressure unbounded: --goal energ
 the pressure's max error at x <= 0.7 b against Sadowsky's half-plane pressure, relative to
 p(0) (tests/methods/test_obstacles.py `sadowsky_errors`, benchmarks/punch_adapt.py).
 
-Run: python benchmarks/adapt_goal.py [--cases r1,r08,budget,fine,punch] [--json FILE]
-(serial; r1, r08, budget and punch a few minutes together, fine ~10 min).
+Run: python benchmarks/adapt_goal.py [--cases r1,r08,budget,fine,punch,r12,r12fine,cyl]
+[--json FILE] (serial; r1, r08, budget and punch a few minutes together, fine ~10 min);
+`--table A.json B.json` prints the README table of runs made in parts.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -26,6 +28,11 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 UNGRADED = ["hertz", "--refine", "1.0", "--h-far", "10", "--refine-edge", "0"]
 HELD_OUT = ["hertz", "--refine", "0.8", "--h-far", "8", "--refine-edge", "0"]
+# A start no planning choice was tuned on (issue 30's contact-levels and zone-halving fixes).
+HELD_OUT_12 = ["hertz", "--refine", "1.2", "--h-far", "12", "--refine-edge", "0"]
+# tests/scenes/two_cylinders.toml from a coarse ungraded start: one size 0.8 along the contact
+# (a = 1.10: under two cells on the half zone), growing x 1 per unit distance to R/6.
+CYLINDERS_COARSE = {"hc1": 0.8, "hc2": 0.8, "slope": 1.0}
 PUNCH = [str(ROOT / "demos" / "scenes" / "rigid_punch.toml"), "--method", "nts"]
 # The half model's exact force (benchmarks/punch_adapt.py: Richardson on graded meshes).
 PUNCH_FORCE = 17.890563
@@ -34,6 +41,9 @@ CASES: dict[str, list[str]] = {
     "r08": [*HELD_OUT, "--tol", "0.002", "--max-dofs", "60000"],
     "budget": [*UNGRADED, "--tol", "1e-6", "--max-dofs", "60000"],
     "fine": [*UNGRADED, "--tol", "0.0005", "--max-dofs", "250000"],
+    "r12": [*HELD_OUT_12, "--tol", "0.002", "--max-dofs", "60000"],
+    "r12fine": [*HELD_OUT_12, "--tol", "0.0005", "--max-dofs", "250000"],
+    "cyl": ["two_cylinders.toml", "--tol", "0.002", "--max-dofs", "60000"],
     "punch": [*PUNCH, "--goal", "energy", "--tol", "0.01", "--max-dofs", "100000"],
 }
 
@@ -48,14 +58,29 @@ def sadowsky_inner(level: dict[str, Any], b: float = 1.0, reach: float = 0.7) ->
     return float(np.max(np.abs(p[inner] - exact)) / (P / (np.pi * b)))
 
 
+def coarse_cylinders(folder: Path) -> Path:
+    """A copy of tests/scenes/two_cylinders.toml whose .geo has CYLINDERS_COARSE's sizes."""
+    src = ROOT / "tests" / "scenes"
+    geo = (src / "two_cylinders.geo").read_text()
+    for name, value in CYLINDERS_COARSE.items():
+        geo = re.sub(rf"{name} = {{[^,]*,", f"{name} = {{{value},", geo, count=1)
+    (folder / "two_cylinders.geo").write_text(geo)
+    toml = folder / "two_cylinders.toml"
+    toml.write_text((src / "two_cylinders.toml").read_text())
+    return toml
+
+
 def run_case(name: str, args: list[str]) -> dict[str, Any]:
     """One `contactfx adapt` command: its levels and why it stopped."""
     with tempfile.TemporaryDirectory() as tmp:
-        cmd = [sys.executable, "-m", "contactfx", "adapt", *args, "--out", tmp]
+        if args[0] == "two_cylinders.toml":
+            args = [str(coarse_cylinders(Path(tmp))), *args[1:]]
+        out = str(Path(tmp) / "out")
+        cmd = [sys.executable, "-m", "contactfx", "adapt", *args, "--out", out]
         proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
         if proc.returncode != 0:
             return {"case": name, "command": args, "error": proc.stderr.strip()}
-        data = json.loads((Path(tmp) / "adapt.json").read_text())
+        data = json.loads((Path(out) / "adapt.json").read_text())
     rows, cumulative = [], 0.0
     for lv in data["levels"]:
         cumulative += lv["time"]
@@ -66,6 +91,7 @@ def run_case(name: str, args: list[str]) -> dict[str, Any]:
             "exact": lv.get("exact_error"),
             "effectivity": lv.get("effectivity"),
             "refined_dofs": lv.get("goal_refined_dofs"),
+            "halvings": lv.get("goal_halvings"),
         }
         if name == "punch":
             row["p_sadowsky_07"] = sadowsky_inner(lv)
@@ -102,7 +128,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--cases", default="r1,r08,budget,punch", help="comma-separated names")
     ap.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "adapt_goal.json")
+    ap.add_argument("--table", type=Path, nargs="*", help="print the table of these JSONs only")
     args = ap.parse_args()
+    if args.table:
+        print("\n".join(table([r for f in args.table for r in json.loads(f.read_text())])))
+        return
     results = []
     for name in args.cases.split(","):
         results.append(run_case(name, CASES[name]))

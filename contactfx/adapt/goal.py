@@ -2,11 +2,27 @@
 
 The level's solution is compared with a second solve of the same scene on a mesh whose
 cells near the contact are halved (the pressure goal: the cells within a few contact cells
-of the surfaces and within half a zone length of each contact zone, where the pressure's
+of the surfaces and within REACH zone lengths of each contact zone, where the pressure's
 error is made) or whose every cell is halved (energy, force). If the error behaves like
 C h^r, the difference d = ||q_h - q_h/2|| lies between (1 - 2^-r) and (1 + 2^-r) times
 ||q - q_h||, so d / (1 - 2^-r) is between 1 and (1 + 2^-r) / (1 - 2^-r) times the error:
 for the pressure (P1 multipliers, a square-root edge: L2 rate 1.5 in h) between 1 and 2.1.
+That bound needs the refined solution in the asymptotic range, and a zone of two or three
+cells is not: on the ungraded Hertz start with contact size 1 (two loaded segments) the
+halved mesh's error was 0.83 of the level's, not 2^-1.5 = 0.35, and the estimate 2.06 x
+the error. So the pressure goal halves the contact cells k times, k the smallest (at most
+MAX_HALVINGS) that puts ZONE_SEGMENTS loaded segments across the narrowest zone, and
+extrapolates with q = 2^(-1.5 k): quartered, the same start's refined error was 0.08-0.22
+of the level's on four starts (q = 0.125 assumed) and the estimate 1.10-1.19 x the error
+(docs/adapt.md). A resolved zone keeps k = 1: the refinement costs nothing past level 0.
+The same bound needs the refinement to reach every cell whose error the pressure carries:
+the near field's too. Halving only the cells within half a zone length left 0.46-0.60 of
+the error in the refined solution on adapted Hertz levels of 8-25k DOFs (q assumed 0.35;
+the estimate fell to 0.70 x the error at 138k DOFs), halving every cell 0.24-0.36; within
+REACH = 4 zone lengths 0.24-0.27, at 3.7 x the level's DOFs (every cell: 4.6-4.9 x).
+The rate stays the assumed 1.5: an observed one needs a third solve (near-only halvings
+cannot see the far part at all) or the level sequence, whose pre-asymptotic levels (an
+error that stalls from one level to the next) would make it meaningless there.
 In the energy norm the two errors are nearly orthogonal (Galerkin): d / sqrt(1 - q^2), q
 the ratio of the residual estimates of the two meshes (the observed rate; the estimator's
 constant cancels). The force is an energy-squared quantity: rate 2. docs/adapt.md has the
@@ -58,8 +74,14 @@ Q_MAX = 0.9
 BAND = 3.0
 
 # And the cells within this many zone lengths of a pair's contact zone: the pressure's error
-# is also the near field's (the stresses that set the zone's width), not only its own cells.
-REACH = 0.5
+# is also the near field's (the stresses that set the zone's width), not only its own cells
+# (the docstring: 0.5 missed half the error on adapted levels).
+REACH = 4.0
+
+# The pressure goal's refined mesh puts at least this many loaded segments across each
+# contact zone (halving its contact cells up to MAX_HALVINGS times; see the docstring).
+ZONE_SEGMENTS = 8
+MAX_HALVINGS = 3
 
 # A peak pressure that grows by more than this factor when the contact cells are halved is
 # singular: a 1/sqrt peak grows by sqrt(2) = 1.41 per halving, a bounded one tends to 1.
@@ -77,14 +99,17 @@ class GoalEstimate:
     goal: Goal
     relative: float  # estimated relative error of the level's solution in the goal
     parts: dict[str, float]  # per pair (pressure, force); energy: difference d and ratio q
-    rate: float  # r of the extrapolation d / (1 - 2^-r)
+    rate: float  # r of the extrapolation d / (1 - 2^(-r k))
     dofs: int  # DOFs of the refined solve
     seconds: float  # remesh + refined solve + comparison
     reference: Solution  # the refined solution (a better answer than the level's own)
+    halvings: int = 1  # k: the refined mesh's near cells are 2^-k of the level's
 
     def record(self) -> GoalRecord:
         """The estimate without the refined solution."""
-        return GoalRecord(self.goal, self.relative, dict(self.parts), self.dofs, self.seconds)
+        return GoalRecord(
+            self.goal, self.relative, dict(self.parts), self.dofs, self.seconds, self.halvings
+        )
 
 
 GOAL_MEANING = {
@@ -103,6 +128,7 @@ class GoalRecord:
     parts: dict[str, float]
     dofs: int  # DOFs of the refined solve (0: none, the residual estimate calibrated)
     seconds: float
+    halvings: int = 1  # how often the refined mesh halved the contact cells
 
     def to_json(self) -> dict[str, Any]:
         """The JSON fields `goal`, `goal_estimate`, `goal_parts`, `goal_refined_dofs`."""
@@ -112,6 +138,7 @@ class GoalRecord:
             "goal_parts": dict(self.parts),
             "goal_refined_dofs": self.dofs,
             "goal_seconds": self.seconds,
+            "goal_halvings": self.halvings,
         }
 
 
@@ -142,6 +169,19 @@ def refined_field(
                 close |= cKDTree(zone).query(mid)[0] <= reach * length
         factor[close] = near
     return vertex_sizes(sol.scene.comm, quads, verts, h * factor)
+
+
+def zone_halvings(sol: Solution) -> int:
+    """k: halvings of the contact cells that put ZONE_SEGMENTS loaded segments across each zone.
+
+    1 when every zone already has ZONE_SEGMENTS / 2 (or no pair carries load), at most
+    MAX_HALVINGS.
+    """
+    counts = [len(zone) for zone, _ in _zones(sol) if len(zone)]
+    k = 1
+    while counts and min(counts) * 2**k < ZONE_SEGMENTS and k < MAX_HALVINGS:
+        k += 1
+    return k
 
 
 def _zones(sol: Solution) -> list[tuple[np.ndarray, float]]:
@@ -259,7 +299,8 @@ def goal_estimate(
 
     Args:
         sol: A multiplier-method solution of a scene that can be remeshed.
-        goal: pressure (contact cells halved), energy or force (every cell halved).
+        goal: pressure (contact cells halved k times, zone_halvings), energy or force
+            (every cell halved).
         solver: The refined solve's solver (the level's own, normally), or the level's
             whole SolveRequest (penalty, mortar's basis: the refined solve is the same).
         options: Further `api.solve` options of the level's solve (not `initial`).
@@ -273,9 +314,12 @@ def goal_estimate(
     goal = Goal(goal)
     r = RATES[goal] if rate is None else rate
     t0 = time.perf_counter()
-    far = 1.0 if goal is Goal.PRESSURE else 0.5
-    ref = _refined(sol, refined_field(sol, far=far, reach=reach), solver, options or {})
-    q = 2.0**-r
+    # Energy and force halve every cell once; the pressure its contact cells k times.
+    k = zone_halvings(sol) if goal is Goal.PRESSURE else 1
+    far, near = (1.0, 0.5**k) if goal is Goal.PRESSURE else (0.5, 0.5)
+    field = refined_field(sol, far=far, near=near, reach=reach)
+    ref = _refined(sol, field, solver, options or {})
+    q = 2.0 ** (-r * k)
     parts: dict[str, float] = {}
     if goal is Goal.ENERGY:
         e = sol.scene.comm.bcast(energy_error(sol, ref), root=0)
@@ -301,7 +345,8 @@ def goal_estimate(
             fine = _force(ref, k)
             parts[pv.label] = abs(_force(sol, k) - fine) / max(fine, 1e-300) / (1.0 - q)
         relative = max(parts.values(), default=0.0)
-    return GoalEstimate(goal, float(relative), parts, r, ref.dofs, time.perf_counter() - t0, ref)
+    seconds = time.perf_counter() - t0
+    return GoalEstimate(goal, float(relative), parts, r, ref.dofs, seconds, ref, k)
 
 
 def _force(sol: Solution, k: int) -> float:

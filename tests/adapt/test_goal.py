@@ -12,6 +12,7 @@ from contactfx.adapt.goal import (
     goal_estimate,
     pressure_difference,
     refined_field,
+    zone_halvings,
 )
 from contactfx.adapt.true_error import energy_error
 from contactfx.results.references import hertz_summary
@@ -71,6 +72,21 @@ def test_hertz_pressure_effectivity(refine: float) -> None:
     exact = hertz_summary(sol).l2_error
     g = goal_estimate(sol, "pressure")
     assert 0.9 <= g.relative / exact <= 2.0, (g.relative, exact)
+
+
+def test_unresolved_zone_is_refined_until_resolved() -> None:
+    """Two loaded segments (contact size 1): halving once left the error at 0.83 of the
+    level's and the estimate at 2.06 x the error; the zone is quartered instead."""
+    sol = contactfx.solve(hertz(HertzParams(refine=1.0, h_far=10.0, refine_edge=0.0)), "mortar")
+    assert zone_halvings(sol) == 2
+    g = goal_estimate(sol, Goal.PRESSURE)
+    assert g.halvings == 2 and g.record().to_json()["goal_halvings"] == 2
+    exact = hertz_summary(sol).l2_error
+    assert 0.9 <= g.relative / exact <= 2.0, (g.relative, exact)
+    assert hertz_summary(g.reference).l2_error < 0.5 * exact
+    # A resolved zone is halved once, as before.
+    fine = contactfx.solve(hertz(HertzParams(refine=0.1, h_far=10.0, refine_edge=0.0)), "mortar")
+    assert zone_halvings(fine) == 1
 
 
 def test_singular_pressure_is_refused() -> None:

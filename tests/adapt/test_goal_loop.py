@@ -12,8 +12,18 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, cli
 
+import contactfx
+from contactfx.adapt.estimate import estimate
 from contactfx.adapt.goal import Goal
-from contactfx.adapt.planned import BUDGET_FILL, MARGIN, MIN_LEVELS, plan_growth
+from contactfx.adapt.planned import (
+    BUDGET_FILL,
+    MARGIN,
+    MIN_LEVELS,
+    PRESSURE_AIM,
+    contact_levels,
+    plan_growth,
+)
+from contactfx.scenes import HertzParams, hertz
 
 # The coarse ungraded start of the issue: contact size 1.0, h_far 10, no edge refinement.
 UNGRADED = ("hertz", "--refine", "1.0", "--h-far", "10", "--refine-edge", "0")
@@ -33,6 +43,34 @@ def test_close_to_tol_the_observed_rate_decides() -> None:
     assert g == pytest.approx(MARGIN * (0.02 / 0.03) ** (1 / s))
 
 
+def test_levels_the_contact_owes_spread_the_budget_further() -> None:
+    """More levels owed than MIN_LEVELS: the budget's room over those; never past --max-levels."""
+    room = BUDGET_FILL * 250_000 / 1000
+    g = plan_growth([(1000, 0.3)], 0.0005, 250_000, Goal.PRESSURE, owed=9)
+    assert g == pytest.approx(room ** (1 / 9))
+    g = plan_growth([(1000, 0.3)], 0.0005, 250_000, Goal.PRESSURE, owed=9, allowed=7)
+    assert g == pytest.approx(room ** (1 / 7))
+    # Fewer owed than MIN_LEVELS: MIN_LEVELS decides, as before.
+    g = plan_growth([(1000, 0.3)], 0.0005, 250_000, Goal.PRESSURE, owed=2)
+    assert g == pytest.approx(room ** (1 / (MIN_LEVELS - 1)))
+
+
+def test_contact_levels_count_the_quarter_steps_to_the_tolerance() -> None:
+    """The ungraded start (contact size 1): the edge needs many x 1/4 steps for a tight
+    tolerance, fewer for a loose one, none for a tolerance already met."""
+    scene = hertz(HertzParams(refine=1.0, h_far=10.0, refine_edge=0.0))
+    sol = contactfx.solve(scene, "mortar")
+    pe = estimate(sol).pressure
+    assert pe is not None and pe.relative < 1.0
+    tight = contact_levels(sol, pe, PRESSURE_AIM * 0.0005, 0.25)
+    loose = contact_levels(sol, pe, PRESSURE_AIM * 0.02, 0.25)
+    assert tight > loose >= 1 and tight >= MIN_LEVELS
+    assert contact_levels(sol, pe, 2.0 * pe.relative, 0.25) == 0
+    # x 1/2 per level needs twice the steps (log 4 / log 2), within the rounding up.
+    halves = contact_levels(sol, pe, PRESSURE_AIM * 0.0005, 0.5)
+    assert 2 * tight - 2 <= halves <= 2 * tight
+
+
 def test_never_past_the_budget() -> None:
     assert plan_growth([(50_000, 0.01)], 1e-6, 54_000, Goal.PRESSURE) is None
     g = plan_growth([(10_000, 0.01)], 1e-6, 15_000, Goal.PRESSURE)
@@ -45,8 +83,8 @@ def test_never_past_the_budget() -> None:
 def test_hertz_tol_is_the_pressure_error(tmp_path: Path) -> None:
     """Defaults only, the ungraded start: the pressure estimate stops the loop at --tol.
 
-    Measured (docs/adapt.md): 6 levels, 1,052 to 57,812 DOFs, exact L2 0.077 % at the stop
-    (estimate 0.0865 %), effectivity 1.12-2.06 (level 0, one cell across the zone: 2.06).
+    Measured (docs/adapt.md): 6 levels, 1,052 to 31,032 DOFs, exact L2 0.103 % at the stop
+    (estimate 0.116 %), effectivity 1.13-1.57 (level 0, quartered zone: 1.19).
     """
     proc = cli("adapt", *UNGRADED, "--tol", "0.002", "--max-dofs", "60000", "--out", str(tmp_path))
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
