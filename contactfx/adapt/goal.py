@@ -8,21 +8,18 @@ C h^r, the difference d = ||q_h - q_h/2|| lies between (1 - 2^-r) and (1 + 2^-r)
 ||q - q_h||, so d / (1 - 2^-r) is between 1 and (1 + 2^-r) / (1 - 2^-r) times the error:
 for the pressure (P1 multipliers, a square-root edge: L2 rate 1.5 in h) between 1 and 2.1.
 That bound needs the refined solution in the asymptotic range, and a zone of two or three
-cells is not: on the ungraded Hertz start with contact size 1 (two loaded segments) the
-halved mesh's error was 0.83 of the level's, not 2^-1.5 = 0.35, and the estimate 2.06 x
-the error. So the pressure goal halves the contact cells k times, k the smallest (at most
-MAX_HALVINGS) that puts ZONE_SEGMENTS loaded segments across the narrowest zone, and
-extrapolates with q = 2^(-1.5 k): quartered, the same start's refined error was 0.08-0.22
-of the level's on four starts (q = 0.125 assumed) and the estimate 1.10-1.19 x the error
-(docs/adapt.md). A resolved zone keeps k = 1: the refinement costs nothing past level 0.
-The same bound needs the refinement to reach every cell whose error the pressure carries:
-the near field's too. Halving only the cells within half a zone length left 0.46-0.60 of
-the error in the refined solution on adapted Hertz levels of 8-25k DOFs (q assumed 0.35;
-the estimate fell to 0.70 x the error at 138k DOFs), halving every cell 0.24-0.36; within
-REACH = 4 zone lengths 0.24-0.27, at 3.7 x the level's DOFs (every cell: 4.6-4.9 x).
-The rate stays the assumed 1.5: an observed one needs a third solve (near-only halvings
-cannot see the far part at all) or the level sequence, whose pre-asymptotic levels (an
-error that stalls from one level to the next) would make it meaningless there.
+cells is not: halved once, such a zone's refined error stays close to the level's, and the
+estimate overshoots the band. So the pressure goal halves the contact cells k times, k the
+smallest (at most MAX_HALVINGS) that puts ZONE_SEGMENTS loaded segments across the
+narrowest zone, and extrapolates with q = 2^(-1.5 k). A resolved zone keeps k = 1: the
+extra refinement costs something on the coarsest levels only. The same bound needs the
+refinement to reach every cell whose error the pressure carries, the near field's too:
+halving only the cells within half a zone length missed about half the error on adapted
+levels, REACH zone lengths about what halving every cell sees, at a smaller cost. The rate
+stays the assumed 1.5: an observed one needs a third solve (near-only halvings cannot see
+the far part, common to both refined solves) or the level sequence, whose pre-asymptotic
+levels (an error that stalls from one level to the next) would make it meaningless where
+it matters. docs/adapt.md ("Zone halvings and REACH 4") has the measurements.
 In the energy norm the two errors are nearly orthogonal (Galerkin): d / sqrt(1 - q^2), q
 the ratio of the residual estimates of the two meshes (the observed rate; the estimator's
 constant cancels). The force is an energy-squared quantity: rate 2. docs/adapt.md has the
@@ -75,7 +72,7 @@ BAND = 3.0
 
 # And the cells within this many zone lengths of a pair's contact zone: the pressure's error
 # is also the near field's (the stresses that set the zone's width), not only its own cells
-# (the docstring: 0.5 missed half the error on adapted levels).
+# (the docstring; docs/adapt.md has the measurements).
 REACH = 4.0
 
 # The pressure goal's refined mesh puts at least this many loaded segments across each

@@ -10,13 +10,11 @@ most the budget itself (90 % of --max-dofs). The levels owed: MIN_LEVELS, or for
 pressure goal more if its contact cells need more. A contact cell shrinks at most x 1/4 per
 level (SizingRule.finest), and the pressure's error is made there: a level planned to grow
 more than the contact zone can use spends the rest on the bulk, where the pressure gains
-little (measured, docs/adapt.md: with --max-dofs 250000 and six levels the third adapted
-level had 29,804 DOFs and 0.45 %, the zone's cells as small as those of a 11,476-DOF level
-of a 60k budget, the rest bulk). So the contact cells' request for the tolerance (the
-pressure indicator aimed at PRESSURE_AIM tol, unclipped) gives the levels it takes at
-x 1/4 each, and the budget is spread over at least those (at most over the levels
---max-levels leaves). Sizing: the pressure goal sizes
-the contact cells with the pressure indicator (adapt/pressure_sizing.py) aimed at
+little (docs/adapt.md, "Growth rule": a 250k budget spread over six levels). So the
+contact cells' request for the tolerance (the pressure indicator aimed at PRESSURE_AIM tol,
+unclipped) gives the levels it takes at x 1/4 each, and the budget is spread over at least
+those (at most over the levels --max-levels leaves). Sizing: the pressure goal sizes the
+contact cells with the pressure indicator (adapt/pressure_sizing.py) aimed at
 PRESSURE_AIM times the error the level is planned to reach, unweighted contact terms
 (docs/adapt.md: what met the pressure target); energy and force size every cell with the
 residual indicators. The budget decides the cell count (the residual tolerance is not
