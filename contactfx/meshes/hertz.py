@@ -2,7 +2,6 @@
 
 import math
 
-import gmsh
 import numpy as np
 
 from .size_field import apply_size_view, restore_options
@@ -35,6 +34,8 @@ def build_hertz(
     `size_field` = (quads, sizes) replaces all that by sizes at the vertices of quads
     (meshes.size_field: the adaptive loop's background mesh).
     """
+    import gmsh  # libgmsh (~0.09 s) only when meshing: docs/scale.md
+
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
     if min(R, width, height, h_contact, r_refine, h_far, slope) <= 0.0:
