@@ -13,9 +13,10 @@ _FIRST_K = 12
 # Bound on the (points x candidates) work arrays, to keep memory flat for far-away points.
 _CHUNK_ENTRIES = 4_000_000
 # Up to this many (points x segments) pairs a search compares every point with every
-# segment: ~1 ms of numpy, where the KD-tree costs the scipy.spatial import (~0.07 s per
-# process; docs/scale.md, "Time to the first answer"). Same segments and coordinates.
-_ALL_PAIRS = 1 << 18
+# segment (same segments and coordinates as the tree's): below it a few such searches cost
+# less than the scipy.spatial import the KD-tree needs (docs/scale.md, "Time to the first
+# answer").
+_ALL_PAIRS = 1 << 17
 
 
 @dataclass(frozen=True)
@@ -136,7 +137,7 @@ class SegmentSearch:
     def _tree(self) -> Any:
         """The KD-tree of the samples, built at the first search that needs one."""
         if self._kdtree is None:
-            from scipy.spatial import cKDTree  # scipy.spatial (~0.07 s): larger searches only
+            from scipy.spatial import cKDTree  # only for larger searches (docs/scale.md)
 
             self._kdtree = cKDTree(self._samples)
         return self._kdtree

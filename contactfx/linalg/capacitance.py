@@ -78,7 +78,7 @@ def released_solve(
             applies += 1
         mu0 = _gathered(comm, x.array_r[rows_r])
         resp = responses(rel_global, released)
-        import scipy.linalg  # scipy.linalg (~0.04 s) only where used: docs/scale.md
+        import scipy.linalg  # only where used (first-answer time: docs/scale.md)
 
         lu = scipy.linalg.lu_factor(_gathered(comm, resp[released]), check_finite=True)
         b.array[rows_r] += scipy.linalg.lu_solve(lu, -mu0)[mine]

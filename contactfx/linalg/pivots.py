@@ -131,7 +131,7 @@ def pivots(B: LocalRows, active: np.ndarray, comm: MPI.Comm, r0: int, n: int) ->
     row_off = np.abs(off).max(axis=1).toarray().ravel() if off.nnz else np.zeros(len(scale))
     if not np.any(row_off > DIAGONAL_TOL * scale):
         return Pivots(rows, piv, coef, _diagonal_rows(B, rows, piv, coef, r0), None)
-    import scipy.sparse.linalg as spla  # (~0.05 s) only where used: docs/scale.md
+    import scipy.sparse.linalg as spla  # only where used (first-answer time: docs/scale.md)
 
     lu = spla.splu(block.tocsc())
     keep = np.ones(n)

@@ -200,7 +200,7 @@ class SchurSolver:
 
     def _dense(self, g: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, object]:
         """The set's w and the factorization of S0 + D_A (kept for responses)."""
-        import scipy.linalg  # scipy.linalg (~0.04 s) only where used: docs/scale.md
+        import scipy.linalg  # only where used (first-answer time: docs/scale.md)
 
         assert self._factor is not None and self._c is not None
         key = active.tobytes()

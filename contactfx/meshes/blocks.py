@@ -21,7 +21,7 @@ def _body(
     Returns the surfaces, the boundary curves by side, the transfinite curve data
     (tag, number of nodes, progression) and the corner points of each surface.
     """
-    import gmsh  # libgmsh (~0.09 s) only when meshing: docs/scale.md
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
 
     geo = gmsh.model.geo
     bottom_pts = [geo.addPoint(x, y0, 0.0) for x in xs]

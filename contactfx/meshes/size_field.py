@@ -22,7 +22,7 @@ def apply_size_view(quads: np.ndarray, sizes: np.ndarray) -> dict[str, float]:
 
     Returns the options it changed, with their previous values (for restore_options).
     """
-    import gmsh  # libgmsh (~0.09 s) only when meshing: docs/scale.md
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
 
     quads = np.asarray(quads, dtype=float).reshape(-1, 4, 2)
     sizes = np.asarray(sizes, dtype=float).reshape(-1, 4)

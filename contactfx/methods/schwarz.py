@@ -116,7 +116,7 @@ def _transfer(r: Roles, ndofs: int, comm: MPI.Comm) -> Transfer:
         surf_a = r.surf1
         op = contact_operator(Kernel.MORTAR, r.surf1.surface, r.surf2.surface, ndofs)
     layout, order = multiplier_layout(comm, surf_a, op)
-    import scipy.sparse.linalg as spla  # (~0.05 s) only where used: docs/scale.md
+    import scipy.sparse.linalg as spla  # only where used (first-answer time: docs/scale.md)
 
     return Transfer(keep, D, M, spla.splu(D), wgap, op, layout, order)
 

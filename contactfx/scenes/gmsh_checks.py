@@ -22,7 +22,7 @@ _GMSH_2D_NAMES = {
 
 def check_quadrilaterals() -> None:
     """Raise MeshError unless the current gmsh model's 2D elements are all 4-node quads."""
-    import gmsh  # libgmsh (~0.09 s) only when meshing: docs/scale.md
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
 
     types, tags, _ = gmsh.model.mesh.getElements(2)
     if not len(types):

@@ -40,7 +40,7 @@ from .model import (
 
 def _gmsh_node_coordinates() -> np.ndarray:
     """The current gmsh model's node coordinates, row i = node tag i + 1."""
-    import gmsh  # libgmsh (~0.09 s) only when meshing: docs/scale.md
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
 
     if not gmsh.isInitialized():
         raise MeshError("balanced_partitioner needs node coordinates: no gmsh session is open")
@@ -68,7 +68,7 @@ def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[...,
         dest = np.zeros(num_cells, dtype=np.int32)
         if num_cells == 0 or nparts == 1:
             return adjacencylist(dest)._cpp_object
-        # scipy.sparse.csgraph (~0.05 s) only when a mesh is split over ranks.
+        # scipy.sparse.csgraph only when a mesh is split over ranks (docs/scale.md).
         from scipy.sparse import coo_array
         from scipy.sparse.csgraph import connected_components
 

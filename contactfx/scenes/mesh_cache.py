@@ -1,6 +1,6 @@
 """A built-in scene's gmsh mesh, kept on disk keyed by its recipe (docs/scale.md).
 
-gmsh meshes the default Hertz scene in ~0.25 s of a ~2.4 s first answer. The first run
+Meshing is a large part of a small scene's first answer (docs/scale.md). The first run
 records every answer gmsh gave DOLFINx's model_to_mesh (node coordinates, elements,
 physical groups) into `$XDG_CACHE_HOME/contactfx/meshes/<key>.npz`; a later run replays them
 to the same model_to_mesh, so the mesh, its tags and its partition are those of a fresh run
@@ -142,7 +142,8 @@ def _save(path: Path, calls: dict[str, Any]) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
         with open(tmp, "wb") as fh:
-            np.savez(fh, index=np.array(index), **{f"a{i}": a for i, a in enumerate(arrays)})
+            payload: dict[str, Any] = {f"a{i}": a for i, a in enumerate(arrays)}
+            np.savez(fh, index=np.array(index), **payload)
         os.replace(tmp, path)
     except (OSError, TypeError) as exc:  # no cache is a slower run, not an error
         log.debug("mesh cache: not written (%s)", exc)
@@ -164,7 +165,7 @@ def _load(path: Path) -> dict[str, Any] | None:
 def cached_to_dolfinx(comm: MPI.Comm, build: Callable[[], None]) -> MeshData:
     """gmsh_io.to_dolfinx(comm, build, balanced_partitioner()), from the cache if kept."""
     path, calls = None, None
-    # gmsh is imported only to mesh (libgmsh, ~0.09 s): not imported means no session open.
+    # gmsh is imported only to mesh: not imported means no session open.
     gmsh_module = sys.modules.get("gmsh")
     if comm.rank == 0 and not (gmsh_module is not None and gmsh_module.isInitialized()):
         path = cache_path(build)
