@@ -129,6 +129,21 @@ def test_an_unreadable_cache_file_is_meshed_again(cache_home: Path) -> None:
         assert "index" in stored
 
 
+def test_a_cache_file_missing_an_answer_is_meshed_again(cache_home: Path) -> None:
+    build = partial(build_hertz, *HERTZ)
+    fresh = cached_to_dolfinx(MPI.COMM_SELF, build)
+    path = cache_path(build)
+    assert path is not None
+    calls = mesh_cache._load(path)
+    assert calls is not None
+    missing = next(k for k in calls if k.startswith("getPhysicalName"))
+    del calls[missing]
+    mesh_cache._save(path, calls)
+    same(fresh, cached_to_dolfinx(MPI.COMM_SELF, build))
+    rewritten = mesh_cache._load(path)
+    assert rewritten is not None and missing in rewritten
+
+
 def _solve_json(tmp_path: Path, name: str, env: dict[str, str]) -> dict:
     out = tmp_path / f"{name}.json"
     cmd = [sys.executable, "-m", "contactfx", "solve", "hertz", "--refine", "0.1", "-q"]
