@@ -33,6 +33,9 @@ from ..logs import log
 from .gmsh_io import balanced_partitioner, mesh_from_model, node_coordinates, to_dolfinx
 
 _NODES = "mesh.getNodes()"  # the call whose answer also gives the partitioner's coordinates
+# Larger recordings are not kept: the cache is for the first answer of small scenes, and a
+# sweep of large meshes would fill the user's cache directory (~115 bytes a node).
+MAX_BYTES = 64 << 20
 
 
 class _Recorder:
@@ -142,6 +145,9 @@ def _save(path: Path, calls: dict[str, Any]) -> None:
     arrays: list[np.ndarray] = []
     try:
         index = json.dumps([[k, _encode(v, arrays)] for k, v in calls.items()])
+        if sum(a.nbytes for a in arrays) > MAX_BYTES:
+            log.debug("mesh cache: %s not written (over %d bytes)", path, MAX_BYTES)
+            return
         path.parent.mkdir(parents=True, exist_ok=True)
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
         with open(tmp, "wb") as fh:

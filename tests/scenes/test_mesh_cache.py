@@ -144,6 +144,14 @@ def test_a_cache_file_missing_an_answer_is_meshed_again(cache_home: Path) -> Non
     assert rewritten is not None and missing in rewritten
 
 
+def test_a_large_mesh_is_not_kept(cache_home: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    build = partial(build_blocks, *BLOCKS)
+    monkeypatch.setattr(mesh_cache, "MAX_BYTES", 1000)
+    cached_to_dolfinx(MPI.COMM_SELF, build)
+    path = cache_path(build)
+    assert path is not None and not path.parent.exists()
+
+
 def _solve_json(tmp_path: Path, name: str, env: dict[str, str]) -> dict:
     out = tmp_path / f"{name}.json"
     cmd = [sys.executable, "-m", "contactfx", "solve", "hertz", "--refine", "0.1", "-q"]
