@@ -3,16 +3,20 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components, depth_first_order
 
 # Samples fetched per point in the first KD-tree round (twice that per run of grouped points);
 # multiplied by 4 for the points not settled yet.
 _FIRST_K = 12
 # Bound on the (points x candidates) work arrays, to keep memory flat for far-away points.
 _CHUNK_ENTRIES = 4_000_000
+# Up to this many (points x segments) pairs a search compares every point with every
+# segment (same segments and coordinates as the tree's): below it a few such searches cost
+# less than the scipy.spatial import the KD-tree needs (docs/scale.md, "Time to the first
+# answer").
+_ALL_PAIRS = 1 << 17
 
 
 @dataclass(frozen=True)
@@ -118,9 +122,8 @@ class SegmentSearch:
         frac /= np.repeat(pieces, pieces)
         samples = a[self._owner] + frac[:, None] * ab[self._owner]
         self._reach = float((0.5 * length / pieces).max()) if m else 0.0
-        from scipy.spatial import cKDTree  # scipy.spatial (~0.15 s) when a search is built
-
-        self._tree = cKDTree(samples) if m else None
+        self._samples = samples
+        self._kdtree: Any = None
         # Distances within this of the minimum count as ties (e.g. a point on a shared vertex).
         self._eps = 1e-12 * max(float(length.max()) if m else 0.0, np.finfo(float).tiny)
         # Ties are broken by a rank that depends on geometry only, so that reordering or
@@ -129,6 +132,15 @@ class SegmentSearch:
         self._rank = np.empty(m, dtype=np.int64)
         self._rank[np.lexsort((mid[:, 1], mid[:, 0]))] = np.arange(m)
         self._is_end = node_degrees(surface) == 1
+
+    @property
+    def _tree(self) -> Any:
+        """The KD-tree of the samples, built at the first search that needs one."""
+        if self._kdtree is None:
+            from scipy.spatial import cKDTree  # only for larger searches (docs/scale.md)
+
+            self._kdtree = cKDTree(self._samples)
+        return self._kdtree
 
     def closest(
         self, points: np.ndarray, tol: float = 1e-8, group: int = 1
@@ -140,14 +152,16 @@ class SegmentSearch:
         t = np.zeros(npts)
         if m == 0 or npts == 0:
             return seg, t, np.zeros(npts, dtype=bool)
-        assert self._tree is not None  # built whenever there are segments
         nsamples = len(self._owner)
+        # A small search takes every segment as a candidate of every point (k = nsamples):
+        # the exact closest segment, ties broken by the same rank, as with the tree.
+        all_pairs = npts * m <= _ALL_PAIRS
         todo = np.arange(npts)
-        if group > 1 and npts % group == 0 and 2 * _FIRST_K < nsamples:
+        if group > 1 and npts % group == 0 and 2 * _FIRST_K < nsamples and not all_pairs:
             # Runs of nearby points (the Gauss points of one segment) share one tree query
             # about their centre; the spread of the run widens the settling bound.
             todo = self._grouped_round(points, group, seg, t)
-        k = min(_FIRST_K, nsamples)
+        k = nsamples if all_pairs else min(_FIRST_K, nsamples)
         while todo.size:
             chunk = max(1, _CHUNK_ENTRIES // k)
             unsettled = []
@@ -171,7 +185,6 @@ class SegmentSearch:
         self, points: np.ndarray, group: int, seg: np.ndarray, t: np.ndarray
     ) -> np.ndarray:
         """First round shared by runs of `group` points; returns the unsettled point ids."""
-        assert self._tree is not None  # only called by closest() with segments present
         k = 2 * _FIRST_K
         centre = points.reshape(-1, group, 2).mean(axis=1)
         spread = np.linalg.norm(points - np.repeat(centre, group, axis=0), axis=1)
@@ -246,6 +259,51 @@ class Chains:
     closed: np.ndarray  # (m,) bool, whether that chain is a closed loop
 
 
+def _component_labels(n: int, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
+    """Connected-component label of each of n nodes, numbered in the order of their least node.
+
+    (scipy's connected_components numbering, without the scipy.sparse.csgraph import.)
+    """
+    label = np.arange(n)
+    while True:
+        # Every node takes the least label across its segments, then its label's label.
+        low = np.minimum(label[s0], label[s1])
+        new = label.copy()
+        np.minimum.at(new, s0, low)
+        np.minimum.at(new, s1, low)
+        new = new[new]
+        if np.array_equal(new, label):
+            break
+        label = new
+    # Labels are now each component's least node: renumber them 0, 1, ... in that order.
+    return np.unique(label, return_inverse=True)[1].reshape(-1)
+
+
+def _incidence(n: int, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
+    """(n, 2): the (at most two) segments at each node, -1 where there are fewer."""
+    ends = np.concatenate([s0, s1])
+    order = np.argsort(ends, kind="stable")
+    e = ends[order]
+    slot = np.arange(len(e)) - np.searchsorted(e, e, side="left")
+    inc = np.full((n, 2), -1, dtype=np.int64)
+    inc[e, slot] = order % len(s0)
+    return inc
+
+
+def _walk(inc: np.ndarray, s0: np.ndarray, s1: np.ndarray, first: int, cut: int) -> np.ndarray:
+    """The nodes of the path from `first` (an end, or a loop's node next to segment `cut`)."""
+    nodes, node, came = [first], first, cut
+    while True:
+        a, b = inc[node]
+        nxt_seg = int(b if a == came else a)
+        if nxt_seg < 0 or nxt_seg == came or nxt_seg == cut:
+            break
+        node = int(s1[nxt_seg] if s0[nxt_seg] == node else s0[nxt_seg])
+        nodes.append(node)
+        came = nxt_seg
+    return np.asarray(nodes, dtype=np.int64)
+
+
 def chains(surface: Surface) -> Chains:
     """Order the segments along each connected polyline of the surface."""
     n, m = surface.n_nodes, surface.n_segments
@@ -255,8 +313,8 @@ def chains(surface: Surface) -> Chains:
     s0, s1 = surface.segments[:, 0], surface.segments[:, 1]
     key = np.minimum(s0, s1) * n + np.maximum(s0, s1)
     key_order = np.argsort(key, kind="stable")
-    adj = sp.coo_matrix((np.ones(m), (s0, s1)), shape=(n, n)).tocsr()
-    _, label = connected_components(adj, directed=False)
+    label = _component_labels(n, s0, s1)
+    inc = _incidence(n, s0, s1)
     seg_comp = label[s0]
     order, position = np.empty(m, np.int64), np.empty(m, np.int64)
     start, length = np.empty(m, np.int64), np.empty(m, np.int64)
@@ -272,12 +330,9 @@ def chains(surface: Surface) -> Chains:
             # Cut the loop at `first` by dropping one of its segments, then walk the path.
             segs_here = np.flatnonzero(seg_comp == comp)
             cut = segs_here[(s0[segs_here] == first) | (s1[segs_here] == first)].min()
-            keep = np.ones(m, dtype=bool)
-            keep[cut] = False
-            graph = sp.coo_matrix((np.ones(keep.sum()), (s0[keep], s1[keep])), shape=(n, n))
-            walk = depth_first_order(graph.tocsr(), first, directed=False)[0].astype(np.int64)
+            walk = _walk(inc, s0, s1, int(first), int(cut))
         else:
-            walk = depth_first_order(adj, first, directed=False)[0].astype(np.int64)
+            walk = _walk(inc, s0, s1, int(first), -1)
         pairs = np.stack([walk[:-1], walk[1:]], axis=1)
         if is_loop:
             pairs = np.vstack([pairs, [[walk[-1], walk[0]]]])

@@ -16,7 +16,6 @@ import logging
 from collections.abc import Callable
 
 import numpy as np
-import scipy.linalg
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -79,6 +78,8 @@ def released_solve(
             applies += 1
         mu0 = _gathered(comm, x.array_r[rows_r])
         resp = responses(rel_global, released)
+        import scipy.linalg  # only where used (first-answer time: docs/scale.md)
+
         lu = scipy.linalg.lu_factor(_gathered(comm, resp[released]), check_finite=True)
         b.array[rows_r] += scipy.linalg.lu_solve(lu, -mu0)[mine]
         apply(b, x)

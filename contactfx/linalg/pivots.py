@@ -16,11 +16,14 @@ diagonal; entries below DROP of a row's largest are round-off and are dropped.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from mpi4py import MPI
+
+if TYPE_CHECKING:
+    import scipy.sparse.linalg as spla
 
 from ..errors import EliminationError
 from .elimination import LocalRows, PivotRows
@@ -128,6 +131,8 @@ def pivots(B: LocalRows, active: np.ndarray, comm: MPI.Comm, r0: int, n: int) ->
     row_off = np.abs(off).max(axis=1).toarray().ravel() if off.nnz else np.zeros(len(scale))
     if not np.any(row_off > DIAGONAL_TOL * scale):
         return Pivots(rows, piv, coef, _diagonal_rows(B, rows, piv, coef, r0), None)
+    import scipy.sparse.linalg as spla  # only where used (first-answer time: docs/scale.md)
+
     lu = spla.splu(block.tocsc())
     keep = np.ones(n)
     keep[all_piv] = 0.0

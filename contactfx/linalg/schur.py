@@ -28,10 +28,13 @@ import functools
 import logging
 import time
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.linalg
 from petsc4py import PETSc
+
+if TYPE_CHECKING:
+    import scipy.linalg
 
 from ..errors import SolverError
 from .blocks import diagonal_matrix
@@ -197,6 +200,8 @@ class SchurSolver:
 
     def _dense(self, g: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, object]:
         """The set's w and the factorization of S0 + D_A (kept for responses)."""
+        import scipy.linalg  # only where used (first-answer time: docs/scale.md)
+
         assert self._factor is not None and self._c is not None
         key = active.tobytes()
         if self._last is not None and self._last[0].tobytes() == key:
@@ -253,6 +258,8 @@ class SchurSolver:
             raise SolverError("Schur responses asked for a set that was not solved last")
         lu = self._last[2]
         rhs = np.where(active[:, None], probes, 0.0)
+        import scipy.linalg  # imported by _dense already: a dict look-up
+
         dw = scipy.linalg.lu_solve(lu, rhs)
         return np.where(active[:, None], dw + self.gamma * rhs, 0.0)
 

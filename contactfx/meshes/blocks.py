@@ -1,6 +1,5 @@
 """Two stacked elastic blocks, half model by symmetry (scenes S1-S4)."""
 
-import gmsh
 import numpy as np
 
 from .size_field import apply_size_view, restore_options
@@ -22,6 +21,8 @@ def _body(
     Returns the surfaces, the boundary curves by side, the transfinite curve data
     (tag, number of nodes, progression) and the corner points of each surface.
     """
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
+
     geo = gmsh.model.geo
     bottom_pts = [geo.addPoint(x, y0, 0.0) for x in xs]
     top_pts = [geo.addPoint(x, y1, 0.0) for x in xs]
@@ -59,6 +60,8 @@ def build_blocks(
     Structured (transfinite) by default; with `size_field` = (quads, sizes) unstructured
     quads sized by it (meshes.size_field: the adaptive loop's background mesh).
     """
+    import gmsh
+
     if min(l1, l2, h1, h2, size1, size2, grading1, grading2) <= 0.0:
         raise ValueError("block dimensions, mesh sizes and gradings must be positive")
     half1, half2 = 0.5 * l1, 0.5 * l2

@@ -2,7 +2,6 @@
 
 import math
 
-import gmsh
 import numpy as np
 
 from .size_field import apply_size_view, restore_options
@@ -29,12 +28,13 @@ def build_hertz(
 ) -> None:
     """Add the Hertz half model (quarter disc on a block) to the current gmsh model and mesh it.
 
-    The size is h_contact along both contact surfaces for x <= r_refine and, if `edge` =
-    (x_edge, h_edge) is given, h_edge at x_edge (the expected edge of the contact zone, where
-    the pressure has its square-root singularity); it grows by `slope` per unit distance.
-    `size_field` = (quads, sizes) replaces all that by sizes at the vertices of quads
-    (meshes.size_field: the adaptive loop's background mesh).
+    Size h_contact on both contact surfaces for x <= r_refine, h_edge at x_edge if `edge` =
+    (x_edge, h_edge) (the contact edge: the pressure's square-root singularity), growing by
+    `slope` per unit distance; or, `size_field` = (quads, sizes), sizes at the vertices of
+    quads (meshes.size_field: the adaptive loop's background mesh).
     """
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
+
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
     if min(R, width, height, h_contact, r_refine, h_far, slope) <= 0.0:
@@ -51,7 +51,6 @@ def build_hertz(
     edge = None if edge is None else (float(edge[0]), float(edge[1]))
     yc = height + R
     geo = gmsh.model.geo
-
     # Block: the top is split at the end of the contact zone.
     b00 = geo.addPoint(0.0, 0.0, 0.0)
     b10 = geo.addPoint(width, 0.0, 0.0)

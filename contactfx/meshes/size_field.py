@@ -6,7 +6,6 @@ PostView field on it, set as the background mesh. The model's own size sources (
 boundaries, curvature) are switched off so that the field alone sets the size.
 """
 
-import gmsh
 import numpy as np
 
 # Set while a background field is active; restore_options puts the saved values back.
@@ -23,6 +22,8 @@ def apply_size_view(quads: np.ndarray, sizes: np.ndarray) -> dict[str, float]:
 
     Returns the options it changed, with their previous values (for restore_options).
     """
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
+
     quads = np.asarray(quads, dtype=float).reshape(-1, 4, 2)
     sizes = np.asarray(sizes, dtype=float).reshape(-1, 4)
     if not len(quads) or not np.all(np.isfinite(sizes)) or np.any(sizes <= 0):
@@ -42,5 +43,7 @@ def apply_size_view(quads: np.ndarray, sizes: np.ndarray) -> dict[str, float]:
 
 def restore_options(saved: dict[str, float]) -> None:
     """Put back the gmsh options apply_size_view changed."""
+    import gmsh
+
     for name, value in saved.items():
         gmsh.option.setNumber(name, value)

@@ -22,7 +22,6 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from dolfinx import fem
 from mpi4py import MPI
 
@@ -117,6 +116,8 @@ def _transfer(r: Roles, ndofs: int, comm: MPI.Comm) -> Transfer:
         surf_a = r.surf1
         op = contact_operator(Kernel.MORTAR, r.surf1.surface, r.surf2.surface, ndofs)
     layout, order = multiplier_layout(comm, surf_a, op)
+    import scipy.sparse.linalg as spla  # only where used (first-answer time: docs/scale.md)
+
     return Transfer(keep, D, M, spla.splu(D), wgap, op, layout, order)
 
 
@@ -258,6 +259,8 @@ def _report(
         # Same force on B1's nodes, expressed as the traction of B1's own mortar multipliers.
         Da, _ = mortar_matrices(r.surf1.surface, r.surf2.surface)
         force = tr.M.T @ lam
+        import scipy.sparse.linalg as spla  # only where used: docs/scale.md
+
         pressure = np.atleast_1d(spla.spsolve(Da[order][:, order].tocsc(), force[order]))
     if np.any(pressure < -1e-8 * np.abs(pressure).max(initial=0.0)) and comm.rank == 0:
         log.warning(

@@ -13,7 +13,7 @@ from mpi4py import MPI
 from ..errors import InputError
 from ..meshes import build_blocks, build_hertz
 from .checks import check_scene
-from .gmsh_io import balanced_partitioner, to_dolfinx
+from .mesh_cache import cached_to_dolfinx
 from .model import (
     Body,
     ContactPair,
@@ -255,7 +255,7 @@ def blocks(
         p.grading2,
         size_field=_field(size_field),
     )
-    data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
+    data = cached_to_dolfinx(comm, build)
     # Equal widths make the stress uniaxial and uniform: the contact patch test.
     refs: tuple[Reference, ...] = (
         (UniformStress(((0.0, 0.0), (0.0, -p.p))),) if p.l1 == p.l2 else ()
@@ -301,7 +301,7 @@ def hertz(
             edge=edge,
             size_field=_field(size_field),
         )
-        data = to_dolfinx(comm, build, partitioner=balanced_partitioner())
+        data = cached_to_dolfinx(comm, build)
     ref = (HertzReference(pair=0, R=h.R, P=h.P, symmetric=True),)
     extra: dict[str, Any] = {"hertz_exact": exact}
     # The load on the flat face: P over its width 2 R (a cylinder), or its disc pi R^2 (a sphere).

@@ -6,7 +6,6 @@ All quadrilaterals (Q1 is what every method assumes), and bodies that share no m
 
 from __future__ import annotations
 
-import gmsh
 import numpy as np
 
 from ..errors import MeshError
@@ -23,6 +22,8 @@ _GMSH_2D_NAMES = {
 
 def check_quadrilaterals() -> None:
     """Raise MeshError unless the current gmsh model's 2D elements are all 4-node quads."""
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
+
     types, tags, _ = gmsh.model.mesh.getElements(2)
     if not len(types):
         raise MeshError("the gmsh model has no 2D elements (mesh it in 2D, or give a .geo)")
@@ -42,6 +43,8 @@ def check_separate_bodies() -> None:
     curves, BooleanFragments, Coherence, or gmsh's automatic coherence after a geometry
     transformation such as Rotate) glues the bodies together where they touch.
     """
+    import gmsh
+
     groups = gmsh.model.getPhysicalGroups(2)
     nodes = [gmsh.model.mesh.getNodesForPhysicalGroup(d, t)[0].astype(np.int64) for d, t in groups]
     top = max((int(n.max()) for n in nodes if n.size), default=0)

@@ -12,14 +12,11 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-import gmsh
 import numpy as np
 from dolfinx.cpp.mesh import cell_num_vertices
 from dolfinx.graph import adjacencylist
 from dolfinx.io.gmsh import MeshData, model_to_mesh
 from mpi4py import MPI
-from scipy.sparse import coo_array
-from scipy.sparse.csgraph import connected_components
 
 from ..errors import ContactFxError, InputError, MeshError, error_type
 from ..meshes.size_field import apply_size_view, restore_options
@@ -43,9 +40,16 @@ from .model import (
 
 def _gmsh_node_coordinates() -> np.ndarray:
     """The current gmsh model's node coordinates, row i = node tag i + 1."""
+    import gmsh  # only to mesh (first-answer time: docs/scale.md)
+
     if not gmsh.isInitialized():
         raise MeshError("balanced_partitioner needs node coordinates: no gmsh session is open")
     tags, xyz, _ = gmsh.model.mesh.getNodes()
+    return node_coordinates(tags, xyz)
+
+
+def node_coordinates(tags: np.ndarray, xyz: np.ndarray) -> np.ndarray:
+    """Node coordinates from gmsh's getNodes() arrays, row i = node tag i + 1."""
     x = np.zeros((int(tags.max()) if len(tags) else 0, 3))
     x[tags.astype(np.int64) - 1] = xyz.reshape(-1, 3)
     return x
@@ -64,6 +68,10 @@ def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[...,
         dest = np.zeros(num_cells, dtype=np.int32)
         if num_cells == 0 or nparts == 1:
             return adjacencylist(dest)._cpp_object
+        # scipy.sparse.csgraph only when a mesh is split over ranks (docs/scale.md).
+        from scipy.sparse import coo_array
+        from scipy.sparse.csgraph import connected_components
+
         x = _gmsh_node_coordinates() if coordinates is None else np.asarray(coordinates)
         mid = np.vstack([x[c, :2].mean(axis=1) for c in conn])
         # Bodies share no node, so the connected components of the node graph are the
@@ -89,6 +97,8 @@ def _run_on_root(
     comm: MPI.Comm, build: Callable[[], None], own_session: bool
 ) -> tuple[bool | None, str | None]:
     """Open a model on rank 0 and run `build` there; the error text is broadcast."""
+    import gmsh
+
     error = ""
     fresh, previous = None, None
     if comm.rank == 0:
@@ -121,6 +131,8 @@ def _run_on_root(
 
 
 def _close(fresh: bool | None, previous: str | None) -> None:
+    import gmsh
+
     if fresh:
         gmsh.finalize()
     else:
@@ -134,21 +146,34 @@ def to_dolfinx(
     build: Callable[[], None],
     partitioner: Callable[..., Any] | None = None,
     own_session: bool = True,
+    model: Any = None,
 ) -> MeshData:
-    """Run `build` on rank 0 (in a fresh gmsh model) and return the distributed MeshData."""
+    """Run `build` on rank 0 (in a fresh gmsh model) and return the distributed MeshData.
+
+    `model`: what DOLFINx reads the mesh from on rank 0 (default: gmsh.model; the mesh
+    cache passes a recorder of it, scenes/mesh_cache.py).
+    """
+    import gmsh
+
     fresh, previous = _run_on_root(comm, build, own_session)
     try:
+        return mesh_from_model(model if model is not None else gmsh.model, comm, partitioner)
+    finally:
+        if comm.rank == 0 and own_session:
+            _close(fresh, previous)
+
+
+def mesh_from_model(model: Any, comm: MPI.Comm, partitioner: Callable[..., Any] | None) -> MeshData:
+    """DOLFINx's model_to_mesh of `model` (read on rank 0), its check as a MeshError."""
+    try:
         return model_to_mesh(
-            gmsh.model if comm.rank == 0 else None, comm, 0, gdim=2, partitioner=partitioner
+            model if comm.rank == 0 else None, comm, 0, gdim=2, partitioner=partitioner
         )
     except RuntimeError as exc:  # raised on every rank alike (DOLFINx broadcasts the check)
         raise MeshError(
             f"the gmsh mesh cannot be loaded: {exc} (every cell must belong to "
             "exactly one physical surface group)"
         ) from None
-    finally:
-        if comm.rank == 0 and own_session:
-            _close(fresh, previous)
 
 
 def open_mesh_file(
@@ -170,6 +195,8 @@ def open_mesh_file(
         raise InputError(f"mesh file {path} is a .msh: it cannot be refined (give a .geo)")
 
     def build() -> None:
+        import gmsh
+
         try:
             gmsh.open(str(path))
         except Exception as exc:
@@ -205,6 +232,8 @@ def load_meshdata(
 
     # A model the user built with the gmsh API: mesh it if it has no 2D elements yet.
     def mesh_model() -> None:
+        import gmsh
+
         if not len(gmsh.model.mesh.getElements(2)[0]):
             gmsh.model.mesh.generate(2)
 

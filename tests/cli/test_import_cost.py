@@ -1,22 +1,33 @@
-"""A plain solve loads no plotting, no pyvista and no scipy piece only some paths need.
+"""A plain solve loads no plotting, no pyvista, no scipy piece only some paths need, no gmsh.
 
 Module presence in a fresh interpreter, not a timing: importing the command line, parsing
 `solve hertz` and importing the module that runs it must leave matplotlib (the charts),
-pyvista (the field files), scipy.optimize (the floating-body LP) and scipy.spatial (the
-KD-trees of the search) unloaded; each is imported where it is first used (docs/scale.md,
-"Time to the first answer").
+pyvista (the field files), scipy.optimize (the floating-body LP), scipy.spatial (the
+KD-trees of larger searches), scipy.sparse.csgraph and scipy.sparse.linalg (a mesh split
+over ranks, the condensed and Schwarz solvers) and gmsh (meshing) unloaded; each is imported
+where it is first used (docs/scale.md, "Time to the first answer"). A whole solve of a
+built-in scene loads gmsh only when its mesh is not in the mesh cache yet.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-DEFERRED = ("matplotlib", "pyvista", "scipy.optimize", "scipy.spatial")
+DEFERRED = (
+    "matplotlib",
+    "pyvista",
+    "scipy.optimize",
+    "scipy.spatial",
+    "scipy.sparse.csgraph",
+    "scipy.sparse.linalg",
+    "gmsh",
+)
 
 PROBE = f"""
 import json, sys
@@ -28,8 +39,9 @@ print(json.dumps(sorted(m for m in {DEFERRED!r} if m in sys.modules)))
 """
 
 
-# A whole solve (coarse Hertz: one free mode, decided without the LP) loads none of them
-# either, but for the search's KD-trees.
+# A whole solve (coarse Hertz: one free mode, decided without the LP; searches small
+# enough to compare every point with every segment) loads none of them either, but gmsh
+# while the mesh is not cached.
 SOLVE = f"""
 import json, sys
 from contactfx.cli import main
@@ -40,6 +52,7 @@ print(json.dumps(sorted(m for m in {DEFERRED!r} if m in sys.modules)))
 
 def loaded(probe: str, tmp_path: Path) -> list[str]:
     """The DEFERRED modules present at the end of `probe` in a fresh interpreter."""
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"))  # an empty mesh cache
     out = subprocess.run(
         [sys.executable, "-c", probe],
         capture_output=True,
@@ -47,6 +60,7 @@ def loaded(probe: str, tmp_path: Path) -> list[str]:
         check=True,
         timeout=300,
         cwd=tmp_path,
+        env=env,
     )
     return list(json.loads(out.stdout.strip().splitlines()[-1]))
 
@@ -58,4 +72,5 @@ def test_command_line_imports_no_plotting_and_no_optional_scipy(tmp_path: Path) 
 
 @pytest.mark.serial
 def test_plain_solve_loads_no_plotting_no_pyvista_no_lp(tmp_path: Path) -> None:
-    assert loaded(SOLVE, tmp_path) == ["scipy.spatial"]
+    assert loaded(SOLVE, tmp_path) == ["gmsh"]  # meshed: the cache was empty
+    assert loaded(SOLVE, tmp_path) == []  # the same scene again: its mesh from the cache
