@@ -94,6 +94,24 @@ def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: T
     return Prepared(setup, replace(request, solver=SOLVERS[CONDENSED]), None, record)
 
 
+def warn_if_too_big(
+    linear: LinearSolver, scene: Scene, request: SolveRequest, timers: Timers
+) -> None:
+    """An explicit MUMPS runs as asked; a log line warns where its estimate does not fit.
+
+    The analysis is the one its first factorization reuses (no cost beyond a collective).
+    """
+    if request.solver.kind is not SolverKind.DIRECT or not isinstance(linear, SaddleSolver):
+        return
+    with timers("solve"):
+        estimate = mumps_estimate(linear)
+    rank_mb = None if estimate is None else estimate.rank_mb
+    needed, avail = node_budget(scene.comm, rank_mb, request.available_mb)
+    if choose(needed, avail, True) is not Choice.DIRECT and scene.comm.rank == 0:
+        reason = SolverChoice(request.solver.name, needed, avail, None).reason
+        log.warning("solver: %s as asked, though %s", request.solver.name, reason)
+
+
 def _say(record: SolverChoice, comm: MPI.Comm) -> None:
     """The log line of the choice (rank 0)."""
     if comm.rank == 0:

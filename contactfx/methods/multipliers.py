@@ -32,7 +32,7 @@ from .active_set import (
     Step,
     run_active_set,
 )
-from .autosolve import Prepared, prepare_solver
+from .autosolve import Prepared, prepare_solver, warn_if_too_big
 from .solution import Solution, finish
 from .solvers import setup_solver
 
@@ -276,11 +276,10 @@ def solve_contact(
     spec = request.solver
     try:
         # One solver for the whole loop: fixed matrix pattern, reused analysis and setup.
-        linear = (
-            prepared.linear
-            if prepared.linear is not None
-            else setup_solver(setup, spec, scene, reuse=True)
-        )
+        linear = prepared.linear
+        if linear is None:
+            linear = setup_solver(setup, spec, scene, reuse=True)
+            warn_if_too_big(linear, scene, request, timers)
         guess = (
             initial_active
             if isinstance(initial_active, InitialSet) or initial_active is None

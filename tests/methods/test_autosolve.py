@@ -93,14 +93,16 @@ def test_auto_runs_what_fits(scene, available: float, preset: str) -> None:
         assert all(h["linear_iterations"] > 1 for h in sol.history)  # CG ran, not MUMPS
 
 
-def test_auto_refuses_where_nothing_fits(scene) -> None:
+def test_auto_refuses_where_nothing_fits(scene, caplog) -> None:
     """The standard basis cannot be condensed: one clear refusal before factorizing."""
     with pytest.raises(InputError, match=r"would not fit.*GB available.*--basis dual"):
         _run(scene, "auto", 1.0, basis="standard")
-    # An explicit MUMPS is honoured whatever the estimate.
+    # An explicit MUMPS is honoured whatever the estimate, with a warning.
     request = SolveRequest.parse("mortar", solver=SOLVERS["mumps"], available_mb=1.0)
-    _, data = run_scene(scene, request)
+    with caplog.at_level("WARNING", logger="contactfx"):
+        _, data = run_scene(scene, request)
     assert data.to_json()["solver"] == "mumps"
+    assert "solver: mumps as asked, though MUMPS needs" in caplog.text
 
 
 HERTZ = ["hertz", "--mesh", "structured", "--refine", "0.08", "--h-far", "0.8", "--method"]
