@@ -50,8 +50,9 @@ class MumpsEstimate:
     """MUMPS' memory estimate after its analysis (MB): this rank's, the largest, the sum.
 
     In-core (INFO(15), INFOG(16), INFOG(17)) unless ICNTL(22) = 1 asks for out-of-core
-    factors (INFO(17), INFOG(26), INFOG(27)). MUMPS allocates this much at the numeric
-    factorization (ICNTL(14)'s relaxation included; docs/scale.md, "The default solver").
+    factors (INFO(17), INFOG(26), INFOG(27)); a rank's is ICNTL(23) where that caps it.
+    MUMPS allocates this much at the numeric factorization (ICNTL(14)'s relaxation
+    included; docs/scale.md, "The default solver").
     """
 
     rank_mb: float
@@ -102,8 +103,9 @@ def analyze(F: PETSc.Mat, A: PETSc.Mat, cholesky: bool) -> MumpsEstimate | None:
         return None
     ooc = F.getMumpsIcntl(22) == 1
     mine, top, total = (17, 26, 27) if ooc else (15, 16, 17)
+    cap = F.getMumpsIcntl(23)  # > 0: each rank allocates this much working memory instead
     return MumpsEstimate(
-        float(F.getMumpsInfo(mine)),
+        float(cap if cap > 0 else F.getMumpsInfo(mine)),
         float(F.getMumpsInfog(top)),
         float(F.getMumpsInfog(total)),
         seconds,

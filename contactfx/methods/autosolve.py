@@ -109,7 +109,7 @@ def warn_if_too_big(
     needed, avail = node_budget(scene.comm, rank_mb, request.available_mb)
     if choose(needed, avail, True) is not Choice.DIRECT and scene.comm.rank == 0:
         reason = SolverChoice(request.solver.name, needed, avail, None).reason
-        log.warning("solver: %s as asked, though %s", request.solver.name, reason)
+        log.warning("solver: %s, although %s", request.solver.name, reason)
 
 
 def _say(record: SolverChoice, comm: MPI.Comm) -> None:

@@ -102,7 +102,7 @@ def test_auto_refuses_where_nothing_fits(scene, caplog) -> None:
     with caplog.at_level("WARNING", logger="contactfx"):
         _, data = run_scene(scene, request)
     assert data.to_json()["solver"] == "mumps"
-    assert "solver: mumps as asked, though MUMPS needs" in caplog.text
+    assert "solver: mumps, although MUMPS needs" in caplog.text
 
 
 HERTZ = ["hertz", "--mesh", "structured", "--refine", "0.08", "--h-far", "0.8", "--method"]
