@@ -14,12 +14,13 @@ from mpi4py import MPI
 
 from .errors import InputError
 from .methods.active_set import ActiveSetOptions
+from .methods.autosolve import prepare_solver
 from .methods.multipliers import solve_contact
 from .methods.penalty import solve_penalty
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.schwarz import solve_schwarz
 from .methods.solution import Solution
-from .options import Basis, Enforcement, Method, Predictor, SolverSpec
+from .options import Basis, Enforcement, Method, Predictor, SolverKind, SolverSpec
 from .request import DEFAULT_MAX_ITERATIONS, DEFAULT_SOLVER, SchwarzOptions, SolveRequest
 from .results.records import RunSummary
 from .results.summary import summary
@@ -95,7 +96,8 @@ def solve(
         method: A SolveRequest, or a method's name: nts, sts, mortar (multipliers), penalty
             or schwarz (mortar with that enforcement).
         enforcement: multipliers, penalty or schwarz on the discretization `method` names.
-        solver: A preset name of `SOLVERS` or a SolverSpec (default mumps).
+        solver: A preset name of `SOLVERS` or a SolverSpec (default auto: mumps unless its
+            memory estimate does not fit, then condensed; docs/scale.md).
         basis: Mortar's multiplier basis: standard or dual (biorthogonal, D diagonal).
         predictor: auto, coarse (a first active set from a coarser solve of the same scene)
             or none; the converged solution does not depend on it.
@@ -138,12 +140,22 @@ def solve_request(
         return solve_penalty(scene, request, timers, aso=aso)
     if request.enforcement is Enforcement.SCHWARZ:
         return solve_schwarz(scene, request, timers)
-    init = (
-        coarse_initial_set(initial, margin=coarse_margin(request.solver))
-        if initial is not None
-        else predict(scene, request, aso, timers)
-    )
-    return solve_contact(scene, request, timers, aso=aso, initial_active=init)
+    # `auto` chooses on the fine system before the predictor, whose mesh follows the choice.
+    prepared = None
+    if request.solver.kind is SolverKind.AUTO:
+        prepared = prepare_solver(scene, request, aso.penetration_tol, timers)
+        request = prepared.request
+    try:
+        init = (
+            coarse_initial_set(initial, margin=coarse_margin(request.solver))
+            if initial is not None
+            else predict(scene, request, aso, timers)
+        )
+    except BaseException:
+        if prepared is not None:
+            prepared.destroy()
+        raise
+    return solve_contact(scene, request, timers, aso=aso, initial_active=init, prepared=prepared)
 
 
 def run_scene(

@@ -157,6 +157,7 @@ class SolverKind(StrEnum):
     # One MUMPS factorization of K + gamma B^T B with every multiplier row as its Schur
     # variables; each active set a dense solve on that block (serial; linalg/schur.py).
     DIRECT_SCHUR = "direct-schur"
+    AUTO = "auto"  # DIRECT unless MUMPS' own estimate does not fit, then CONDENSED (autosolve)
 
     @property
     def factorizes_saddle(self) -> bool:
@@ -225,15 +226,13 @@ class SolverSpec:
             SolverKind.CONDENSED: pc in ("fieldsplit", "lu", "cholesky"),
             SolverKind.CONDENSED_DIRECT: pc not in ("lu", "cholesky"),
             SolverKind.DIRECT_SCHUR: pc not in ("lu", "cholesky"),
-        }[self.kind]
+        }[SolverKind.DIRECT if self.kind is SolverKind.AUTO else self.kind]
         if bad:
             fix = {
                 SolverKind.DIRECT: "a direct solver factorizes (pc_type lu or cholesky)",
                 SolverKind.FIELDSPLIT: "a fieldsplit solver needs pc_type fieldsplit",
                 SolverKind.CONDENSED: "it preconditions by multigrid (condensed-direct factorizes)",
-                SolverKind.CONDENSED_DIRECT: "it factorizes (pc_type cholesky or lu)",
-                SolverKind.DIRECT_SCHUR: "it factorizes (pc_type cholesky or lu)",
-            }[self.kind]
+            }.get(self.kind, "it factorizes (pc_type cholesky or lu)")
             raise InputError(
                 f"solver '{self.name}' ({self.kind.value}): PETSc option pc_type={pc} "
                 f"contradicts it: {fix}; choose the solver with --solver instead"
@@ -293,6 +292,7 @@ _MUMPS_LDLT: dict[str, object] = {**_MUMPS_LU, "pc_type": "cholesky"}
 
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
     {
+        "auto": SolverSpec(SolverKind.AUTO, _MUMPS_LDLT, name="auto"),  # docs/scale.md
         "mumps": SolverSpec(SolverKind.DIRECT, _MUMPS_LDLT, name="mumps"),
         "mumps-lu": SolverSpec(SolverKind.DIRECT, _MUMPS_LU, name="mumps-lu"),
         # Opt-in (docs/scale.md, "The Schur route, measured"): MUMPS' Schur complement of

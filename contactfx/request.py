@@ -9,7 +9,7 @@ that exists can be run, and nothing downstream checks a combination again.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import NoReturn
 
 from .contact import Kernel
@@ -27,7 +27,7 @@ from .options import (
 )
 
 # The defaults of a request made from names (SolveRequest.parse, contactfx.solve).
-DEFAULT_SOLVER = "mumps"
+DEFAULT_SOLVER = "auto"
 DEFAULT_MAX_ITERATIONS = 50
 
 
@@ -60,6 +60,8 @@ class SolveRequest:
         penalty: The penalty's normal stiffness eps (MPa/cm); None: 1e3 E_max / h.
         schwarz: The Schwarz iteration's controls; None: the defaults with max_iterations.
         reference_timing: Also time one fresh solve of the final system (multipliers).
+        available_mb: The memory (MB per node) the `auto` solver compares MUMPS' estimate
+            with; None: MemAvailable of /proc/meminfo (tests force the choice with it).
     """
 
     discretization: Discretization = Discretization.MORTAR
@@ -71,10 +73,16 @@ class SolveRequest:
     penalty: float | None = None
     schwarz: SchwarzOptions | None = None
     reference_timing: bool = False
+    available_mb: float | None = None
 
     def __post_init__(self) -> None:
         """Refuse an impossible combination, one rule per line."""
+        if self.solver.kind is SolverKind.AUTO and self.enforcement is not Enforcement.MULTIPLIERS:
+            # Penalty and Schwarz factorize with MUMPS: `auto` has nothing to choose there.
+            object.__setattr__(self, "solver", direct_path(self.solver))
         enf, kind = self.enforcement, self.solver.kind
+        if self.available_mb is not None and not self.available_mb > 0:
+            _refuse(f"the available memory must be positive (got {self.available_mb} MB)")
         if self.max_iterations < 1:
             _refuse(f"max_iterations must be at least 1 (got {self.max_iterations})")
         if self.basis is Basis.DUAL and self.method is not Method.MORTAR:
@@ -113,6 +121,7 @@ class SolveRequest:
         penalty: float | None = None,
         schwarz: SchwarzOptions | None = None,
         reference_timing: bool = False,
+        available_mb: float | None = None,
     ) -> SolveRequest:
         """The request named by strings (the CLI's and the Python API's).
 
@@ -128,6 +137,7 @@ class SolveRequest:
             penalty: The penalty's normal stiffness (None: the default).
             schwarz: The Schwarz controls (None: the defaults).
             reference_timing: Also time a fresh solve of the final system.
+            available_mb: The memory the `auto` solver may count on (None: MemAvailable).
 
         Returns:
             The validated request (InputError naming the first rule it breaks).
@@ -146,6 +156,7 @@ class SolveRequest:
             penalty=None if penalty is None else float(penalty),
             schwarz=schwarz,
             reference_timing=reference_timing,
+            available_mb=available_mb,
         )
 
     @property
@@ -178,6 +189,17 @@ class SolveRequest:
     def schwarz_options(self) -> SchwarzOptions:
         """The Schwarz controls, the defaults with max_iterations if none were given."""
         return self.schwarz or SchwarzOptions(max_iterations=self.max_iterations)
+
+
+def direct_path(spec: SolverSpec) -> SolverSpec:
+    """An `auto` spec's direct path: MUMPS with its options (any other spec: itself).
+
+    `auto` runs it unless MUMPS' memory estimate does not fit (methods/autosolve.py); its
+    PETSc options (--petsc-option) are this path's.
+    """
+    if spec.kind is not SolverKind.AUTO:
+        return spec
+    return replace(spec, kind=SolverKind.DIRECT, name="mumps")
 
 
 def _refuse(message: str) -> NoReturn:

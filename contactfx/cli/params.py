@@ -157,6 +157,7 @@ def request_from_args(args: argparse.Namespace) -> SolveRequest:
         max_iterations=args.max_iterations,
         penalty=getattr(args, "penalty", None),
         reference_timing=getattr(args, "reference_timing", False),
+        available_mb=getattr(args, "available_memory", None),
     )
 
 

@@ -128,10 +128,10 @@ def _solver_options(p: argparse.ArgumentParser) -> Any:
     v = p.add_argument_group("linear solver")
     v.add_argument(
         "--solver",
-        default="mumps",
-        help=f"one of {', '.join(SOLVERS)}: mumps (default) factorizes the saddle point, "
-        "condensed eliminates the multipliers (CG + GAMG; needs --method nts or mortar "
-        "--basis dual)",
+        default="auto",
+        help=f"one of {', '.join(SOLVERS)}: mumps factorizes the saddle point, condensed "
+        "eliminates the multipliers (CG + GAMG; needs --method nts or mortar --basis dual); "
+        "auto (default): mumps unless MUMPS' own memory estimate does not fit, then condensed",
     )
     v.add_argument(
         "--petsc-option",
@@ -140,6 +140,14 @@ def _solver_options(p: argparse.ArgumentParser) -> Any:
         metavar="KEY=VALUE",
         help="extra PETSc option for the solver's KSP (no leading dash); it cannot change "
         "the solver's kind (choose that with --solver)",
+    )
+    v.add_argument(
+        "--available-memory",
+        type=float,
+        default=None,
+        metavar="MB",
+        help="memory per node (MB) that --solver auto compares MUMPS' estimate with "
+        "(default: MemAvailable of /proc/meminfo)",
     )
     return v
 

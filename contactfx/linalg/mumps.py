@@ -1,7 +1,8 @@
-"""MUMPS calls that petsc4py does not wrap (selected entries of the inverse), via ctypes.
+"""MUMPS calls that petsc4py does not wrap, via ctypes: selected inverse entries, analysis.
 
-The active-set loop's probes need a few hundred entries of the saddle-point inverse; MUMPS
-computes them by pruning its elimination tree (ICNTL(30)), far cheaper than dense solves.
+The analysis alone gives MUMPS' memory estimate before any factorization. The active-set
+loop's probes need a few hundred entries of the saddle-point inverse; MUMPS computes them
+by pruning its elimination tree (ICNTL(30)), far cheaper than dense solves.
 """
 
 from __future__ import annotations
@@ -9,10 +10,15 @@ from __future__ import annotations
 import ctypes
 import functools
 import logging
+import time
+from dataclasses import dataclass
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
+
+from ..errors import SolverError
+from .petsc_options import petsc_error_message
 
 log = logging.getLogger("contactfx")
 
@@ -33,7 +39,77 @@ def petsc_library() -> ctypes.CDLL | None:
     get_inverse.argtypes = [ctypes.c_void_p, ctypes.c_void_p]
     lib.MatMumpsGetIcntl.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.POINTER(ctypes.c_int)]
     set_icntl.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+    lib.MatCholeskyFactorSymbolic.argtypes = [ctypes.c_void_p] * 4
+    lib.MatLUFactorSymbolic.argtypes = [ctypes.c_void_p] * 5
+    lib.MatFactorInfoInitialize.argtypes = [ctypes.c_void_p]
     return lib
+
+
+@dataclass(frozen=True)
+class MumpsEstimate:
+    """MUMPS' memory estimate after its analysis (MB): this rank's, the largest, the sum.
+
+    In-core (INFO(15), INFOG(16), INFOG(17)) unless ICNTL(22) = 1 asks for out-of-core
+    factors (INFO(17), INFOG(26), INFOG(27)); a rank's is ICNTL(23) where that caps it.
+    MUMPS allocates this much at the numeric factorization (ICNTL(14)'s relaxation
+    included; docs/scale.md, "The default solver").
+    """
+
+    rank_mb: float
+    max_mb: float
+    total_mb: float
+    seconds: float  # of the analysis
+
+
+def analyze_pc(pc: PETSc.PC, A: PETSc.Mat) -> MumpsEstimate | None:
+    """MUMPS' analysis of A by a factorization PC before its first setup (`analyze`).
+
+    None if the PC does not factorize with MUMPS or the analysis failed. The PC's options
+    must be in PETSc's database.
+    """
+    if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
+        return None
+    try:
+        pc.setFactorSetUpSolverType()
+        return analyze(pc.getFactorMatrix(), A, pc.getType() == "cholesky")
+    except PETSc.Error as err:
+        raise SolverError(petsc_error_message(err, "MUMPS analysis")) from None
+
+
+def analyze(F: PETSc.Mat, A: PETSc.Mat, cholesky: bool) -> MumpsEstimate | None:
+    """Run MUMPS' analysis of A into its factor F alone, and read its memory estimate.
+
+    F is a PC's factor matrix before its first setup: PETSc's MUMPS interface then skips a
+    second analysis of the same pattern, so the factorization reuses this one. The PETSc
+    options of F's prefix must be in the database (MUMPS' ICNTLs are read here). None if
+    the analysis failed (a log line says why), the same on every rank.
+    """
+    lib = petsc_library()
+    if lib is None:
+        return None
+    info = (ctypes.c_double * 64)()  # a MatFactorInfo (about 20 reals); MUMPS ignores it
+    lib.MatFactorInfoInitialize(ctypes.byref(info))
+    mpi = F.getComm().tompi4py()
+    t0 = time.perf_counter()
+    if cholesky:
+        err = lib.MatCholeskyFactorSymbolic(F.handle, A.handle, None, ctypes.byref(info))
+    else:
+        err = lib.MatLUFactorSymbolic(F.handle, A.handle, None, None, ctypes.byref(info))
+    seconds = mpi.allreduce(time.perf_counter() - t0, op=MPI.MAX)
+    status = F.getMumpsInfog(1) if err == 0 else -1
+    if mpi.allreduce(int(err != 0 or status < 0), op=MPI.MAX):
+        if mpi.rank == 0:
+            log.info("MUMPS analysis failed (PETSc error %d, INFOG(1) %d)", err, status)
+        return None
+    ooc = F.getMumpsIcntl(22) == 1
+    mine, top, total = (17, 26, 27) if ooc else (15, 16, 17)
+    cap = F.getMumpsIcntl(23)  # > 0: each rank allocates this much working memory instead
+    return MumpsEstimate(
+        float(cap if cap > 0 else F.getMumpsInfo(mine)),
+        float(F.getMumpsInfog(top)),
+        float(F.getMumpsInfog(total)),
+        seconds,
+    )
 
 
 def _pattern(rows: np.ndarray, cols: np.ndarray, symmetric: bool) -> list[np.ndarray]:

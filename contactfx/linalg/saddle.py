@@ -23,7 +23,7 @@ from petsc4py import PETSc
 from ..errors import SolverError
 from .blocks import SaddleBlocks
 from .capacitance import released_solve
-from .mumps import petsc_library
+from .mumps import MumpsEstimate, analyze_pc, petsc_library
 from .petsc_options import PrefixedOptions, petsc_error_message, reason_name
 from .policy import Decision, Factored, FactorizationPolicy
 from .protocol import SaddleResult
@@ -319,3 +319,16 @@ class SaddleSolver:
             r0 = m.B.getOwnershipRange()[0]
             self._cache.store(self.factored.count, probes, active, out, r0, self._mpi)
         return out
+
+
+def mumps_estimate(solver: SaddleSolver) -> MumpsEstimate | None:
+    """MUMPS' analysis of the solver's saddle point alone, before any factorization.
+
+    Its memory estimate, or None (not a MUMPS factorization, or the analysis failed); the
+    solver's first factorization reuses the analysis (linalg/mumps.py: `analyze_pc`).
+    """
+    if not solver.direct:
+        return None
+    solver._configure()  # a function of this module: the class stays within its size
+    with solver._options.inserted():
+        return analyze_pc(solver._ksp.getPC(), solver._m.A)

@@ -17,8 +17,7 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from ..discretize.setup import ContactSetup, prepare_contact
-from ..discretize.supports import rigid_body_modes
+from ..discretize.setup import ContactSetup
 from ..errors import EliminationError, InputError
 from ..linalg import LinearSolver, SaddleResult
 from ..options import SolverKind, SolverSpec
@@ -33,8 +32,9 @@ from .active_set import (
     Step,
     run_active_set,
 )
+from .autosolve import Prepared, prepare_solver, warn_if_too_big
 from .solution import Solution, finish
-from .solvers import make_solver
+from .solvers import setup_solver
 
 log = logging.getLogger("contactfx")
 
@@ -213,29 +213,13 @@ def refusal(setup: ContactSetup, err: EliminationError) -> str:
     )
 
 
-def _solver(setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool) -> LinearSolver:
-    """The loop's solver (reuse: it keeps its setup across sets) or a throwaway one."""
-    el = setup.elasticity
-    return make_solver(
-        spec,
-        el.K,
-        setup.B,
-        el.f,
-        e_max=setup.e_max,
-        h=setup.h,
-        modes=lambda: rigid_body_modes(el.V, scene),
-        node_dofs=setup.node_dofs(),
-        reuse=reuse,
-    )
-
-
 def _timed_fresh_solve(
     setup: ContactSetup, spec: SolverSpec, scene: Scene, active: np.ndarray
 ) -> tuple[SaddleResult, float]:
     """One fresh solve of the final system by `spec` (a throwaway solver), and its seconds."""
     setup.comm.Barrier()
     t0 = time.perf_counter()
-    fresh = _solver(setup, spec, scene, reuse=False)
+    fresh = setup_solver(setup, spec, scene, reuse=False)
     try:
         return fresh.solve(setup.g, active, fresh=True), time.perf_counter() - t0
     finally:
@@ -273,6 +257,7 @@ def solve_contact(
     aso: ActiveSetOptions | None = None,
     initial_active: InitialSet | Callable[[np.ndarray], np.ndarray] | None = None,
     label: str = "active set",
+    prepared: Prepared | None = None,
 ) -> Solution:
     """Solve the frictionless unilateral contact problem of `scene` with Lagrange multipliers.
 
@@ -280,15 +265,21 @@ def solve_contact(
     enforcement is the multipliers': `contactfx.solve` dispatches the others); `aso` other
     loop controls. `initial_active` (node coordinates -> bool, or an InitialSet) adds nodes
     to the first active set; only the loop's cost depends on it, never the converged
-    solution. `label` heads the log lines.
+    solution. `label` heads the log lines. `prepared`: the setup (and solver) made already
+    (`autosolve.prepare_solver`, which also resolves an `auto` solver); this call owns it.
     """
     aso = aso or ActiveSetOptions(request.max_iterations)
-    spec = request.solver
     timers = timers or Timers()
-    setup = prepare_contact(scene, request.kernel, aso.penetration_tol, timers, request.basis)
+    if prepared is None:
+        prepared = prepare_solver(scene, request, aso.penetration_tol, timers)
+    setup, request = prepared.setup, prepared.request
+    spec = request.solver
     try:
         # One solver for the whole loop: fixed matrix pattern, reused analysis and setup.
-        linear = _solver(setup, spec, scene, reuse=True)
+        linear = prepared.linear
+        if linear is None:
+            linear = setup_solver(setup, spec, scene, reuse=True)
+            warn_if_too_big(linear, scene, request, timers)
         guess = (
             initial_active
             if isinstance(initial_active, InitialSet) or initial_active is None
@@ -311,6 +302,7 @@ def solve_contact(
     finally:
         setup.destroy()
     sol.basis = request.basis
+    sol.solver_choice = prepared.choice
     if ref is not None:
         sol.reference_linear_iterations = ref.iterations
     return sol

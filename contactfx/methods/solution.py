@@ -19,6 +19,7 @@ from ..discretize.surfaces import GatheredSurface
 from ..options import Basis, Method
 from ..scenes import Body, ContactPair, Obstacle, Scene
 from ..timers import Timers
+from .solver_choice import SolverChoice
 
 # One record per active-set (or Schwarz) iteration; None where a value is undefined.
 History = list[dict[str, float | None]]
@@ -155,6 +156,7 @@ class Solution:
     penalty: PenaltyResult | None = None
     schwarz_dirichlet_body: str | None = None  # Schwarz: the body that took Dirichlet data
     reference_linear_iterations: int | None = None  # of the fresh solve (reference timing)
+    solver_choice: SolverChoice | None = None  # what the `auto` solver ran and why
     cache: Cache = field(default_factory=Cache, repr=False)
 
     @property

@@ -10,6 +10,8 @@ from collections.abc import Callable, Mapping
 import numpy as np
 from petsc4py import PETSc
 
+from ..discretize.setup import ContactSetup
+from ..discretize.supports import rigid_body_modes
 from ..linalg.condensed import CondensedSolver
 from ..linalg.nullspace import near_nullspace
 from ..linalg.policy import FactorizationPolicy
@@ -17,6 +19,8 @@ from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
 from ..linalg.schur import SchurSolver, schur_available
 from ..options import SchurPre, SolverKind, SolverSpec
+from ..request import direct_path
+from ..scenes import Scene
 
 # MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the ordering below on
 # the host; parallel analysis with PT-Scotch orders worse on these meshes
@@ -77,8 +81,10 @@ def make_solver(
 
     `modes()`: the rigid-body modes (called only by the solvers that use GAMG on the
     displacements); `node_dofs` (m, 2): the dofs of each multiplier row's active node (the
-    condensed solver's pivots); `reuse` False: a throwaway solver for one set.
+    condensed solver's pivots); `reuse` False: a throwaway solver for one set. An `auto`
+    spec must be resolved first (methods/autosolve.py); here it is its direct path.
     """
+    spec = direct_path(spec)
     if spec.kind.condensed:
         factorized = spec.kind is SolverKind.CONDENSED_DIRECT
         return CondensedSolver(
@@ -117,4 +123,22 @@ def make_solver(
         fieldsplit=spec.kind is SolverKind.FIELDSPLIT,
         # PETSc then asks the code for the Schur preconditioning matrix: -I/gamma.
         schur_user=spec.schur is SchurPre.USER,
+    )
+
+
+def setup_solver(
+    setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool
+) -> LinearSolver:
+    """The solver of a contact setup's saddle points (reuse: it keeps its setup across sets)."""
+    el = setup.elasticity
+    return make_solver(
+        spec,
+        el.K,
+        setup.B,
+        el.f,
+        e_max=setup.e_max,
+        h=setup.h,
+        modes=lambda: rigid_body_modes(el.V, scene),
+        node_dofs=setup.node_dofs(),
+        reuse=reuse,
     )

@@ -221,7 +221,8 @@ class RunSummary:
     active_set: list[Any]  # the active-set (or Schwarz) history, step by step
     times: dict[str, float]
     contacts: tuple[ContactSummary, ...]
-    solver: str  # the label of the linear solver
+    solver: str  # the label of the linear solver that ran
+    solver_choice: dict[str, Any] | None = None  # `auto`: what it ran and why
     discretization: Discretization
     enforcement: Enforcement
     memory: dict[str, float]
@@ -277,6 +278,8 @@ class RunSummary:
         if self.lame:
             out["lame"] = [r.to_json() for r in self.lame]
         out["solver"] = self.solver
+        if self.solver_choice is not None:
+            out["solver_choice"] = self.solver_choice
         out["discretization"] = self.discretization.value
         out["enforcement"] = self.enforcement.value
         out["memory"] = self.memory

@@ -96,7 +96,12 @@ def summary(
         active_set=sol.history,
         times=times,
         contacts=contacts_summary(sol),
-        solver=solver_label(request.method, request.solver),
+        solver=(
+            solver_label(request.method, request.solver)
+            if sol.solver_choice is None
+            else sol.solver_choice.ran
+        ),
+        solver_choice=None if sol.solver_choice is None else sol.solver_choice.to_json(),
         discretization=request.discretization,
         enforcement=request.enforcement,
         memory=memory,

@@ -279,6 +279,18 @@ def condensed_nts() -> tuple[Solution, Arrays]:
 CASES["hertz-condensed-nts"] = Case(condensed_nts, {"act": Exact(), "p": Rel(1e-6)})
 
 
+def auto_condensed() -> tuple[Solution, Arrays]:
+    """The default solver with the memory forced tiny: condensed, dual mortar, on any ranks."""
+    request = SolveRequest.parse("mortar", basis="dual", available_mb=1.0)
+    sol = solve(hertz(HertzParams(refine=0.08, h_far=0.8, mesh="structured")), request)
+    assert sol.solver_choice is not None and sol.solver_choice.ran == "condensed"
+    order = np.lexsort(sol.layout.x.T[::-1])
+    return sol, {"act": sol.active[order], "p": sol.pressure[order]}
+
+
+CASES["hertz-auto-condensed"] = Case(auto_condensed, {"act": Exact(), "p": Rel(1e-6)})
+
+
 def probe_by_selected_inverse(solver: str) -> Callable[[], Any]:
     """Mortar on Hertz: the rows probed in step 1 (selected inverse) and the pressures."""
 

@@ -1,0 +1,118 @@
+"""The default solver `auto`: MUMPS' factorization unless MUMPS says it would not fit.
+
+Before any factorization MUMPS' analysis alone runs on the loop's own saddle-point solver
+(linalg/saddle.py: `mumps_estimate`) and gives the memory its factorization will allocate.
+On each node the ranks' estimates add up against the memory available there; with room (the
+SAFETY factor) the direct path runs and its first factorization reuses that analysis, else
+the condensed path runs (multipliers eliminated, CG + GAMG) where D is diagonal, and
+elsewhere the run is refused before factorizing. The rule and its measurements:
+docs/scale.md, "The default solver".
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, replace
+
+from mpi4py import MPI
+
+from ..discretize.setup import ContactSetup, prepare_contact
+from ..errors import InputError
+from ..linalg import LinearSolver
+from ..linalg.saddle import SaddleSolver, mumps_estimate
+from ..options import SOLVERS, SolverKind
+from ..request import SolveRequest, direct_path
+from ..scenes import Scene
+from ..timers import Timers
+from .solver_choice import CONDENSED, SAFETY, Choice, SolverChoice, choose, node_budget
+from .solvers import setup_solver
+
+log = logging.getLogger("contactfx")
+
+
+@dataclass
+class Prepared:
+    """A multiplier run's fine setup, its request (solver resolved) and a ready solver."""
+
+    setup: ContactSetup
+    request: SolveRequest
+    linear: LinearSolver | None = None  # the direct solver whose analysis is done
+    choice: SolverChoice | None = None
+
+    def destroy(self) -> None:
+        """Free the solver and the setup (on an error before the loop takes them)."""
+        if self.linear is not None:
+            self.linear.destroy()
+        self.setup.destroy()
+
+
+def prepare_solver(
+    scene: Scene, request: SolveRequest, penetration_tol: float, timers: Timers
+) -> Prepared:
+    """Assemble the contact setup of `scene` and resolve an `auto` solver on it."""
+    setup = prepare_contact(scene, request.kernel, penetration_tol, timers, request.basis)
+    if request.solver.kind is not SolverKind.AUTO:
+        return Prepared(setup, request)
+    try:
+        return _resolve(setup, scene, request, timers)
+    except BaseException:
+        setup.destroy()
+        raise
+
+
+def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: Timers) -> Prepared:
+    """Run MUMPS' analysis on the loop's direct solver and choose (module docstring)."""
+    direct = replace(request, solver=direct_path(request.solver))
+    linear = setup_solver(setup, direct.solver, scene, reuse=True)
+    try:
+        with timers("solve"):
+            estimate = mumps_estimate(linear) if isinstance(linear, SaddleSolver) else None
+        needed, avail = node_budget(
+            scene.comm, None if estimate is None else estimate.rank_mb, request.available_mb
+        )
+        choice = choose(needed, avail, request.diagonal)
+    except BaseException:
+        linear.destroy()
+        raise
+    seconds = None if estimate is None else estimate.seconds
+    if choice is Choice.DIRECT:
+        record = SolverChoice(direct.solver.name, needed, avail, seconds)
+        _say(record, scene.comm)
+        return Prepared(setup, direct, linear, record)
+    linear.destroy()  # frees MUMPS' analysis before the other path runs
+    assert needed is not None and avail is not None  # a known estimate that does not fit
+    if choice is Choice.REFUSE:
+        raise InputError(
+            f"the direct solver would not fit: MUMPS estimates {needed / 1e3:.2f} GB, "
+            f"{avail / 1e3:.2f} GB available (margin x{SAFETY:g}); use --method mortar "
+            "--basis dual (or nts) for the condensed path, or fewer DOFs"
+        )
+    record = SolverChoice(CONDENSED, needed, avail, seconds)
+    _say(record, scene.comm)
+    if request.solver.petsc != SOLVERS["auto"].petsc and scene.comm.rank == 0:
+        log.info("solver: the --petsc-option values were for MUMPS: not applied")
+    return Prepared(setup, replace(request, solver=SOLVERS[CONDENSED]), None, record)
+
+
+def warn_if_too_big(
+    linear: LinearSolver, scene: Scene, request: SolveRequest, timers: Timers
+) -> None:
+    """An explicit MUMPS runs as asked; a log line warns where its estimate does not fit.
+
+    The analysis is the one its first factorization reuses (no cost beyond a collective).
+    """
+    if request.solver.kind is not SolverKind.DIRECT or not isinstance(linear, SaddleSolver):
+        return
+    with timers("solve"):
+        estimate = mumps_estimate(linear)
+    rank_mb = None if estimate is None else estimate.rank_mb
+    needed, avail = node_budget(scene.comm, rank_mb, request.available_mb)
+    if choose(needed, avail, True) is not Choice.DIRECT and scene.comm.rank == 0:
+        reason = SolverChoice(request.solver.name, needed, avail, None).reason
+        log.warning("solver: %s, although %s", request.solver.name, reason)
+
+
+def _say(record: SolverChoice, comm: MPI.Comm) -> None:
+    """The log line of the choice (rank 0)."""
+    if comm.rank == 0:
+        log.info("solver: %s (%s)", record.ran, record.reason)

@@ -1,0 +1,125 @@
+"""The default solver `auto`: the choice rule alone, and the whole run with the available
+memory forced (SolveRequest.available_mb / --available-memory) on a small Hertz mesh.
+
+References: the explicit presets (`--solver mumps`, `--solver condensed`) on the same scene,
+independent runs of the paths `auto` chooses between.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import run_cli
+from mpi4py import MPI
+
+from contactfx import run_scene
+from contactfx.api import as_request
+from contactfx.errors import InputError
+from contactfx.methods.solver_choice import SAFETY, Choice, choose, mem_available_mb, node_budget
+from contactfx.options import SOLVERS, SolverKind
+from contactfx.request import SolveRequest
+from contactfx.scenes import HertzParams, hertz
+
+SMALL = HertzParams(refine=0.08, h_far=0.8, mesh="structured")  # about 50k DOFs
+
+
+@pytest.mark.parametrize(
+    ("needed", "available", "condensable", "expected"),
+    [
+        (1000.0, 4000.0, True, Choice.DIRECT),
+        (1000.0, 1000.0 * SAFETY, False, Choice.DIRECT),  # exactly fits with the margin
+        (1000.0, 1000.0 * SAFETY - 1.0, True, Choice.CONDENSED),
+        (1000.0, 1100.0, False, Choice.REFUSE),
+        (None, 10.0, False, Choice.DIRECT),  # no estimate: the direct default
+        (1000.0, None, True, Choice.DIRECT),  # no MemAvailable: likewise
+    ],
+)
+def test_choose(needed, available, condensable: bool, expected: Choice) -> None:
+    assert choose(needed, available, condensable) is expected
+
+
+def test_choose_safety_factor() -> None:
+    assert choose(1000.0, 1000.0, True, safety=1.0) is Choice.DIRECT
+    assert choose(1000.0, 1000.0, True, safety=1.01) is Choice.CONDENSED
+
+
+def test_node_budget_one_rank() -> None:
+    comm = MPI.COMM_SELF
+    assert node_budget(comm, 300.0, 500.0) == (300.0, 500.0)
+    assert node_budget(comm, None, 500.0) == (None, None)
+    avail = mem_available_mb()
+    assert avail is None or avail > 0.0
+    assert node_budget(comm, 300.0, None) == ((300.0, avail) if avail else (None, None))
+
+
+def test_auto_is_the_default_and_direct_elsewhere() -> None:
+    assert as_request("mortar").solver.kind is SolverKind.AUTO
+    # Penalty and Schwarz factorize with MUMPS: nothing to choose.
+    assert as_request("penalty").solver.kind is SolverKind.DIRECT
+    assert as_request("schwarz").solver.kind is SolverKind.DIRECT
+    with pytest.raises(InputError, match="available memory must be positive"):
+        SolveRequest(available_mb=0.0)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return hertz(SMALL, comm=MPI.COMM_SELF)
+
+
+def _run(scene, solver: str, available_mb: float | None = None, basis: str = "dual"):
+    request = SolveRequest.parse("mortar", basis=basis, solver=solver, available_mb=available_mb)
+    return run_scene(scene, request)
+
+
+@pytest.mark.parametrize(("available", "preset"), [(1.0, "condensed"), (1e9, "mumps")])
+def test_auto_runs_what_fits(scene, available: float, preset: str) -> None:
+    """Tiny memory: condensed, its answer; ample: MUMPS, its answer (same set, 1e-7)."""
+    sol, data = _run(scene, "auto", available)
+    ref, _ = _run(scene, preset)
+    out = data.to_json()
+    assert out["solver"] == preset
+    choice = out["solver_choice"]
+    assert choice["ran"] == preset and choice["available_mb"] == available
+    assert choice["mumps_estimate_mb"] > 1.0  # a real estimate, compared with the override
+    assert np.array_equal(sol.active, ref.active)
+    scale = np.abs(ref.pressure).max()
+    assert np.abs(sol.pressure - ref.pressure).max() <= 1e-7 * scale
+    du = np.abs(sol.u.x.array - ref.u.x.array).max()
+    assert du <= 1e-7 * np.abs(ref.u.x.array).max()
+    if preset == "condensed":
+        assert all(h["linear_iterations"] > 1 for h in sol.history)  # CG ran, not MUMPS
+
+
+def test_auto_refuses_where_nothing_fits(scene, caplog) -> None:
+    """The standard basis cannot be condensed: one clear refusal before factorizing."""
+    with pytest.raises(InputError, match=r"would not fit.*GB available.*--basis dual"):
+        _run(scene, "auto", 1.0, basis="standard")
+    # An explicit MUMPS is honoured whatever the estimate, with a warning.
+    request = SolveRequest.parse("mortar", solver=SOLVERS["mumps"], available_mb=1.0)
+    with caplog.at_level("WARNING", logger="contactfx"):
+        _, data = run_scene(scene, request)
+    assert data.to_json()["solver"] == "mumps"
+    assert "solver: mumps, although MUMPS needs" in caplog.text
+
+
+HERTZ = ["hertz", "--mesh", "structured", "--refine", "0.08", "--h-far", "0.8", "--method"]
+
+
+@pytest.mark.mpi
+def test_auto_under_mpi(tmp_path: Path) -> None:
+    """Two ranks: tiny memory runs condensed (logged); without dual mortar a one-line exit 2."""
+    out = tmp_path / "run.json"
+    args = [*HERTZ, "mortar", "--basis", "dual", "--available-memory", "1", "--json", str(out)]
+    proc = run_cli("solve", *args, ranks=2)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "solver: condensed (MUMPS would need" in proc.stdout + proc.stderr
+    data = json.loads(out.read_text())
+    assert data["solver"] == "condensed" and data["ranks"] == 2
+    bad = run_cli("solve", *HERTZ, "mortar", "--available-memory", "1", ranks=2)
+    assert bad.returncode == 2
+    lines = [ln for ln in bad.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "would not fit" in lines[0], bad.stderr
+    assert "Traceback" not in bad.stderr
