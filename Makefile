@@ -11,7 +11,7 @@ PYTHON312 := $(shell python3.12 -c 'import sys' >/dev/null 2>&1 && echo python3.
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: demo test docs bench bench-scale clean venv lock
+.PHONY: demo test docs bench bench-scale bench-scaling clean venv lock
 
 venv: $(STAMP)
 
@@ -75,6 +75,11 @@ bench: $(STAMP)
 # The condensed solver against MUMPS from 100k to 10M dofs (about 25 min).
 bench-scale: $(STAMP)
 	$(PY) benchmarks/scale.py
+
+# The scaling table of the accurate family, 1 and 2 ranks (docs/scale.md, "Scaling").
+bench-scaling: $(STAMP)
+	$(PY) benchmarks/scaling.py --sizes 100e3,400e3,1e6,2e6 --ranks 1,2
+	$(PY) benchmarks/scaling.py --sizes 100e3,400e3,1e6,2e6 --ranks 1,2 --solver mumps
 
 clean:
 	rm -rf results .pytest_cache docs/_build docs/demos docs/reference/api docs/reference/scene_file.md
