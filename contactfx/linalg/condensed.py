@@ -26,7 +26,6 @@ from .elimination import (
     t_mult,
     t_mult_transpose,
 )
-from .memory import release_freed_memory
 from .nullspace import orthonormalize
 from .petsc_options import PrefixedOptions, global_options, petsc_error_message, reason_name
 from .pivots import pivots
@@ -90,7 +89,6 @@ class CondensedSolver:
         self._setup_options: dict[str, object] = (
             {"mat_product_clear": True} if free_products else {}
         )
-        release_freed_memory()  # what meshing and assembly freed: before the big matrices
 
     exact = False  # the loop's solves stop at loose_rtol: a stationary set is polished
     can_probe = False  # no factorization: no exact responses
@@ -150,8 +148,6 @@ class CondensedSolver:
                 ksp.setTolerances(rtol=self._relative_to_b(A, v, b, rtol))
                 with global_options({} if reuse else self._setup_options):
                     ksp.setUp()
-                if not reuse:
-                    release_freed_memory()  # the setup's intermediates (products, graphs)
                 t1 = time.perf_counter()
                 ksp.solve(b, v)
         except PETSc.Error as err:
@@ -209,7 +205,6 @@ class CondensedSolver:
             ksp.setOperators(A, self._A)
             return A
         A = condensed_matrix(self._K, E, piv, self._diag)
-        release_freed_memory()  # the products' intermediates, before GAMG's setup
         if self._modes:
             A.setNearNullSpace(self._near_nullspace(piv))
         ksp.setOperators(A)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from petsc4py import PETSc
 
-from contactfx.linalg.memory import release_freed_memory
 from contactfx.linalg.petsc_options import global_options
 
 
@@ -20,10 +19,3 @@ def test_global_options_are_removed_and_user_keys_kept() -> None:
         assert db.getString("contactfx_test_user_key") == "7"
     finally:
         db.delValue("contactfx_test_user_key")
-
-
-def test_release_freed_memory_runs() -> None:
-    """glibc's malloc_trim is found on this platform (Linux); elsewhere it reports False."""
-    import platform
-
-    assert release_freed_memory() is (platform.libc_ver()[0] == "glibc")
