@@ -201,6 +201,7 @@ class SolverSpec:
     loose_rtol: float | None = None
     name: str = "custom"
     schur: SchurPre | None = None
+    free_products: bool = False  # GAMG's setup frees its products' data (methods/solvers.py)
 
     def __post_init__(self) -> None:
         self._check()
@@ -355,11 +356,9 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
                 "ksp_norm_type": "unpreconditioned",
                 "ksp_max_it": 5000,
                 "pc_type": "gamg",
-                # Why each of these: docs/scale.md, "GAMG on stretched cells". The threshold
-                # drops weak couplings across stretched cells from the aggregation graph;
-                # ICC(0) blocks keep the strong couplings along them that point Jacobi
-                # cannot (iterations independent of cell shape); three Chebyshev steps, not
-                # two, for fewer iterations (each step costs more).
+                # Why: docs/scale.md, "GAMG on stretched cells". The threshold drops weak
+                # couplings across stretched cells from the graph; ICC(0) blocks keep the
+                # strong ones along them; 3 Chebyshev steps, not 2: fewer (dearer) iterations.
                 "pc_gamg_threshold": 0.05,
                 "pc_gamg_aggressive_coarsening": 1,
                 "mg_levels_pc_type": "bjacobi",
@@ -369,6 +368,7 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
             rtol=1e-9,
             loose_rtol=1e-4,
             name="condensed",
+            free_products=True,  # never reused: docs/scale.md, "Memory of the condensed path"
         ),
         # The same condensed system factorized: MUMPS Cholesky (SPD, SYM=1). Later sets run CG
         # preconditioned by the kept factorization (a low-rank change: a few iterations)

@@ -18,9 +18,16 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import SolverError
-from .elimination import CondensedOperator, LocalRows, condensed_matrix, elimination_matrix
+from .elimination import (
+    CondensedOperator,
+    LocalRows,
+    condensed_matrix,
+    elimination_matrix,
+    t_mult,
+    t_mult_transpose,
+)
 from .nullspace import orthonormalize
-from .petsc_options import PrefixedOptions, petsc_error_message, reason_name
+from .petsc_options import PrefixedOptions, global_options, petsc_error_message, reason_name
 from .pivots import pivots
 from .policy import Decision, FactorizationPolicy
 from .protocol import SaddleResult
@@ -40,6 +47,8 @@ class CondensedSolver:
     tolerance (`polish`); `loose_rtol`: the relative reduction of the loop's solves.
     `reuse` False: a throwaway solver (a new preconditioner for every set). `policy`: the
     preconditioner is a factorization, kept while that is cheaper than a new one.
+    `free_products`: the preconditioner's setup frees its matrix products' intermediate data
+    (PETSc's unprefixed mat_product_clear: GAMG's products carry no prefix).
     """
 
     def __init__(
@@ -55,6 +64,7 @@ class CondensedSolver:
         loose_rtol: float | None = None,
         reuse: bool = True,
         policy: FactorizationPolicy | None = None,
+        free_products: bool = False,
     ) -> None:
         self._K, self._f = K, f
         self._comm = K.getComm()
@@ -76,6 +86,9 @@ class CondensedSolver:
         self.reuse = reuse
         # With a factorization as preconditioner: refactor by measured costs (policy.py).
         self.policy = policy
+        self._setup_options: dict[str, object] = (
+            {"mat_product_clear": True} if free_products else {}
+        )
 
     exact = False  # the loop's solves stop at loose_rtol: a stationary set is polished
     can_probe = False  # no factorization: no exact responses
@@ -110,7 +123,8 @@ class CondensedSolver:
         rows, piv, prows = pv.rows, pv.dofs, pv.e_rows
         # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
         ip: Any = piv.astype(PETSc.IntType)
-        T = elimination_matrix(prows, self._r0, self._r1, nglob, self._comm, identity=True)
+        # E = T - I: the pivot rows only (T itself would hold a row per dof).
+        E = elimination_matrix(prows, self._r0, self._r1, nglob, self._comm, identity=False)
         d, t, r, b = (self._f.duplicate() for _ in range(4))
         d.set(0.0)
         d.setValues(ip, cast(Any, self._diag.getValues(ip)))
@@ -120,7 +134,7 @@ class CondensedSolver:
         t.assemble()
         self._K.mult(t, r)
         r.aypx(-1.0, self._f)  # f - K t
-        T.multTranspose(r, b)
+        t_mult_transpose(E, r, b)
         v = self._u.copy()  # warm start: the last displacement, pivots free
         v.setValues(ip, cast(Any, np.zeros(len(piv))))
         v.assemble()
@@ -128,11 +142,12 @@ class CondensedSolver:
         ksp = self._ksp
         try:
             with self._options.inserted():  # read lazily at setup and solve (GAMG levels)
-                A = self._operator(reuse, T, d, prows, piv)
+                A = self._operator(reuse, E, d, piv)
                 ksp.getPC().setReusePreconditioner(reuse)
                 ksp.setInitialGuessNonzero(True)
                 ksp.setTolerances(rtol=self._relative_to_b(A, v, b, rtol))
-                ksp.setUp()
+                with global_options({} if reuse else self._setup_options):
+                    ksp.setUp()
                 t1 = time.perf_counter()
                 ksp.solve(b, v)
         except PETSc.Error as err:
@@ -143,7 +158,7 @@ class CondensedSolver:
                 f"condensed solve ({ksp.getType()}) did not converge: PETSc "
                 f"reason {reason} ({reason_name(reason)}) after {its} iterations"
             )
-        T.mult(v, self._u)
+        t_mult(E, v, self._u)
         self._u.axpy(1.0, t)
         self._K.mult(self._u, r)
         r.aypx(-1.0, self._f)  # f - K u: the contact force on the pivots
@@ -151,7 +166,7 @@ class CondensedSolver:
         mu[rows] = pv.multipliers(r.getValues(ip))
         u = self._u.array.copy()
         t2 = time.perf_counter()
-        for obj in (T, d, t, r, b, v):
+        for obj in (E, d, t, r, b, v):
             obj.destroy()
         if reuse:
             A.destroy()
@@ -178,22 +193,18 @@ class CondensedSolver:
         n_piv = self._mpi.allreduce(len(piv))
         return changed <= max(REBUILD_FRACTION * n_piv, REBUILD_CHANGES)
 
-    def _operator(
-        self, reuse: bool, T: PETSc.Mat, d: PETSc.Vec, prows: dict[int, Any], piv: np.ndarray
-    ) -> PETSc.Mat:
+    def _operator(self, reuse: bool, E: PETSc.Mat, d: PETSc.Vec, piv: np.ndarray) -> PETSc.Mat:
         """The KSP's operator: matrix-free on the kept multigrid, or a new matrix and setup."""
         ksp = self._ksp
         if reuse:
             A = PETSc.Mat().createPython(
-                cast(Any, self._K.getSizes()), CondensedOperator(self._K, T, d), comm=self._comm
+                cast(Any, self._K.getSizes()), CondensedOperator(self._K, E, d), comm=self._comm
             )
             A.setUp()
             assert self._A is not None
             ksp.setOperators(A, self._A)
             return A
-        E = elimination_matrix(prows, self._r0, self._r1, self._K.getSize()[0], self._comm, False)
         A = condensed_matrix(self._K, E, piv, self._diag)
-        E.destroy()
         if self._modes:
             A.setNearNullSpace(self._near_nullspace(piv))
         ksp.setOperators(A)

@@ -73,18 +73,21 @@ def condensed_matrix(K: PETSc.Mat, E: PETSc.Mat, piv: np.ndarray, k_diag: PETSc.
 
     A general PtAP costs several passes over K and leaves the pivot rows without a diagonal
     (inserting one reallocates the matrix, once per row). Here E^T K is a few rows of K (the
-    pivots' neighbourhoods); only the final sum passes over K once.
+    pivots' neighbourhoods); only the final sum passes over K once, into a new matrix: the
+    small coupling C plus K, not a copy of K plus C (which held two copies of K at once;
+    docs/scale.md, "Memory of the condensed path").
     """
     ip: Any = piv.astype(PETSc.IntType)
     diff = cast(Any, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
     Et = E.transpose(PETSc.Mat())  # without `out` petsc4py transposes in place
     EtK = Et.matMult(K)
-    C = EtK.transpose(PETSc.Mat())  # K E (K is symmetric)
-    C.axpy(1.0, EtK, structure=diff)
+    A = EtK.transpose(PETSc.Mat())  # K E (K is symmetric)
+    A.axpy(1.0, EtK, structure=diff)
     EtKE = EtK.matMult(E)
-    C.axpy(1.0, EtKE, structure=diff)
-    A = K.copy()
-    A.axpy(1.0, C, structure=diff)
+    A.axpy(1.0, EtKE, structure=diff)
+    for obj in (Et, EtK, EtKE):
+        obj.destroy()
+    A.axpy(1.0, K, structure=diff)  # the union pattern, allocated once
     # Round-off leaves ~1e-16 on the pivot rows and columns: zero them, with K_pp on the
     # diagonal (the decoupled v_p = 0).
     A.zeroRowsColumns(ip, diag=1.0)
@@ -92,25 +95,41 @@ def condensed_matrix(K: PETSc.Mat, E: PETSc.Mat, piv: np.ndarray, k_diag: PETSc.
     diag.setValues(ip, cast(Any, k_diag.getValues(ip)))
     diag.assemble()
     A.setDiagonal(diag)
+    diag.destroy()
     A.setBlockSize(2)
     # Symmetric positive definite: what a Cholesky factorization (MUMPS SYM=1) needs to know.
     A.setOption(cast(PETSc.Mat.Option, PETSc.Mat.Option.SPD), True)
-    for obj in (Et, EtK, C, EtKE, diag):
-        obj.destroy()
     return A
 
 
-class CondensedOperator:
-    """y = (T^T K T + P) x applied matrix-free (a petsc4py Python matrix context)."""
+def t_mult(E: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
+    """Set y = T x = x + E x, without an assembled T (its identity part costs a row per dof)."""
+    E.mult(x, y)
+    y.axpy(1.0, x)
 
-    def __init__(self, K: PETSc.Mat, T: PETSc.Mat, d: PETSc.Vec) -> None:
-        self._K, self._T, self._d = K, T, d
+
+def t_mult_transpose(E: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
+    """Set y = T^T x = x + E^T x."""
+    E.multTranspose(x, y)
+    y.axpy(1.0, x)
+
+
+class CondensedOperator:
+    """y = (T^T K T + P) x applied matrix-free, T = I + E (a petsc4py Python matrix context)."""
+
+    def __init__(self, K: PETSc.Mat, E: PETSc.Mat, d: PETSc.Vec) -> None:
+        self._K, self._E, self._d = K, E, d
         self._w1, self._w2 = K.createVecRight(), K.createVecLeft()
 
     def mult(self, mat: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
         """The product with x (the pivots' own diagonal added: they are decoupled)."""
-        self._T.mult(x, self._w1)
+        t_mult(self._E, x, self._w1)
         self._K.mult(self._w1, self._w2)
-        self._T.multTranspose(self._w2, y)
+        t_mult_transpose(self._E, self._w2, y)
         self._w1.pointwiseMult(self._d, x)
         y.axpy(1.0, self._w1)
+
+    def destroy(self, mat: PETSc.Mat) -> None:
+        """Free the work vectors with the shell matrix."""
+        self._w1.destroy()
+        self._w2.destroy()

@@ -41,6 +41,24 @@ class PrefixedOptions:
 
 
 @contextmanager
+def global_options(options: Mapping[str, object]) -> Iterator[None]:
+    """`options` in PETSc's database without a prefix for the block, then removed.
+
+    For what reads only unprefixed keys: the products GAMG creates inside its setup carry no
+    options prefix. Keys already set (by the user, e.g. PETSC_OPTIONS) are left as they are.
+    """
+    db = PETSc.Options()
+    added = [key for key in options if not db.hasName(key)]
+    for key in added:
+        db[key] = options[key]  # type: ignore[index]  # stub lacks Options.__setitem__
+    try:
+        yield
+    finally:
+        for key in added:
+            db.delValue(key)
+
+
+@contextmanager
 def petsc_options(options: Mapping[str, object]) -> Iterator[str]:
     """Set `options` under a fresh unique prefix and remove them afterwards."""
     with PrefixedOptions(options).inserted() as prefix:

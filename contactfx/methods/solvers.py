@@ -60,6 +60,17 @@ def direct_options(petsc: Mapping[str, object], K: PETSc.Mat) -> Mapping[str, ob
     )
 
 
+# GAMG recomputes a kept hierarchy from its products' data when asked to reuse the
+# interpolation: then that data must stay (SolverSpec.free_products is ignored).
+REUSE_INTERPOLATION = "pc_gamg_reuse_interpolation"
+
+
+def reuses_interpolation(petsc: Mapping[str, object]) -> bool:
+    """Whether the options ask GAMG to reuse its interpolation (PETSc's reading of a bool)."""
+    value = petsc.get(REUSE_INTERPOLATION, False)
+    return str(value).strip().lower() not in ("0", "false", "no", "off")
+
+
 def augmentation(spec: SolverSpec, e_max: float, h: float) -> float:
     """Gamma of A00 = K + gamma B^T B: E_max / h^2 for a fieldsplit (scales as K), else 0."""
     return e_max / h**2 if spec.augmented else 0.0
@@ -100,6 +111,7 @@ def make_solver(
             # A kept Cholesky factorization pays per CG iteration (one back-substitution):
             # the cost rule of the saddle-point solver decides when to refactor.
             policy=FactorizationPolicy(reuse) if factorized else None,
+            free_products=spec.free_products and not reuses_interpolation(spec.petsc),
         )
     direct = spec.kind.factorizes_saddle
     if spec.kind is SolverKind.DIRECT_SCHUR and schur_available(K.getComm()):

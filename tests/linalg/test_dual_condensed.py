@@ -81,10 +81,20 @@ def _condensed_solver(scene, reuse: bool = True):
 
 
 def test_condensed_matrix_equals_ptap(small_hertz) -> None:
-    """K + E^T K + K E + E^T K E with the pivots decoupled is PETSc's PtAP T^T K T + P."""
+    """K + E^T K + K E + E^T K E with the pivots decoupled is PETSc's PtAP T^T K T + P.
+
+    Also: K is left as it was (the sum is built into a new matrix), and T = I + E applied
+    without an assembled T (`t_mult`, `t_mult_transpose`) is the assembled T's product.
+    """
     from petsc4py import PETSc
 
-    from contactfx.linalg.elimination import LocalRows, condensed_matrix, elimination_matrix
+    from contactfx.linalg.elimination import (
+        LocalRows,
+        condensed_matrix,
+        elimination_matrix,
+        t_mult,
+        t_mult_transpose,
+    )
     from contactfx.linalg.pivots import pivots
 
     setup, solver = _condensed_solver(small_hertz)
@@ -98,7 +108,16 @@ def test_condensed_matrix_equals_ptap(small_hertz) -> None:
     T = elimination_matrix(prows, r0, r1, K.getSize()[0], K.getComm(), identity=True)
     E = elimination_matrix(prows, r0, r1, K.getSize()[0], K.getComm(), identity=False)
     ip = piv.astype(PETSc.IntType)
+    k_norm = K.norm()
     A = condensed_matrix(K, E, piv, K.getDiagonal())
+    assert K.norm() == k_norm
+    x, y, z = K.createVecRight(), K.createVecLeft(), K.createVecLeft()
+    x.setRandom()
+    for assembled, free in ((T.mult, t_mult), (T.multTranspose, t_mult_transpose)):
+        assembled(x, y)
+        free(E, x, z)
+        z.axpy(-1.0, y)
+        assert z.norm() <= 1e-14 * y.norm()
     E.destroy()
     R = K.ptap(T)
     R.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
@@ -111,7 +130,7 @@ def test_condensed_matrix_equals_ptap(small_hertz) -> None:
     assert len(piv) >= 10
     R.axpy(-1.0, A, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
     assert R.norm() <= 1e-13 * A.norm()
-    for obj in (T, A, R, d):
+    for obj in (T, A, R, d, x, y, z):
         obj.destroy()
     solver.destroy()
 

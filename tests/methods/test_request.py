@@ -205,3 +205,17 @@ def test_the_schur_preconditioner_is_a_field() -> None:
         )
     with pytest.raises(InputError, match="needs a fieldsplit"):
         SolverSpec(SolverKind.DIRECT, {"pc_type": "lu"}, schur=SchurPre.USER)
+
+
+def test_freeing_the_products_is_a_field() -> None:
+    """The condensed preset frees GAMG's product data, unless the options ask for the reuse
+    of the interpolation that needs it."""
+    from contactfx.methods.solvers import reuses_interpolation
+
+    assert SOLVERS["condensed"].free_products
+    assert not SOLVERS["mumps"].free_products and not SOLVERS["condensed-direct"].free_products
+    assert not reuses_interpolation(SOLVERS["condensed"].petsc)
+    for value, reuses in (("1", True), ("true", True), ("0", False), ("False", False)):
+        spec = SOLVERS["condensed"].with_petsc([f"pc_gamg_reuse_interpolation={value}"])
+        assert reuses_interpolation(spec.petsc) is reuses
+    assert reuses_interpolation({"pc_gamg_reuse_interpolation": True})
