@@ -35,9 +35,8 @@ import pytest
 
 from contactfx.contact import Surface
 from contactfx.discretize.setup import ContactSetup
-from contactfx.discretize.supports import rigid_body_modes
 from contactfx.linalg.protocol import LinearSolver
-from contactfx.methods.solvers import make_solver
+from contactfx.methods.solvers import setup_solver
 from contactfx.options import SOLVERS, Method, SolverSpec
 from contactfx.scenes import Scene
 
@@ -210,15 +209,4 @@ def solver_for(
 ) -> LinearSolver:
     """The solver the active-set loop builds on `setup` (methods/multipliers.py): `spec` is a
     SolverSpec or a name of SOLVERS; the rigid-body modes of `scene` for GAMG."""
-    el = setup.elasticity
-    return make_solver(
-        SOLVERS[spec] if isinstance(spec, str) else spec,
-        el.K,
-        setup.B,
-        el.f,
-        e_max=setup.e_max,
-        h=setup.h,
-        modes=lambda: rigid_body_modes(el.V, scene),
-        node_dofs=setup.node_dofs(),
-        reuse=reuse,
-    )
+    return setup_solver(setup, SOLVERS[spec] if isinstance(spec, str) else spec, scene, reuse=reuse)
