@@ -262,21 +262,27 @@ class Chains:
 def _component_labels(n: int, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
     """Connected-component label of each of n nodes, numbered in the order of their least node.
 
-    (scipy's connected_components numbering, without the scipy.sparse.csgraph import.)
+    (scipy's connected_components numbering, without the scipy.sparse.csgraph import.) Each
+    round hooks every tree's root onto the least root across its segments, then jumps the
+    pointers to the roots: the roots stay their trees' least nodes, and on polylines every
+    tree that is not a local minimum of its neighbours merges, so the rounds are logarithmic
+    in the chain length whatever the node numbering.
     """
-    label = np.arange(n)
+    parent = np.arange(n)
     while True:
-        # Every node takes the least label across its segments, then its label's label.
-        low = np.minimum(label[s0], label[s1])
-        new = label.copy()
-        np.minimum.at(new, s0, low)
-        np.minimum.at(new, s1, low)
-        new = new[new]
-        if np.array_equal(new, label):
+        r0, r1 = parent[s0], parent[s1]
+        lo, hi = np.minimum(r0, r1), np.maximum(r0, r1)
+        join = lo != hi
+        if not join.any():
             break
-        label = new
-    # Labels are now each component's least node: renumber them 0, 1, ... in that order.
-    return np.unique(label, return_inverse=True)[1].reshape(-1)
+        np.minimum.at(parent, hi[join], lo[join])
+        while True:
+            up = parent[parent]
+            if np.array_equal(up, parent):
+                break
+            parent = up
+    # Roots are each component's least node: renumber them 0, 1, ... in that order.
+    return np.unique(parent, return_inverse=True)[1].reshape(-1)
 
 
 def _incidence(n: int, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:

@@ -124,3 +124,18 @@ def test_all_pairs_search_is_the_tree_search(surface, seed, group):
     assert search._kdtree is not None or len(search._owner) <= geometry._FIRST_K
     for a, b in zip(small, tree, strict=True):
         assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+def test_component_labels_of_long_scrambled_chains_are_scipys():
+    # Long polylines with random node numbering: the case a label propagation one hop per
+    # round would take thousands of rounds on; the labels must still be scipy's.
+    rng = np.random.default_rng(7)
+    n = 20_000
+    perm = rng.permutation(n)
+    cuts = np.sort(rng.choice(np.arange(1, n - 1), 5, replace=False))
+    keep = ~np.isin(np.arange(n - 1), cuts)
+    s0, s1 = perm[:-1][keep], perm[1:][keep]
+    adj = sp.coo_matrix((np.ones(len(s0)), (s0, s1)), shape=(n, n))
+    ncomp, label = connected_components(adj, directed=False)
+    assert ncomp == 6
+    assert np.array_equal(geometry._component_labels(n, s0, s1), label)
