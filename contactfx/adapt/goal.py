@@ -46,7 +46,7 @@ from ..request import SolveRequest
 from ..results.interface import pair_forces
 from ..scenes import Model, SizeField
 from .estimate import estimate
-from .sizing import owned_cells, vertex_sizes
+from .sizing import cell_sizes, owned_cells, vertex_sizes
 from .true_error import energy_error
 
 
@@ -153,8 +153,7 @@ def refined_field(
     0.5 halves it too. Collective; the field's arrays on rank 0.
     """
     quads, verts = owned_cells(sol)
-    d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
-    h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
+    h = cell_sizes(quads)
     factor = np.full(len(h), far)
     if near != far:
         mid = quads.mean(axis=1)

@@ -41,7 +41,7 @@ from .goal import GOAL_MEANING, Goal, GoalRecord, goal_estimate
 from .loop import REPLANS, AdaptLevel, AdaptOptions, AdaptResult, adapt, level_line, solve_level
 from .pressure_estimate import PressureEstimate
 from .pressure_sizing import pressure_cell_sizes
-from .sizing import Plan, SizingRule, owned_cells, plan_mesh
+from .sizing import Plan, SizingRule, cell_sizes, owned_cells, plan_mesh
 
 # Error ~ N^s on level 0 (no observed rate yet): P1 pressure h^1.5 on a mesh refined along
 # a line (N ~ h^-2 overall: s = -0.75); Q1 energy h^1 (s = -0.5); the force h^2 (s = -1).
@@ -107,8 +107,7 @@ def contact_levels(sol: Solution, pe: PressureEstimate | None, aim: float, fines
     ratio = np.inf
     if pe is not None:
         quads, _ = owned_cells(sol)
-        d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
-        h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
+        h = cell_sizes(quads)
         asked = pressure_cell_sizes(pe, aim, quads, h, 0.0) / np.maximum(h, 1e-300)
         ratio = float(np.min(asked, initial=np.inf))
     ratio = sol.scene.comm.allreduce(ratio, op=MPI.MIN)

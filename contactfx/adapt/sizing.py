@@ -69,6 +69,12 @@ def owned_cells(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
     return msh.geometry.x[geo][:, order, :2], gv.reshape(-1, 4)
 
 
+def cell_sizes(quads: np.ndarray) -> np.ndarray:
+    """Each quad's size: the square root of its area (from the diagonals' cross product)."""
+    d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
+    return np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
+
+
 def vertex_sizes(comm: MPI.Comm, quads: np.ndarray, verts: np.ndarray, h: np.ndarray) -> SizeField:
     """The size field on rank 0: at each vertex the smallest new size of the cells around it.
 
@@ -165,8 +171,7 @@ def plan_mesh(
     eta_true = est.eta.x.array[Q.dofmap.list[:nloc, 0]]
     quads, verts = owned_cells(sol)
     eta = est.marking(rule.contact_weight)
-    d1, d2 = quads[:, 2] - quads[:, 0], quads[:, 3] - quads[:, 1]
-    h = np.sqrt(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]))
+    h = cell_sizes(quads)
     q = rule.rate + 1.0
     eta = np.maximum(eta, 1e-300)
     S = comm.allreduce(float(np.sum(eta ** (2 / q))))

@@ -14,8 +14,8 @@ from typing import Any
 from mpi4py import MPI
 
 # The direct path runs if SAFETY x MUMPS' estimate fits in the memory available after the
-# analysis. Measured peak-RSS growth over the estimate: up to 1.13 (docs/scale.md, "The
-# default solver"); the rest covers the loop after the factorization (probes, GMRES).
+# analysis: the margin covers the resident memory the factorization adds beyond MUMPS' own
+# count and the loop after it (probes, GMRES); measured in docs/scale.md, "The default solver".
 SAFETY = 1.25
 CONDENSED = "condensed"  # the preset `auto` falls back to
 

@@ -34,7 +34,7 @@ from .gmsh_io import balanced_partitioner, mesh_from_model, node_coordinates, to
 
 _NODES = "mesh.getNodes()"  # the call whose answer also gives the partitioner's coordinates
 # Larger recordings are not kept: the cache is for the first answer of small scenes, and a
-# sweep of large meshes would fill the user's cache directory (~115 bytes a node).
+# sweep of large meshes would fill the user's cache directory (size per node: docs/usage.md).
 MAX_BYTES = 64 << 20
 
 
