@@ -286,7 +286,9 @@ def main() -> None:
     solvers = args.solvers.split(",")
     methods = tuple(args.methods.split(","))
     ranks = [int(r) for r in args.ranks.split(",")]
-    families = tuple(args.families.split(","))
+    families = FAMILIES if args.families == "both" else tuple(args.families.split(","))
+    if unknown := set(families) - set(FAMILIES):
+        ap.error(f"--families: unknown {', '.join(sorted(unknown))} (10H, default or both)")
     sizes = tuple(float(s) for s in args.sizes.split(",")) if args.sizes else SIZES
     meta: dict[str, Any] = {
         "date": time.strftime("%Y-%m-%d %H:%M"),
