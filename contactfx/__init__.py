@@ -4,9 +4,16 @@ A `Scene` (built-in scenes, scene files or `scene_from_gmsh`) and `solve(scene, 
 the Python API; `python -m contactfx solve ...` is the command line over the same calls.
 """
 
+import gc as _gc
 from importlib.metadata import version as _version
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
+
+# The package's imports allocate ~1e5 objects on top of DOLFINx's: the collector would walk
+# all of them once on the way (a full collection, 20-60 ms of a 0.6 s start); it is off while
+# they load and back as it was after (docs/scale.md, "Time to the first answer").
+_collecting = _gc.isenabled()
+_gc.disable()
 
 from .api import run_case, run_scene, solve
 from .errors import (
@@ -44,6 +51,9 @@ from .scenes import (
 from .scenes import from_gmsh as scene_from_gmsh
 
 __version__ = _version("contactfx")
+
+if _collecting:
+    _gc.enable()
 
 __all__ = [
     "SOLVERS",
