@@ -9,9 +9,9 @@ from importlib.metadata import version as _version
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 
-# The package's imports allocate ~1e5 objects on top of DOLFINx's: the collector would walk
-# all of them once on the way (a full collection, 20-60 ms of a 0.6 s start); it is off while
-# they load and back as it was after (docs/scale.md, "Time to the first answer").
+# The package's imports allocate many objects on top of DOLFINx's: the collector would walk
+# all of them once on the way (a full collection); it is off while they load and back as it
+# was after (measured: docs/scale.md, "Time to the first answer").
 _collecting = _gc.isenabled()
 _gc.disable()
 

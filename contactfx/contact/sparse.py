@@ -3,8 +3,8 @@
 The contact operators, the pair views and the load-path check need a handful of operations
 (build from point contributions with duplicates summed, row selection, column slices and
 masks, products with vectors and with a narrow sparse matrix, transpose, stacking); holding
-them in numpy arrays keeps `import scipy.sparse` (~0.2 s, most of it scipy's own import-time
-work) off a plain solve (docs/scale.md, "Time to the first answer"). `to_scipy()` hands a
+them in numpy arrays keeps `import scipy.sparse` (most of it scipy's own import-time work)
+off a plain solve (docs/scale.md, "Time to the first answer"). `to_scipy()` hands a
 scipy matrix to the paths that really need one (sparse LU, LP). The sums run in the order
 scipy's kernels use (entries of a row in column order, rows in order), so products equal
 scipy's bit for bit; only duplicates of one entry may be summed in another order.

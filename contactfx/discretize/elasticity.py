@@ -206,8 +206,8 @@ def load_form(scene: Scene, v: ufl.Argument) -> ufl.Form:
 
 # dolfinx.fem.petsc's assemble_matrix / assemble_vector + apply_lifting for one form, by the
 # same calls in the same order (K and f equal bit for bit: tests/methods/test_assembly.py):
-# importing dolfinx.fem.petsc builds a cffi parser of PETSc's C declarations (pycparser,
-# ~0.03 s of a 0.6 s start) that nothing here uses (docs/scale.md, "Time to the first answer").
+# importing dolfinx.fem.petsc builds a cffi parser of PETSc's C declarations (pycparser) that
+# nothing here uses; its cost: docs/scale.md, "Time to the first answer".
 def petsc_matrix(a: fem.Form, bcs: list[fem.DirichletBC]) -> PETSc.Mat:
     """The PETSc matrix of the form `a`, `bcs` rows and columns zeroed, 1 on their diagonal.
 

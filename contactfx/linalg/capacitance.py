@@ -30,7 +30,8 @@ RELEASED_RTOL = 1e-8
 REFINEMENTS = 2
 # Up to this many released rows numpy's gesv refactors the capacitance matrix for each solve
 # instead of keeping scipy.linalg's LU: a plain solve then never imports scipy.linalg, and a
-# refinement step costs at most a few tens of ms (docs/scale.md, "Time to the first answer").
+# refactorization costs less than the import up to here (docs/scale.md, "Time to the first
+# answer").
 NUMPY_ROWS = 1000
 
 Apply = Callable[[PETSc.Vec, PETSc.Vec], None]
