@@ -9,13 +9,20 @@ from importlib.metadata import version as _version
 
 import dolfinx_solver  # noqa: F401  (must precede dolfinx and petsc4py)
 
-# The package's imports allocate many objects on top of DOLFINx's: the collector would walk
+# The package's own modules allocate many objects on top of DOLFINx's: the collector would walk
 # all of them once on the way (a full collection); it is off while they load and back as it
-# was after (measured: docs/scale.md, "Time to the first answer").
+# was after, whatever happens. DOLFINx loads before, with the collector on: its objects, held
+# back too, would make the first young collection after this walk them all (measured:
+# docs/scale.md, "Time to the first answer").
 _collecting = _gc.isenabled()
-_gc.disable()
+import dolfinx  # noqa: F401  (with the collector on)
 
-from .api import run_case, run_scene, solve
+_gc.disable()
+try:
+    from .api import run_case, run_scene, solve  # every stage below loads with it
+finally:
+    if _collecting:
+        _gc.enable()
 from .errors import (
     ActiveSetError,
     ContactFxError,
@@ -51,9 +58,6 @@ from .scenes import (
 from .scenes import from_gmsh as scene_from_gmsh
 
 __version__ = _version("contactfx")
-
-if _collecting:
-    _gc.enable()
 
 __all__ = [
     "SOLVERS",
