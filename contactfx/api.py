@@ -16,9 +16,7 @@ from .errors import InputError
 from .methods.active_set import ActiveSetOptions
 from .methods.autosolve import prepare_solver
 from .methods.multipliers import solve_contact
-from .methods.penalty import solve_penalty
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
-from .methods.schwarz import solve_schwarz
 from .methods.solution import Solution
 from .options import Basis, Enforcement, Method, Predictor, SolverKind, SolverSpec
 from .request import DEFAULT_MAX_ITERATIONS, DEFAULT_SOLVER, SchwarzOptions, SolveRequest
@@ -136,9 +134,15 @@ def solve_request(
     """Run the method of `request` on `scene` (see `solve`)."""
     timers = timers or Timers()
     aso = ActiveSetOptions(request.max_iterations)
+    # The penalty and Schwarz modules are imported when they run (first-answer time of a
+    # plain solve: docs/scale.md).
     if request.enforcement is Enforcement.PENALTY:
+        from .methods.penalty import solve_penalty
+
         return solve_penalty(scene, request, timers, aso=aso)
     if request.enforcement is Enforcement.SCHWARZ:
+        from .methods.schwarz import solve_schwarz
+
         return solve_schwarz(scene, request, timers)
     # `auto` chooses on the fine system before the predictor, whose mesh follows the choice.
     prepared = None

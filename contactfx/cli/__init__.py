@@ -5,6 +5,7 @@ Nothing in the library imports this package.
 
 from __future__ import annotations
 
+import gc
 import logging
 import sys
 
@@ -12,6 +13,15 @@ from mpi4py import MPI
 
 from ..errors import ContactFxError
 from .parser import parser
+
+
+def entry() -> int:
+    """The process entry (`python -m contactfx`, the `contactfx` script): main() on sys.argv."""
+    # The command owns its process and the imported modules live as long as it: frozen, the
+    # collector never walks them again (docs/scale.md, "Time to the first answer"). Not in
+    # main(), which a test or a script may call in a process of its own.
+    gc.freeze()
+    return main()
 
 
 def main(argv: list[str] | None = None) -> int:

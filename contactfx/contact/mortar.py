@@ -38,11 +38,15 @@ the patch test stays exact.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import scipy.sparse as sp
 
 from .geometry import Surface, chains, nodal_normals, project, radial_weight, segment_lengths
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 # Gauss points per sub-segment: the integrand N_j N_A is quadratic there, so 2 are exact.
 GAUSS_POINTS = 2
@@ -317,6 +321,8 @@ def mortar_matrices(
     m_cols = np.broadcast_to(passive.segments[seg_p][:, None, :], m_vals.shape)
     r = np.broadcast_to(rows[:, :, None], d_vals.shape).ravel()
     na, npas = active.n_nodes, passive.n_nodes
+    import scipy.sparse as sp  # the Schwarz reference only: not on a plain solve (docs/scale.md)
+
     D = sp.coo_matrix((d_vals.ravel(), (r, d_cols.ravel())), shape=(na, na)).tocsr()
     M = sp.coo_matrix((m_vals.ravel(), (r, m_cols.ravel())), shape=(na, npas)).tocsr()
     D.sum_duplicates()

@@ -5,16 +5,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
 from .geometry import Surface
+from .sparse import CSR
 
 
 @dataclass(frozen=True)
 class ContactOperator:
     """Weighted gap g_tilde(u) = gap + B @ u, one row per active-surface node."""
 
-    B: sp.csr_matrix  # (n_active_nodes, ndofs): row j = active node j
+    B: CSR  # (n_active_nodes, ndofs): row j = active node j
     gap: np.ndarray  # (n_active_nodes,) weighted gap at u = 0 (reference config)
     weights: np.ndarray  # (n_active_nodes,) int over the overlapped part of N_j dGamma
 
@@ -82,7 +82,5 @@ def assemble(
     shape = vals.shape
     r = np.broadcast_to(rows[:, :, None, None], shape).ravel()
     c = np.broadcast_to(cols[:, None, :, :], shape).ravel()
-    B = sp.coo_matrix((vals.ravel(), (r, c)), shape=(na, ndofs)).tocsr()
-    B.sum_duplicates()
-    B.eliminate_zeros()
+    B = CSR.from_coo(r, c, vals.ravel(), (na, ndofs), drop_zeros=True)
     return ContactOperator(B=B, gap=gap, weights=weights)

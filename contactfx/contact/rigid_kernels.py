@@ -22,12 +22,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
 from .geometry import Surface, nodal_normals, radial_weight, segment_lengths
 from .mortar import SLIVER, _check_basis, _dual_values
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
 from .rigid import Circle, Closest, Plane, Polyline, RigidShape
+from .sparse import CSR
 from .sts import gauss_points
 
 GAUSS_FLAT = 2
@@ -45,7 +45,7 @@ class RigidOperator:
     """
 
     operator: ContactOperator
-    motion: sp.csr_matrix
+    motion: CSR
 
     def moved(self, displacement: np.ndarray) -> ContactOperator:
         """The operator with the obstacle displaced rigidly by `displacement` (2,)."""
@@ -85,10 +85,10 @@ def _assemble(
         pas_coef=np.ones((k, 1)),
         normal=near.normal,
     )
-    B = full.B.tocsc()
-    body = B[:, :ndofs].tocsr()
-    body.eliminate_zeros()
-    return RigidOperator(ContactOperator(body, full.gap, full.weights), B[:, ndofs:].tocsr())
+    body = full.B.columns(0, ndofs)  # assemble dropped the exact zeros already
+    return RigidOperator(
+        ContactOperator(body, full.gap, full.weights), full.B.columns(ndofs, ndofs + 2)
+    )
 
 
 def _cuts(active: Surface, shape: RigidShape) -> list[np.ndarray]:

@@ -52,14 +52,14 @@ def constrained_rows(op: ContactOperator, dirichlet: np.ndarray, rtol: float = 1
     """
     cols = np.zeros(op.B.shape[1], dtype=bool)
     cols[dirichlet[dirichlet < op.B.shape[1]]] = True
-    B = op.B.tocoo()
+    row = op.B.entry_rows()
     n = op.B.shape[0]
-    size = np.abs(B.data)
+    size = np.abs(op.B.data)
     whole = np.zeros(n)
-    np.maximum.at(whole, B.row, size)
+    np.maximum.at(whole, row, size)
     free = np.zeros(n)
-    keep = ~cols[B.col]
-    np.maximum.at(free, B.row[keep], size[keep])
+    keep = ~cols[op.B.indices]
+    np.maximum.at(free, row[keep], size[keep])
     return free > rtol * whole
 
 
@@ -98,13 +98,9 @@ def petsc_constraint(
     imap = V.dofmap.index_map
     bs = V.dofmap.index_map_bs
     n_local, n_global = imap.size_local * bs, imap.size_global * bs
-    rows = op.B[order[layout.mine]].tocsr()
-    if dirichlet.size:
-        mask = np.ones(op.B.shape[1])
-        mask[dirichlet[dirichlet < op.B.shape[1]]] = 0.0
-        rows = rows.multiply(mask[None, :]).tocsr()
-    rows.eliminate_zeros()
-    rows.sort_indices()
+    drop = np.zeros(op.B.shape[1], dtype=bool)
+    drop[dirichlet[dirichlet < op.B.shape[1]]] = True
+    rows = op.B.rows(order[layout.mine]).without_columns(drop)  # column indices sorted
     m = rows.shape[0]
     B = PETSc.Mat().createAIJ(
         size=((m, layout.size), (n_local, n_global)),
@@ -112,7 +108,7 @@ def petsc_constraint(
             rows.indptr.astype(PETSc.IntType),
             rows.indices.astype(PETSc.IntType),
             rows.data.astype(PETSc.ScalarType),
-        ),
+        ),  # type: ignore[arg-type]  # the stub wants Sequences; PETSc takes the arrays
         comm=V.mesh.comm,
     )
     B.assemble()

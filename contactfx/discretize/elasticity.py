@@ -12,10 +12,11 @@ import math
 from dataclasses import dataclass
 from typing import Any, cast
 
-import dolfinx.fem.petsc
+import dolfinx.la.petsc
 import numpy as np
 import ufl
 from dolfinx import fem, mesh
+from dolfinx.cpp.fem import petsc as cpp_petsc
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -203,6 +204,37 @@ def load_form(scene: Scene, v: ufl.Argument) -> ufl.Form:
     return L
 
 
+# dolfinx.fem.petsc's assemble_matrix / assemble_vector + apply_lifting for one form, by the
+# same calls in the same order (K and f equal bit for bit: tests/methods/test_assembly.py):
+# importing dolfinx.fem.petsc builds a cffi parser of PETSc's C declarations (pycparser) that
+# nothing here uses; its cost: docs/scale.md, "Time to the first answer".
+def petsc_matrix(a: fem.Form, bcs: list[fem.DirichletBC]) -> PETSc.Mat:
+    """The PETSc matrix of the form `a`, `bcs` rows and columns zeroed, 1 on their diagonal.
+
+    Not finalized: the caller calls assemble() (as after dolfinx.fem.petsc.assemble_matrix).
+    """
+    cbcs = [bc._cpp_object for bc in bcs]
+    A = cpp_petsc.create_matrix(a._cpp_object, None)
+    constants, coeffs = fem.assemble.pack_constants(a), fem.assemble.pack_coefficients(a)
+    cpp_petsc.assemble_matrix(A, a._cpp_object, constants, coeffs, cbcs)
+    if a.function_spaces[0] is a.function_spaces[1]:
+        A.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)
+        A.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
+        cpp_petsc.insert_diagonal(A, a.function_spaces[0], cbcs, 1.0)
+    return A
+
+
+def petsc_vector(L: fem.Form, a: fem.Form, bcs: list[fem.DirichletBC]) -> PETSc.Vec:
+    """The PETSc vector of the linear form `L`, lifted by `a` and `bcs` (ghosts not summed)."""
+    V = L.function_spaces[0]
+    b = dolfinx.la.petsc.create_vector([(V.dofmap.index_map, V.dofmap.index_map_bs)])
+    with b.localForm() as local:
+        local.set(0.0)
+        fem.assemble_vector(local.array_w, L)  # type: ignore[arg-type]  # (array, form): dispatch
+        fem.apply_lifting(local.array_w, [a], [bcs], [], 1.0)
+    return b
+
+
 def assemble_elasticity(scene: Scene) -> Elasticity:
     """Assemble K and f of every body with the scene's supports and loads."""
     msh = scene.mesh
@@ -215,16 +247,16 @@ def assemble_elasticity(scene: Scene) -> Elasticity:
     L = fem.form(load_form(scene, v) if thermal is None else load_form(scene, v) + thermal)
     bcs = dirichlet_conditions(scene, V)
 
-    K = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs)
+    K = petsc_matrix(a, bcs)
     K.assemble()
-    f = dolfinx.fem.petsc.assemble_vector(L)
-    dolfinx.fem.petsc.apply_lifting(f, [a], bcs=[bcs])
+    f = petsc_vector(L, a, bcs)
     # The stub types the mode values as int but the parameters as the enum classes.
     f.ghostUpdate(
         addv=cast(PETSc.InsertMode, PETSc.InsertMode.ADD),
         mode=cast(PETSc.ScatterMode, PETSc.ScatterMode.REVERSE),
     )
-    dolfinx.fem.petsc.set_bc(f, bcs)
+    for bc in bcs:  # dolfinx.fem.petsc.set_bc(f, bcs)
+        bc.set(f.array_w, None, 1.0)
     bc_dofs = (
         np.unique(np.concatenate([bc.dof_indices()[0] for bc in bcs]))
         if bcs

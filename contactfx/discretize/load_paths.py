@@ -22,12 +22,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..contact.geometry import Surface
+from ..contact.sparse import CSR
 from ..errors import SingularSystemError
 from ..scenes import Body, Scene
 from .pairs import PairData
@@ -54,7 +54,7 @@ class LoadPaths:
     carries: np.ndarray
 
 
-def surface_modes(pairs: list[PairData], hold: Holding, ndofs: int) -> sp.csr_matrix:
+def surface_modes(pairs: list[PairData], hold: Holding, ndofs: int) -> CSR:
     """(ndofs, 3 nb) rigid modes of every body at the dofs of the pairs' surfaces."""
     dofs, x, body = [], [], []
     for p in pairs:
@@ -78,9 +78,11 @@ def surface_modes(pairs: list[PairData], hold: Holding, ndofs: int) -> sp.csr_ma
                 vals.append(m[:, c, j])
                 rows.append(d[sel, c])
                 cols.append(np.full(int(sel.sum()), 3 * kb + j))
-    return sp.csr_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-        shape=(ndofs, 3 * len(hold.bodies)),
+    return CSR.from_coo(
+        np.concatenate(rows),
+        np.concatenate(cols),
+        np.concatenate(vals),
+        (ndofs, 3 * len(hold.bodies)),
     )
 
 
@@ -143,6 +145,8 @@ def _carrying_lp(
     fl = load / max(float(np.abs(load).max()), 1e-300)
     m, k = len(j), a.shape[1]
     # Unknowns (lam, s, t): a^T lam + load s = 0, t <= lam, s >= 1, 0 <= t <= 1.
+    import scipy.sparse as sp  # with scipy.optimize below: only for 2+ free modes
+
     a_eq = sp.hstack([sp.csr_matrix(aj.T), sp.csr_matrix(fl.reshape(k, 1)), sp.csr_matrix((k, m))])
     eye = sp.identity(m, format="csr")
     a_ub = sp.hstack([-eye, sp.csr_matrix((m, 1)), eye])
@@ -245,7 +249,7 @@ def load_paths(
     V: fem.FunctionSpace,
     f: PETSc.Vec,
     pairs: list[PairData],
-    B: sp.csr_matrix,
+    B: CSR,
     order: np.ndarray,
     layout_pair: np.ndarray,
     hold: Holding,
@@ -257,7 +261,7 @@ def load_paths(
     free, if no nonnegative contact force balances the load on the free modes (the load
     pulls the bodies apart), or if the rows that can carry load leave a body free.
     """
-    rows = np.asarray((B[order] @ surface_modes(pairs, hold, B.shape[1])).toarray())
+    rows = B.rows(order).dense_product(surface_modes(pairs, hold, B.shape[1]))
     rows[np.abs(rows) <= ROW_RTOL * float(np.abs(rows).max(initial=0.0))] = 0.0
     every = LoadPaths(rows, np.ones(len(rows), dtype=bool))
     # Free even with every row bilateral: no load can make the system regular.

@@ -113,13 +113,14 @@ def node_free_rows(
         if p.obstacle is None:
             continue
         rows = np.arange(p.first_row, p.first_row + p.active.surface.n_nodes)
-        sub = abs(op.B[rows].tocsr())
-        whole = sub.max(axis=1).toarray().ravel()
+        sub = op.B.rows(rows)
+        whole = sub.row_max_abs()
+        r = sub.entry_rows()
         own = np.zeros(len(rows))
         for c in (0, 1):
             dof = node_dofs[rows, c]
-            vals = np.asarray(sub[np.arange(len(rows)), dof]).ravel()
-            own = np.maximum(own, np.where(fixed[dof], 0.0, vals))
+            at = (sub.indices == dof[r]) & ~fixed[sub.indices]  # the row's own dof, free
+            np.maximum.at(own, r[at], np.abs(sub.data[at]))
         # Relative to the row, as constrained_rows: "prescribed" is up to round-off.
         keep[rows] = own > 1e-10 * whole
     return keep

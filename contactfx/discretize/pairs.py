@@ -10,10 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 from dolfinx import fem
 
 from ..contact import ContactOperator, Kernel, Surface, contact_operator
+from ..contact.sparse import CSR
 from ..scenes import Body, ContactPair, Obstacle, Scene
 from .surfaces import GatheredSurface, gather_surface
 
@@ -40,7 +40,7 @@ class PairData:
     operator: ContactOperator
     first_row: int  # first row of this pair in the stacked operator
     obstacle: Obstacle | None = None
-    motion: sp.csr_matrix | None = None
+    motion: CSR | None = None
     initial_overlap: float = 0.0  # max over the rows of -gap before the solve (>= 0)
 
     @property
@@ -113,7 +113,7 @@ def stack(pairs: list[PairData]) -> tuple[GatheredSurface, ContactOperator, np.n
         ops[0]
         if len(ops) == 1
         else ContactOperator(
-            B=sp.vstack([o.B for o in ops]).tocsr(),
+            B=CSR.vstack([o.B for o in ops]),
             gap=np.concatenate([o.gap for o in ops]),
             weights=np.concatenate([o.weights for o in ops]),
         )

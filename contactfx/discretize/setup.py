@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -208,10 +207,9 @@ def prescribed_gap_shift(
     vals = np.zeros(len(dofs))
     vals[mine] = ub.x.array[2 * blocks[mine] + dofs[mine] % 2]
     V.mesh.comm.Allreduce(MPI.IN_PLACE, vals, op=MPI.SUM)
-    ud = sp.csc_matrix(
-        (vals, (dofs, np.zeros(len(dofs), dtype=np.int64))), shape=(op.B.shape[1], 1)
-    )
-    return np.asarray((op.B @ ud).todense()).ravel()
+    ud = np.zeros(op.B.shape[1])
+    ud[dofs] = vals
+    return op.B @ ud
 
 
 def prepare_contact(

@@ -28,10 +28,38 @@ log = logging.getLogger("contactfx")
 RELEASED_RTOL = 1e-8
 # Refinement steps before giving up (each costs two back-substitutions).
 REFINEMENTS = 2
+# Up to this many released rows numpy's gesv refactors the capacitance matrix for each solve
+# instead of keeping scipy.linalg's LU: a plain solve then never imports scipy.linalg, and a
+# refactorization costs less than the import up to here (docs/scale.md, "Time to the first
+# answer").
+NUMPY_ROWS = 1000
 
 Apply = Callable[[PETSc.Vec, PETSc.Vec], None]
 Residual = Callable[[PETSc.Vec], tuple[PETSc.Vec, float]]
 Responses = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+
+class DenseLU:
+    """Solves with one dense matrix: LAPACK's LU, by numpy (small) or scipy.linalg (kept)."""
+
+    def __init__(self, a: np.ndarray) -> None:
+        """Factorize `a` (square); ValueError if it holds a non-finite entry."""
+        if not np.all(np.isfinite(a)):
+            raise ValueError("the capacitance matrix has non-finite entries")
+        self._a = a
+        self._lu: tuple[np.ndarray, np.ndarray] | None = None
+        if len(a) > NUMPY_ROWS:
+            import scipy.linalg  # only for a large released set (docs/scale.md)
+
+            self._lu = scipy.linalg.lu_factor(a, check_finite=False)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """a^-1 b (np.linalg.LinAlgError if numpy finds `a` singular)."""
+        if self._lu is None:
+            return np.linalg.solve(self._a, b)
+        import scipy.linalg  # imported by __init__ already: a dict look-up
+
+        return scipy.linalg.lu_solve(self._lu, b)
 
 
 def _gathered(comm: MPI.Comm, local: np.ndarray) -> np.ndarray:
@@ -78,10 +106,8 @@ def released_solve(
             applies += 1
         mu0 = _gathered(comm, x.array_r[rows_r])
         resp = responses(rel_global, released)
-        import scipy.linalg  # only where used (first-answer time: docs/scale.md)
-
-        lu = scipy.linalg.lu_factor(_gathered(comm, resp[released]), check_finite=True)
-        b.array[rows_r] += scipy.linalg.lu_solve(lu, -mu0)[mine]
+        lu = DenseLU(_gathered(comm, resp[released]))
+        b.array[rows_r] += lu.solve(-mu0)[mine]
         apply(b, x)
         x.array[rows_r] = 0.0
         r, res = residual(x)
@@ -94,7 +120,7 @@ def released_solve(
             dx = r.duplicate()
             apply(r, dx)
             d0 = _gathered(comm, dx.array_r[rows_r])
-            r.array[rows_r] = scipy.linalg.lu_solve(lu, -d0)[mine]
+            r.array[rows_r] = lu.solve(-d0)[mine]
             apply(r, dx)
             dx.array[rows_r] = 0.0
             x.axpy(1.0, dx)

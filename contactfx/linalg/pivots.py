@@ -19,10 +19,10 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 from mpi4py import MPI
 
 if TYPE_CHECKING:
+    import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
 from ..errors import EliminationError
@@ -73,6 +73,8 @@ def _gathered_rows(B: LocalRows, rows: np.ndarray, comm: MPI.Comm, n: int) -> sp
         np.concatenate(comm.allgather(a)) for a in (counts, cols.astype(np.int64), vals)
     )
     indptr = np.concatenate([[0], np.cumsum(counts_all)])
+    import scipy.sparse as sp  # only the condensed solver: not on a plain solve (docs/scale.md)
+
     return sp.csr_matrix((vals_all, cols_all, indptr), shape=(len(counts_all), n))
 
 
@@ -124,6 +126,8 @@ def pivots(B: LocalRows, active: np.ndarray, comm: MPI.Comm, r0: int, n: int) ->
     counts = comm.allgather(len(rows))
     mine = slice(sum(counts[: comm.rank]), sum(counts[: comm.rank + 1]))
     A = _gathered_rows(B, rows, comm, n)
+    import scipy.sparse as sp  # imported by _gathered_rows already: a dict look-up
+
     block = A[:, all_piv].tocsr()
     off = (block - sp.diags(block.diagonal())).tocsr()
     off.eliminate_zeros()

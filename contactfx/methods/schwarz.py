@@ -18,12 +18,14 @@ from __future__ import annotations
 
 import logging
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 from ..contact import Kernel, contact_operator
 from ..contact.mortar import mortar_matrices

@@ -6,12 +6,12 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
-import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
 if TYPE_CHECKING:
+    import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
 from ..contact import ContactOperator

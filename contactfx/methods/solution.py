@@ -7,11 +7,11 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 from dolfinx import fem
 from mpi4py import MPI
 
 from ..contact.geometry import arc_length, nodal_normals, project
+from ..contact.sparse import CSR
 from ..discretize.coupling import Multipliers
 from ..discretize.pairs import PairData
 from ..discretize.setup import ContactSetup
@@ -53,9 +53,9 @@ class PairView:
     passive: GatheredSurface | None
     rows: np.ndarray  # layout rows of the pair's multipliers
     gblock: np.ndarray  # global node (dof block) of each of those rows
-    B: sp.csr_matrix
+    B: CSR
     obstacle: Obstacle | None = None
-    motion: sp.csr_matrix | None = None
+    motion: CSR | None = None
     initial_overlap: float = 0.0  # max over the pair's rows of -gap before the solve
 
     @property
@@ -182,7 +182,7 @@ def gather_all(comm: MPI.Comm, local: np.ndarray) -> np.ndarray:
 
 
 def pair_views(
-    setup_pairs: list[PairData], layout: Multipliers, B: sp.csr_matrix, order: np.ndarray
+    setup_pairs: list[PairData], layout: Multipliers, B: CSR, order: np.ndarray
 ) -> list[PairView]:
     """One PairView per pair: its layout rows and their rows of the stacked operator B."""
     out = []
@@ -197,9 +197,9 @@ def pair_views(
             p.passive,
             rows,
             layout.gblock[rows],
-            B[order[rows]].tocsr(),
+            B.rows(order[rows]),
             p.obstacle,
-            None if p.motion is None else p.motion[order[rows] - p.first_row].tocsr(),
+            None if p.motion is None else p.motion.rows(order[rows] - p.first_row),
             p.initial_overlap,
         )
         out.append(view)

@@ -12,7 +12,6 @@ from petsc4py import PETSc
 
 from ..discretize.setup import ContactSetup
 from ..discretize.supports import rigid_body_modes
-from ..linalg.condensed import CondensedSolver
 from ..linalg.nullspace import near_nullspace
 from ..linalg.policy import FactorizationPolicy
 from ..linalg.protocol import LinearSolver
@@ -97,6 +96,8 @@ def make_solver(
     """
     spec = direct_path(spec)
     if spec.kind.condensed:
+        from ..linalg.condensed import CondensedSolver  # not on the direct path: docs/scale.md
+
         factorized = spec.kind is SolverKind.CONDENSED_DIRECT
         return CondensedSolver(
             K,
