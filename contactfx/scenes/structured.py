@@ -53,7 +53,8 @@ def build_hertz_structured(
         x, cells, n_block = np.zeros((0, 2)), np.zeros((0, 4), dtype=np.int64), 0
     n_block = comm.bcast(n_block, root=0)
     element = ufl.Mesh(basix.ufl.element("Lagrange", "quadrilateral", 1, shape=(2,)))
-    partitioner = balanced_partitioner(np.column_stack([x, np.zeros(len(x))]))
+    bodies = np.arange(len(cells)) >= n_block  # the grid numbers body 1's cells first
+    partitioner = balanced_partitioner(np.column_stack([x, np.zeros(len(x))]), bodies)
     msh = dmesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
     tdim = msh.topology.dim
     ncells = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
