@@ -33,7 +33,7 @@ def body_blocks(V: fem.FunctionSpace, cells: np.ndarray) -> np.ndarray:
     """Local dof blocks (nodes, owned and ghost) of the cells `cells` (a body's), sorted.
 
     A mask over the local blocks, not np.unique: the same sorted blocks without the hash
-    (np.unique took 3.3 s of a 2M-DOF run's setup, docs/scale.md "Setup").
+    (np.unique took 2.8 s of a 2M-DOF run's setup, docs/scale.md "Setup").
     """
     im = V.dofmap.index_map
     mask = np.zeros(im.size_local + im.num_ghosts, dtype=bool)

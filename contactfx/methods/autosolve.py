@@ -117,13 +117,11 @@ def _coarse_bound(
     rank_mb = None if est is None else scaled_bound(est.rank_mb, coarse_dofs, dofs)
     needed, avail = node_budget(comm, rank_mb, request.available_mb)
     choice = choose(needed, avail, request.diagonal)
-    if comm.rank == 0:
-        log.info(
-            "solver: coarse check, %s",
-            SolverChoice(direct.name, needed, avail, None, coarse_dofs=coarse_dofs).reason,
-        )
     if choice is Choice.DIRECT:
-        return None  # it may fit: the fine analysis decides (its first factorization reuses it)
+        if comm.rank == 0:  # it may fit: the fine analysis decides (and is reused if so)
+            bound = SolverChoice(direct.name, needed, avail, None, coarse_dofs=coarse_dofs)
+            log.info("solver: coarse check: %s; the fine analysis decides", bound.reason)
+        return None
     assert needed is not None and avail is not None and est is not None
     ran = CONDENSED if choice is Choice.CONDENSED else direct.name
     record = SolverChoice(ran, needed, avail, est.seconds, coarse_dofs=coarse_dofs)
