@@ -37,9 +37,9 @@ def timed(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
 def main() -> None:
     """Mesh once and print each rank's parts."""
     h = float(sys.argv[1])
-    partitioner = structured.balanced_partitioner
+    partitioner = structured.known_bodies_partitioner
     structured.hertz_grid = timed("grid", structured.hertz_grid)
-    structured.balanced_partitioner = lambda *a: timed("partition", partitioner(*a))
+    structured.known_bodies_partitioner = lambda *a: timed("partition", partitioner(*a))
     structured.dmesh.create_mesh = timed("create_mesh", structured.dmesh.create_mesh)
     comm = MPI.COMM_WORLD
     t0 = time.perf_counter()

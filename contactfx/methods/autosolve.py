@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 
 from mpi4py import MPI
 
+from ..discretize.mesh_utils import scene_dofs
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import InputError
 from ..linalg import LinearSolver
@@ -91,9 +92,6 @@ def _coarse_bound(
     fine estimate, compared with the memory available before any fine analysis. None (the
     fine analysis decides) where it fits or is unknown.
     """
-    # Imported here: the predictor's module imports the loop's, which imports this one.
-    from .predictor import scene_dofs
-
     dofs = scene_dofs(scene)
     if not scene.can_remesh or dofs < COARSE_BOUND_DOFS * COARSE_BOUND_FACTOR**2:
         return None

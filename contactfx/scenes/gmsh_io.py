@@ -36,6 +36,7 @@ from .model import (
     SizeField,
     Units,
 )
+from .partition import body_strips
 
 
 def _gmsh_node_coordinates() -> np.ndarray:
@@ -55,15 +56,8 @@ def node_coordinates(tags: np.ndarray, xyz: np.ndarray) -> np.ndarray:
     return x
 
 
-def balanced_partitioner(
-    coordinates: np.ndarray | None = None, cell_bodies: np.ndarray | None = None
-) -> Callable[..., Any]:
-    """A cell partitioner that splits every body (connected component) over all ranks.
-
-    `cell_bodies`: each cell's body where the caller knows it (the structured grid), which
-    saves finding the bodies as the node graph's connected components (the same labels up
-    to their numbering, so the same partition).
-    """
+def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[..., Any]:
+    """A cell partitioner that splits every body (connected component) over all ranks."""
 
     def partition(comm: MPI.Comm, nparts: int, cell_types: list[Any], cells: list[Any]) -> Any:
         # Cells of one type per list entry, flattened; node index = gmsh node tag - 1.
@@ -81,9 +75,6 @@ def balanced_partitioner(
 
         x = _gmsh_node_coordinates() if coordinates is None else np.asarray(coordinates)
         mid = np.vstack([x[c, :2].mean(axis=1) for c in conn])
-        if cell_bodies is not None and len(cell_bodies) == num_cells:
-            _strips(dest, np.asarray(cell_bodies), mid, nparts)
-            return adjacencylist(dest)._cpp_object
         # Bodies share no node, so the connected components of the node graph are the
         # bodies: linking each cell's first vertex to its others is enough to find them.
         first = np.concatenate([np.repeat(c[:, 0], c.shape[1]) for c in conn])
@@ -92,22 +83,10 @@ def balanced_partitioner(
         graph = coo_array((np.ones(len(first)), (first, other)), shape=(n, n))
         _, node_label = connected_components(graph, directed=False)
         cell_label = node_label[np.concatenate([c[:, 0] for c in conn])]
-        _strips(dest, cell_label, mid, nparts)
+        body_strips(dest, cell_label, mid, nparts)
         return adjacencylist(dest)._cpp_object
 
     return partition
-
-
-def _strips(dest: np.ndarray, cell_label: np.ndarray, mid: np.ndarray, nparts: int) -> None:
-    """Within each body, equal-count strips by midpoint x (then y), into `dest`.
-
-    The contact line of each body is spread over all ranks, and the strips of the bodies
-    overlap.
-    """
-    for label in np.unique(cell_label):
-        ids = np.flatnonzero(cell_label == label)
-        order = ids[np.lexsort((mid[ids, 1], mid[ids, 0]))]
-        dest[order] = (np.arange(len(order)) * nparts) // len(order)
 
 
 def _run_on_root(

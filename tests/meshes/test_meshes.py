@@ -195,12 +195,13 @@ def test_known_bodies_give_the_connected_components_partition(nparts: int) -> No
     """The structured grid's cell bodies (block cells first) skip the component search and
     give the very partition the node graph's connected components give."""
     from contactfx.meshes import hertz_grid
+    from contactfx.scenes.partition import known_bodies_partitioner
 
     x, cells, n_block = hertz_grid(60.0, 60.0, 60.0, 0.1, 2.0, 1.0, 0.1)
     coords = np.column_stack([x, np.zeros(len(x))])
     ct = [CellType.quadrilateral]
     found = balanced_partitioner(coords)(MPI.COMM_SELF, nparts, ct, [cells.ravel()])
     bodies = np.arange(len(cells)) >= n_block
-    known = balanced_partitioner(coords, bodies)(MPI.COMM_SELF, nparts, ct, [cells.ravel()])
+    known = known_bodies_partitioner(x, bodies)(MPI.COMM_SELF, nparts, ct, [cells.ravel()])
     assert np.array_equal(found.array, known.array)
     assert np.unique(known.array).size == nparts
