@@ -9,6 +9,11 @@ from dolfinx import fem
 from ..scenes import Scene
 
 
+def scene_dofs(scene: Scene) -> int:
+    """Displacement dofs of `scene` (P1 vector: two per vertex)."""
+    return 2 * scene.mesh.topology.index_map(0).size_global
+
+
 def vertex_to_block(V: fem.FunctionSpace) -> np.ndarray:
     """Local dof block of every local vertex (Q1: one block per vertex)."""
     msh = V.mesh

@@ -5,8 +5,10 @@ Before any factorization MUMPS' analysis alone runs on the loop's own saddle-poi
 On each node the ranks' estimates add up against the memory available there; with room (the
 SAFETY factor) the direct path runs and its first factorization reuses that analysis, else
 the condensed path runs (multipliers eliminated, CG + GAMG) where D is diagonal, and
-elsewhere the run is refused before factorizing. The rule and its measurements:
-docs/scale.md, "The default solver".
+elsewhere the run is refused before factorizing. On a large scene the analysis of the
+same scene meshed coarser (a quarter of the DOFs) comes first: its estimate scaled to the
+fine DOFs is a lower bound, and where even that does not fit the fine analysis is skipped.
+The rule and its measurements: docs/scale.md, "The default solver".
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dataclasses import dataclass, replace
 
 from mpi4py import MPI
 
+from ..discretize.mesh_utils import scene_dofs
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import InputError
 from ..linalg import LinearSolver
@@ -24,7 +27,18 @@ from ..options import SOLVERS, SolverKind
 from ..request import SolveRequest, direct_path
 from ..scenes import Scene
 from ..timers import Timers
-from .solver_choice import CONDENSED, SAFETY, Choice, SolverChoice, choose, node_budget
+from .solver_choice import (
+    CHECK_KB_PER_DOF,
+    COARSE_BOUND_DOFS,
+    COARSE_BOUND_FACTOR,
+    CONDENSED,
+    SAFETY,
+    Choice,
+    SolverChoice,
+    choose,
+    node_budget,
+    scaled_bound,
+)
 from .solvers import setup_solver
 
 log = logging.getLogger("contactfx")
@@ -54,10 +68,62 @@ def prepare_solver(
     if request.solver.kind is not SolverKind.AUTO:
         return Prepared(setup, request)
     try:
+        coarse = _coarse_bound(setup, scene, request, penetration_tol, timers)
+        if coarse is not None:
+            return coarse
         return _resolve(setup, scene, request, timers)
     except BaseException:
         setup.destroy()
         raise
+
+
+def _coarse_bound(
+    setup: ContactSetup,
+    scene: Scene,
+    request: SolveRequest,
+    penetration_tol: float,
+    timers: Timers,
+) -> Prepared | None:
+    """The choice from a coarse system's analysis where even its lower bound does not fit.
+
+    Runs on a remeshable scene whose coarse system (sizes x COARSE_BOUND_FACTOR) holds at
+    least COARSE_BOUND_DOFS, where CHECK_KB_PER_DOF says the fine estimate might not fit:
+    MUMPS' estimate for the coarse system, scaled to the fine DOFs, is a lower bound of the
+    fine estimate, compared with the memory available before any fine analysis. None (the
+    fine analysis decides) where it fits or is unknown.
+    """
+    dofs = scene_dofs(scene)
+    if not scene.can_remesh or dofs < COARSE_BOUND_DOFS * COARSE_BOUND_FACTOR**2:
+        return None
+    comm = scene.comm
+    share = CHECK_KB_PER_DOF * dofs / 1e3 / comm.size  # MB per rank
+    if choose(*node_budget(comm, share, request.available_mb), True) is Choice.DIRECT:
+        return None  # it would fit even at that much per DOF: the fine analysis decides
+    direct = direct_path(request.solver)
+    with timers("solve"):
+        coarse = scene.remeshed(COARSE_BOUND_FACTOR)
+        coarse_dofs = scene_dofs(coarse)
+        csetup = prepare_contact(coarse, request.kernel, penetration_tol, Timers(), request.basis)
+        try:
+            linear = setup_solver(csetup, direct, coarse, reuse=True)
+            try:
+                est = mumps_estimate(linear) if isinstance(linear, SaddleSolver) else None
+            finally:
+                linear.destroy()
+        finally:
+            csetup.destroy()
+    rank_mb = None if est is None else scaled_bound(est.rank_mb, coarse_dofs, dofs)
+    needed, avail = node_budget(comm, rank_mb, request.available_mb)
+    choice = choose(needed, avail, request.diagonal)
+    if choice is Choice.DIRECT:
+        if comm.rank == 0:  # it may fit: the fine analysis decides (and is reused if so)
+            bound = SolverChoice(direct.name, needed, avail, None, coarse_dofs=coarse_dofs)
+            log.info("solver: coarse check: %s; the fine analysis decides", bound.reason)
+        return None
+    assert needed is not None and avail is not None and est is not None
+    ran = CONDENSED if choice is Choice.CONDENSED else direct.name
+    record = SolverChoice(ran, needed, avail, est.seconds, coarse_dofs=coarse_dofs)
+    return _condensed(setup, scene, request, record)
 
 
 def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: Timers) -> Prepared:
@@ -81,13 +147,26 @@ def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: T
         return Prepared(setup, direct, linear, record)
     linear.destroy()  # frees MUMPS' analysis before the other path runs
     assert needed is not None and avail is not None  # a known estimate that does not fit
-    if choice is Choice.REFUSE:
+    ran = CONDENSED if choice is Choice.CONDENSED else direct.solver.name
+    return _condensed(setup, scene, request, SolverChoice(ran, needed, avail, seconds))
+
+
+def _condensed(
+    setup: ContactSetup,
+    scene: Scene,
+    request: SolveRequest,
+    record: SolverChoice,
+) -> Prepared:
+    """The condensed path where MUMPS does not fit; a one-line refusal where D is not diagonal."""
+    if record.ran != CONDENSED:
+        assert record.needed_mb is not None and record.available_mb is not None
+        bound = ">= " if record.coarse_dofs is not None else ""
         raise InputError(
-            f"the direct solver would not fit: MUMPS estimates {needed / 1e3:.2f} GB, "
-            f"{avail / 1e3:.2f} GB available (margin x{SAFETY:g}); use --method mortar "
-            "--basis dual (or nts) for the condensed path, or fewer DOFs"
+            f"the direct solver would not fit: MUMPS estimates {bound}"
+            f"{record.needed_mb / 1e3:.2f} GB, {record.available_mb / 1e3:.2f} GB available "
+            f"(margin x{SAFETY:g}); use --method mortar --basis dual (or nts) for the "
+            "condensed path, or fewer DOFs"
         )
-    record = SolverChoice(CONDENSED, needed, avail, seconds)
     _say(record, scene.comm)
     if request.solver.petsc != SOLVERS["auto"].petsc and scene.comm.rank == 0:
         log.info("solver: the --petsc-option values were for MUMPS: not applied")

@@ -12,7 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..discretize.mesh_utils import owned_facets
+from ..discretize.mesh_utils import owned_facets, scene_dofs
 from ..errors import InputError
 from ..logs import stage
 from ..options import SOLVERS, Predictor, SolverKind, SolverSpec
@@ -34,11 +34,6 @@ COARSE_FACTOR = 8.0
 # The condensed loop pays a whole solve per ring of nodes it adds or releases: a sharper
 # prediction (1/16 of the DOFs) pays for itself.
 CONDENSED_COARSE_FACTOR = 4.0
-
-
-def scene_dofs(scene: Scene) -> int:
-    """Displacement dofs of `scene` (P1 vector: two per vertex)."""
-    return 2 * scene.mesh.topology.index_map(0).size_global
 
 
 # A direct solver's probes are selected entries of the inverse, whose cost grows with the

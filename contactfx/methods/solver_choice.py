@@ -18,6 +18,19 @@ from mpi4py import MPI
 # count and the loop after it (probes, GMRES); measured in docs/scale.md, "The default solver".
 SAFETY = 1.25
 CONDENSED = "condensed"  # the preset `auto` falls back to
+# Where the fine analysis would be long, `auto` first analyses the same scene meshed this
+# much coarser (a quarter of the DOFs): MUMPS' estimate per DOF grows with the DOFs on this
+# family from COARSE_BOUND_DOFS up (1 and 2 ranks), so the coarse estimate scaled to the
+# fine DOFs is a lower bound of the fine one (`scaled_bound`); below that size a rank's
+# fixed share can make the per-DOF figure fall. A quarter, not the predictor's 1/16: the
+# estimate per DOF is 9 % short of the fine one at 10.46M from a quarter, 19 % from 1/16,
+# which then fitted on the 23 GB machine (docs/scale.md, "The default solver").
+COARSE_BOUND_FACTOR = 2.0
+COARSE_BOUND_DOFS = 400_000
+# The coarse check runs only where it could decide: where SAFETY x this much per DOF (above
+# every measured estimate per DOF, 1.19-1.74 KB) would not fit; elsewhere the fine analysis
+# decides at once (its first factorization reuses it).
+CHECK_KB_PER_DOF = 2.0
 
 
 class Choice(StrEnum):
@@ -41,6 +54,15 @@ def choose(
     return Choice.CONDENSED if condensable else Choice.REFUSE
 
 
+def scaled_bound(coarse_mb: float, coarse_dofs: int, dofs: int) -> float:
+    """A lower bound of MUMPS' estimate for `dofs` DOFs from its estimate for `coarse_dofs`.
+
+    Valid where the estimate per DOF does not fall with the DOFs (from COARSE_BOUND_DOFS):
+    est(dofs) >= est(coarse) x dofs / coarse_dofs.
+    """
+    return coarse_mb * dofs / coarse_dofs
+
+
 @dataclass(frozen=True)
 class SolverChoice:
     """Which solver `auto` ran and why (the JSON's `solver_choice`); memory in MB per node."""
@@ -50,6 +72,9 @@ class SolverChoice:
     available_mb: float | None
     analysis_seconds: float | None
     safety: float = SAFETY
+    # DOFs of the coarse system whose analysis, scaled, bounds the estimate from below (None:
+    # the estimate is the fine system's own).
+    coarse_dofs: int | None = None
 
     @property
     def reason(self) -> str:
@@ -57,8 +82,11 @@ class SolverChoice:
         if self.needed_mb is None or self.available_mb is None:
             return "no MUMPS memory estimate: the direct default"
         verb = "needs" if self.ran != CONDENSED else "would need"
+        amount = f"{self.needed_mb / 1e3:.2f} GB"
+        if self.coarse_dofs is not None:
+            amount = f">= {amount} (analysis of the {self.coarse_dofs:,}-DOF coarse system, scaled)"
         return (
-            f"MUMPS {verb} {self.needed_mb / 1e3:.2f} GB, {self.available_mb / 1e3:.2f} GB "
+            f"MUMPS {verb} {amount}, {self.available_mb / 1e3:.2f} GB "
             f"available; margin x{self.safety:g}"
         )
 
@@ -72,6 +100,8 @@ class SolverChoice:
             "available_mb": self.available_mb,
             "safety": self.safety,
             "analysis_seconds": self.analysis_seconds,
+            "estimate_of": "fine" if self.coarse_dofs is None else "coarse, scaled (a lower bound)",
+            "coarse_dofs": self.coarse_dofs,
         }
 
 

@@ -36,6 +36,7 @@ from .model import (
     SizeField,
     Units,
 )
+from .partition import body_strips
 
 
 def _gmsh_node_coordinates() -> np.ndarray:
@@ -82,12 +83,7 @@ def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[...,
         graph = coo_array((np.ones(len(first)), (first, other)), shape=(n, n))
         _, node_label = connected_components(graph, directed=False)
         cell_label = node_label[np.concatenate([c[:, 0] for c in conn])]
-        # Within each body, equal-count strips by midpoint x (then y): the contact line of
-        # each body is spread over all ranks, and the strips of the bodies overlap.
-        for label in np.unique(cell_label):
-            ids = np.flatnonzero(cell_label == label)
-            order = ids[np.lexsort((mid[ids, 1], mid[ids, 0]))]
-            dest[order] = (np.arange(len(order)) * nparts) // len(order)
+        body_strips(dest, cell_label, mid, nparts)
         return adjacencylist(dest)._cpp_object
 
     return partition

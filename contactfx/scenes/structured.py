@@ -11,7 +11,7 @@ from mpi4py import MPI
 
 from ..errors import InputError
 from ..meshes import hertz_grid
-from .gmsh_io import balanced_partitioner
+from .partition import known_bodies_partitioner
 
 # Physical groups, named like the gmsh scene's (the numbers themselves are free).
 TAGS = {
@@ -53,7 +53,8 @@ def build_hertz_structured(
         x, cells, n_block = np.zeros((0, 2)), np.zeros((0, 4), dtype=np.int64), 0
     n_block = comm.bcast(n_block, root=0)
     element = ufl.Mesh(basix.ufl.element("Lagrange", "quadrilateral", 1, shape=(2,)))
-    partitioner = balanced_partitioner(np.column_stack([x, np.zeros(len(x))]))
+    bodies = np.arange(len(cells)) >= n_block  # the grid numbers body 1's cells first
+    partitioner = known_bodies_partitioner(x, bodies)
     msh = dmesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
     tdim = msh.topology.dim
     ncells = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts

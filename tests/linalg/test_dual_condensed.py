@@ -208,3 +208,31 @@ def test_condensed_predictor_is_solved_directly(small_hertz, caplog) -> None:
     assert coarse and "probes" in coarse[0]  # only a direct solver probes
     assert all(h["probes"] == 0 for h in sol.history)  # the fine loop has no probes
     assert any(h["linear_iterations"] > 1 for h in sol.history)  # CG ran on the fine mesh
+
+
+def test_release_solve_stops_at_the_first_solves_accuracy(small_hertz, monkeypatch) -> None:
+    """A loose solve after a release stops at loose_rtol ||b|| (the first solve's accuracy),
+    having reduced its own residual by WARM_REDUCTION: fewer iterations than reducing it by
+    loose_rtol (the former rule), the same updated signs, and it still iterates.
+    """
+    import contactfx.linalg.condensed as condensed
+
+    setup = None
+    runs = {}
+    for name, warm in (("now", condensed.WARM_REDUCTION), ("former", 1e-4)):
+        monkeypatch.setattr(condensed, "WARM_REDUCTION", warm)
+        setup, solver = _condensed_solver(small_hertz)
+        x = setup.layout.x[setup.layout.mine, 0]
+        a = small_hertz.params["hertz_exact"]["a"]
+        solver.solve(setup.g, x < 1.12 * a)  # from zero to loose_rtol ||b||
+        second = x < a
+        assert 0 < (x < 1.12 * a).sum() - second.sum() <= 8  # a release, multigrid kept
+        res = solver.solve(setup.g, second)
+        assert not res.refactored and res.iterations >= 1
+        runs[name] = res
+        solver.destroy()
+    assert runs["now"].iterations < runs["former"].iterations
+    mu = {k: r.mu for k, r in runs.items()}
+    assert np.array_equal(mu["now"] < 0, mu["former"] < 0)  # the same tension signs
+    scale = np.abs(mu["former"]).max()
+    assert np.abs(mu["now"] - mu["former"]).max() <= 1e-2 * scale

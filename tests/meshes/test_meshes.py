@@ -188,3 +188,20 @@ def test_balanced_partition_under_mpirun(tmp_path: Path, mpi_script) -> None:
 def test_balanced_partitioner_serial_is_identity() -> None:
     md = to_dolfinx(MPI.COMM_SELF, partial(build_blocks, *S1), balanced_partitioner())
     assert md.mesh.topology.index_map(2).size_local == 960 + 576
+
+
+@pytest.mark.parametrize("nparts", [2, 3])
+def test_known_bodies_give_the_connected_components_partition(nparts: int) -> None:
+    """The structured grid's cell bodies (block cells first) skip the component search and
+    give the very partition the node graph's connected components give."""
+    from contactfx.meshes import hertz_grid
+    from contactfx.scenes.partition import known_bodies_partitioner
+
+    x, cells, n_block = hertz_grid(60.0, 60.0, 60.0, 0.1, 2.0, 1.0, 0.1)
+    coords = np.column_stack([x, np.zeros(len(x))])
+    ct = [CellType.quadrilateral]
+    found = balanced_partitioner(coords)(MPI.COMM_SELF, nparts, ct, [cells.ravel()])
+    bodies = np.arange(len(cells)) >= n_block
+    known = known_bodies_partitioner(x, bodies)(MPI.COMM_SELF, nparts, ct, [cells.ravel()])
+    assert np.array_equal(found.array, known.array)
+    assert np.unique(known.array).size == nparts

@@ -18,7 +18,15 @@ from mpi4py import MPI
 from contactfx import run_scene
 from contactfx.api import as_request
 from contactfx.errors import InputError
-from contactfx.methods.solver_choice import SAFETY, Choice, choose, mem_available_mb, node_budget
+from contactfx.methods.solver_choice import (
+    SAFETY,
+    Choice,
+    SolverChoice,
+    choose,
+    mem_available_mb,
+    node_budget,
+    scaled_bound,
+)
 from contactfx.options import SOLVERS, SolverKind
 from contactfx.request import SolveRequest
 from contactfx.scenes import HertzParams, hertz
@@ -103,6 +111,92 @@ def test_auto_refuses_where_nothing_fits(scene, caplog) -> None:
         _, data = run_scene(scene, request)
     assert data.to_json()["solver"] == "mumps"
     assert "solver: mumps, although MUMPS needs" in caplog.text
+
+
+def test_scaled_bound_and_its_reason() -> None:
+    """The coarse estimate scales with the DOFs, and the log says it is a scaled lower bound."""
+    assert scaled_bound(981.0, 695_006, 10_455_512) == pytest.approx(981.0 * 15.0439, rel=1e-4)
+    record = SolverChoice("condensed", 14_760.0, 15_000.0, 5.0, coarse_dofs=695_006)
+    assert record.reason == (
+        "MUMPS would need >= 14.76 GB (analysis of the 695,006-DOF coarse system, scaled), "
+        "15.00 GB available; margin x1.25"
+    )
+    assert record.to_json()["coarse_dofs"] == 695_006
+    assert SolverChoice("mumps", 1.0, 2.0, 0.1).to_json()["coarse_dofs"] is None
+
+
+@pytest.mark.parametrize(("available", "preset"), [(1.0, "condensed"), (1e9, "mumps")])
+def test_auto_coarse_bound(scene, monkeypatch, available: float, preset: str) -> None:
+    """With the coarse check on (its size floor and gate opened for this small scene): where
+    the scaled coarse estimate does not fit, condensed after the coarse analysis alone (the
+    fine one is skipped); where it fits, the fine analysis decides as before. Answers: the
+    presets'.
+    """
+    import contactfx.methods.autosolve as autosolve
+
+    calls: list[int] = []
+
+    def counted(linear):
+        calls.append(linear._m.A.getSize()[0])  # the saddle point analysed
+        return estimate(linear)
+
+    estimate = autosolve.mumps_estimate
+    remeshed = type(scene).remeshed
+    meshes: list[float] = []
+
+    def counted_remesh(self, factor: float):
+        meshes.append(factor)
+        return remeshed(self, factor)
+
+    monkeypatch.setattr(autosolve, "COARSE_BOUND_DOFS", 0)
+    monkeypatch.setattr(autosolve, "CHECK_KB_PER_DOF", 1e12)
+    monkeypatch.setattr(autosolve, "mumps_estimate", counted)
+    monkeypatch.setattr(type(scene), "remeshed", counted_remesh)
+    sol, data = _run(scene, "auto", available)
+    seen = list(calls)  # the auto run's analyses (an explicit mumps run checks too)
+    ref, _ = _run(scene, preset)
+    choice = data.to_json()["solver_choice"]
+    assert choice["ran"] == preset
+    dofs = 2 * scene.mesh.topology.index_map(0).size_global
+    fine = [n for n in seen if n >= dofs]
+    assert meshes[0] == 2.0  # the coarse check's mesh: a quarter of the DOFs
+    assert seen and seen[0] < dofs / 2  # its analysis comes first
+    if preset == "condensed":
+        assert not fine  # skipped (later coarse ones: the predictor's direct solve)
+        assert 0 < choice["coarse_dofs"] < dofs / 2
+        assert "coarse system, scaled" in choice["reason"]
+    else:
+        assert len(fine) == 1  # it fits: the fine analysis decides, as before
+        assert choice["coarse_dofs"] is None
+    assert np.array_equal(sol.active, ref.active)
+    scale = np.abs(ref.pressure).max()
+    assert np.abs(sol.pressure - ref.pressure).max() <= 1e-7 * scale
+
+
+def test_auto_coarse_check_only_where_it_could_decide(scene, monkeypatch) -> None:
+    """Size floor open, gate as shipped: ample memory skips the coarse check (one analysis,
+    the fine one); the gate is what keeps the check off where MUMPS plainly fits."""
+    import contactfx.methods.autosolve as autosolve
+
+    calls: list[int] = []
+    estimate = autosolve.mumps_estimate
+    monkeypatch.setattr(autosolve, "COARSE_BOUND_DOFS", 0)
+    monkeypatch.setattr(autosolve, "mumps_estimate", lambda lin: calls.append(1) or estimate(lin))
+    _, data = _run(scene, "auto", 1e9)
+    assert len(calls) == 1 and data.to_json()["solver_choice"]["coarse_dofs"] is None
+    calls.clear()
+    _, data = _run(scene, "auto", 1.0)  # no room even at CHECK_KB_PER_DOF: the check runs
+    assert data.to_json()["solver_choice"]["coarse_dofs"] is not None
+
+
+def test_auto_coarse_bound_refuses_without_a_diagonal_d(scene, monkeypatch) -> None:
+    """The standard basis where even the coarse bound does not fit: the one-line refusal."""
+    import contactfx.methods.autosolve as autosolve
+
+    monkeypatch.setattr(autosolve, "COARSE_BOUND_DOFS", 0)
+    monkeypatch.setattr(autosolve, "CHECK_KB_PER_DOF", 1e12)
+    with pytest.raises(InputError, match=r"would not fit: MUMPS estimates >= .*GB available"):
+        _run(scene, "auto", 1.0, basis="standard")
 
 
 HERTZ = ["hertz", "--mesh", "structured", "--refine", "0.08", "--h-far", "0.8", "--method"]

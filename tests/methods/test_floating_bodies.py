@@ -197,3 +197,20 @@ def test_disk_between_rigid_plates_is_refused_along_the_plates_normal(method: st
     assert "before the first solve" in message, message
     assert "[[dirichlet]]" in message and "[[obstacle]]" in message, message
     assert "[[contact]]" not in message, message
+
+
+def test_body_blocks_are_the_sorted_unique_blocks() -> None:
+    """The mask in body_blocks gives np.unique's blocks: sorted, each once, per body."""
+    from dolfinx import fem
+    from mpi4py import MPI
+
+    from contactfx.discretize.supports import body_blocks
+    from contactfx.scenes import HertzParams, hertz
+
+    scene = hertz(HertzParams(refine=0.3, h_far=3.0, mesh="structured"), comm=MPI.COMM_SELF)
+    V = fem.functionspace(scene.mesh, ("Lagrange", 1, (2,)))
+    for body in scene.bodies:
+        cells = scene.body_cells(body)
+        expected = np.unique(V.dofmap.list[cells].ravel())
+        assert np.array_equal(body_blocks(V, cells), expected)
+    assert body_blocks(V, np.zeros(0, dtype=np.int32)).size == 0
