@@ -18,6 +18,7 @@ import pytest
 from dolfinx.mesh import entities_to_geometry
 from mpi4py import MPI
 
+from contactfx.scenes import Scene
 from contactfx.scenes.builtin import HertzParams, hertz
 
 R = 60.0
@@ -25,7 +26,7 @@ H_FAR = 5.0
 GROUPS = ("contact1", "contact2", "symmetry", "support", "load")
 
 
-def _facet_points(scene, name: str) -> np.ndarray:  # type: ignore[no-untyped-def]
+def _facet_points(scene: Scene, name: str) -> np.ndarray:
     """Coordinates of the vertices of the facets of group `name`, shape (facets, 2, 2)."""
     tag = scene.groups.tag(name, 1, "test")
     facets = scene.facet_tags.find(tag)
@@ -33,7 +34,7 @@ def _facet_points(scene, name: str) -> np.ndarray:  # type: ignore[no-untyped-de
     return scene.mesh.geometry.x[geo][:, :, :2]
 
 
-def _body_area(scene, body: str) -> float:  # type: ignore[no-untyped-def]
+def _body_area(scene: Scene, body: str) -> float:
     """Area of the body's quads (shoelace over the tensor-product vertex order)."""
     cells = scene.cell_tags.find(scene.groups.tag(body, 2, "test"))
     x = scene.mesh.geometry.x[entities_to_geometry(scene.mesh, 2, cells)][:, :, :2]
@@ -43,7 +44,7 @@ def _body_area(scene, body: str) -> float:  # type: ignore[no-untyped-def]
 
 
 @pytest.fixture(scope="module")
-def scenes():  # type: ignore[no-untyped-def]
+def scenes() -> dict[str, Scene]:
     """The built-in Hertz scene on both meshers, coarse (a few thousand cells)."""
     out = {}
     for mesher in ("gmsh", "structured"):
@@ -52,7 +53,7 @@ def scenes():  # type: ignore[no-untyped-def]
     return out
 
 
-def test_groups_span_the_same_segments(scenes) -> None:  # type: ignore[no-untyped-def]
+def test_groups_span_the_same_segments(scenes: dict[str, Scene]) -> None:
     """Every boundary group covers the same extent on both meshers, to round-off.
 
     But the contact surfaces' outer end: x = R/4 on gmsh (a geometry point), the first grid
@@ -73,7 +74,7 @@ def test_groups_span_the_same_segments(scenes) -> None:  # type: ignore[no-untyp
         assert np.allclose(boxes[0], boxes[1], rtol=0.0, atol=1e-9 * R), (name, boxes)
 
 
-def test_bodies_have_the_exact_areas(scenes) -> None:  # type: ignore[no-untyped-def]
+def test_bodies_have_the_exact_areas(scenes: dict[str, Scene]) -> None:
     """The block is 60 x 60 on both; the disc a chord polygon of the same quarter circle."""
     for mesher, scene in scenes.items():
         assert _body_area(scene, "body1") == pytest.approx(60.0 * 60.0, rel=1e-12), mesher
@@ -87,7 +88,7 @@ def test_bodies_have_the_exact_areas(scenes) -> None:  # type: ignore[no-untyped
         assert 0.0 <= deficit <= quarter * theta**2 / 6, (mesher, deficit, theta)
 
 
-def test_same_problem_data(scenes) -> None:  # type: ignore[no-untyped-def]
+def test_same_problem_data(scenes: dict[str, Scene]) -> None:
     """Materials, supports, loads, contact pair and the Hertz reference are equal."""
     a, b = scenes["gmsh"], scenes["structured"]
     assert a.bodies == b.bodies
