@@ -15,7 +15,10 @@ narrowest zone, and extrapolates with q = 2^(-1.5 k). A resolved zone keeps k = 
 extra refinement costs something on the coarsest levels only. The same bound needs the
 refinement to reach every cell whose error the pressure carries, the near field's too:
 halving only the cells within half a zone length missed about half the error on adapted
-levels, REACH zone lengths about what halving every cell sees, at a smaller cost. The rate
+levels, REACH zone lengths about what halving every cell sees, at a smaller cost. The cells
+at a zone's edge are refined twice more: the pressure's error there is O(h) with a constant
+set by where the edge falls in the cell, and a refined edge cell only half the level's can
+be the unluckier one (a refined solution worse than the level's). The rate
 stays the assumed 1.5: an observed one needs a third solve (near-only halvings cannot see
 the far part, common to both refined solves) or the level sequence, whose pre-asymptotic
 levels (an error that stalls from one level to the next) would make it meaningless where
@@ -79,6 +82,14 @@ REACH = 4.0
 # contact zone (halving its contact cells up to MAX_HALVINGS times; see the docstring).
 ZONE_SEGMENTS = 8
 MAX_HALVINGS = 3
+
+# And the cells within EDGE_CELLS of the level's edge cells of a zone's edge (the segment
+# the pressure falls to zero in) EDGE_HALVINGS times more: the error there is O(h) with a
+# constant set by where the edge falls in the cell, so a refined edge cell of half the
+# level's can be the unluckier one and the refined solution worse than the level's (r12
+# level 2: 1.49 % against 0.94 %; docs/adapt.md, "An edge-refined reference").
+EDGE_CELLS = 2.0
+EDGE_HALVINGS = 2
 
 # A peak pressure that grows by more than this factor when the contact cells are halved is
 # singular: a 1/sqrt peak grows by sqrt(2) = 1.41 per halving, a bounded one tends to 1.
@@ -145,12 +156,15 @@ def refined_field(
     near: float = 0.5,
     band: float = BAND,
     reach: float = REACH,
+    edge: float | None = None,
 ) -> SizeField:
     """The current mesh's sizes, times `near` near the contact surfaces, `far` elsewhere.
 
     Near: within `band` local contact cell sizes of a contact surface, or within `reach`
     times a pair's contact zone length of that zone. `far` 1 leaves the rest unchanged,
-    0.5 halves it too. Collective; the field's arrays on rank 0.
+    0.5 halves it too. `edge` (if not None): the factor of the cells within EDGE_CELLS
+    edge-segment lengths of a zone's edge (`_edges`). Collective; the field's arrays on
+    rank 0.
     """
     quads, verts = owned_cells(sol)
     h = cell_sizes(quads)
@@ -164,7 +178,28 @@ def refined_field(
             if reach > 0 and len(zone):
                 close |= cKDTree(zone).query(mid)[0] <= reach * length
         factor[close] = near
+        if edge is not None:
+            ends, lengths = _edges(sol)
+            if len(ends):
+                dist, nearest = cKDTree(ends).query(mid)
+                factor[dist <= EDGE_CELLS * lengths[nearest]] = edge
     return vertex_sizes(sol.scene.comm, quads, verts, h * factor)
+
+
+def _edges(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
+    """Both end nodes of every segment a zone ends in (one end loaded), and its length."""
+    points, lengths = [], []
+    for pv in sol.pairs:
+        x, seg = pv.active.surface.x[:, :2], pv.active.surface.segments
+        p = np.zeros(len(x))
+        p[pv.nodes] = sol.pressure[pv.rows]
+        ends = seg[(p[seg[:, 0]] > 0) ^ (p[seg[:, 1]] > 0)]
+        length = np.linalg.norm(x[ends[:, 1]] - x[ends[:, 0]], axis=1)
+        points += [x[ends[:, 0]], x[ends[:, 1]]]
+        lengths += [length, length]
+    if not points:
+        return np.zeros((0, 2)), np.zeros(0)
+    return np.concatenate(points), np.concatenate(lengths)
 
 
 def zone_halvings(sol: Solution) -> int:
@@ -313,7 +348,8 @@ def goal_estimate(
     # Energy and force halve every cell once; the pressure its contact cells k times.
     k = zone_halvings(sol) if goal is Goal.PRESSURE else 1
     far, near = (1.0, 0.5**k) if goal is Goal.PRESSURE else (0.5, 0.5)
-    field = refined_field(sol, far=far, near=near, reach=reach)
+    edge = 0.5 ** (k + EDGE_HALVINGS) if goal is Goal.PRESSURE else None
+    field = refined_field(sol, far=far, near=near, reach=reach, edge=edge)
     ref = _refined(sol, field, solver, options or {})
     q = 2.0 ** (-r * k)
     parts: dict[str, float] = {}

@@ -64,6 +64,21 @@ def test_refined_field_halves_only_near_contact() -> None:
     assert np.median(ratio) == pytest.approx(1.0)
 
 
+def test_refined_field_refines_the_zone_edge_further() -> None:
+    """`edge`: the cells around the segment the zone ends in get that factor, no others."""
+    sol = contactfx.solve(hertz(HertzParams(refine=0.2, h_far=10.0, refine_edge=0.0)), "mortar")
+    plain = refined_field(sol)
+    field = refined_field(sol, edge=0.125)
+    ratio = field.sizes / plain.sizes
+    assert ratio.min() == pytest.approx(0.25, rel=1e-5)  # the edge's 0.125 over the band's 0.5
+    # Where the sizes changed: around x = a (the zone's edge, Hertz a = 1.44), within
+    # EDGE_CELLS of the edge segment's length (0.2 here) of its ends, and a vertex more.
+    changed = field.quads[np.any(np.abs(ratio - 1.0) > 1e-9, axis=1)].reshape(-1, 2)
+    assert changed.size
+    a = hertz_summary(sol).a_exact
+    assert np.all(np.abs(changed[:, 0] - a) <= 0.2 * (1 + 2.0) + 2 * 0.2), changed[:, 0]
+
+
 @pytest.mark.parametrize("refine", [0.1, 0.05, 0.025])
 def test_hertz_pressure_effectivity(refine: float) -> None:
     """Ungraded Hertz starts: estimate / exact L2 pressure error within [0.9, 2]."""
