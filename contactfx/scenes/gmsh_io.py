@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from dolfinx.cpp.mesh import cell_num_vertices
 from dolfinx.graph import adjacencylist
 from dolfinx.io.gmsh import MeshData, model_to_mesh
 from mpi4py import MPI
@@ -36,7 +35,7 @@ from .model import (
     SizeField,
     Units,
 )
-from .partition import body_strips
+from .partition import body_strips, cell_arrays
 
 
 def _gmsh_node_coordinates() -> np.ndarray:
@@ -61,10 +60,7 @@ def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[...,
 
     def partition(comm: MPI.Comm, nparts: int, cell_types: list[Any], cells: list[Any]) -> Any:
         # Cells of one type per list entry, flattened; node index = gmsh node tag - 1.
-        conn = [
-            np.asarray(c, dtype=np.int64).reshape(-1, cell_num_vertices(ct))
-            for ct, c in zip(cell_types, cells, strict=True)
-        ]
+        conn = cell_arrays(cell_types, cells)
         num_cells = sum(len(c) for c in conn)
         dest = np.zeros(num_cells, dtype=np.int32)
         if num_cells == 0 or nparts == 1:

@@ -23,6 +23,14 @@ def body_strips(dest: np.ndarray, cell_label: np.ndarray, mid: np.ndarray, npart
         dest[order] = (np.arange(len(order)) * nparts) // len(order)
 
 
+def cell_arrays(cell_types: list[Any], cells: list[Any]) -> list[np.ndarray]:
+    """A partitioner's flat cell lists as (cells, vertices) int64 arrays, one per cell type."""
+    return [
+        np.asarray(c, dtype=np.int64).reshape(-1, cell_num_vertices(ct))
+        for ct, c in zip(cell_types, cells, strict=True)
+    ]
+
+
 def known_bodies_partitioner(
     coordinates: np.ndarray, cell_bodies: np.ndarray
 ) -> Callable[..., Any]:
@@ -35,10 +43,7 @@ def known_bodies_partitioner(
     """
 
     def partition(comm: MPI.Comm, nparts: int, cell_types: list[Any], cells: list[Any]) -> Any:
-        conn = [
-            np.asarray(c, dtype=np.int64).reshape(-1, cell_num_vertices(ct))
-            for ct, c in zip(cell_types, cells, strict=True)
-        ]
+        conn = cell_arrays(cell_types, cells)
         num_cells = sum(len(c) for c in conn)
         dest = np.zeros(num_cells, dtype=np.int32)
         if num_cells and nparts > 1:
