@@ -48,7 +48,12 @@ EDGE_SLOPE = 0.1
 ARCS: dict[str, list[tuple[tuple[float, float], float, tuple[float, float]]]] = {
     "rotated_hertz": [((-10.0 * np.sin(_PHI), 10.0 * np.cos(_PHI)), 10.0, (0.0, 0.0))],
     "cylinder_between_blocks": [((0.0, 0.0), 20.0, (0.0, -20.0)), ((0.0, 0.0), 20.0, (0.0, 20.0))],
+    # two_cylinders.geo: the active (upper) disc centred at (0, 60), R = 60, touching at the
+    # origin; a half model (x >= 0).
+    "two_cylinders": [((0.0, 60.0), 60.0, (0.0, 0.0))],
 }
+# Each scene's .geo background field, which the edge grading joins by a Min.
+BACKGROUND = {"rotated_hertz": 1, "cylinder_between_blocks": 7, "two_cylinders": 5}
 
 
 def edge_points(scene: str, a: float) -> list[tuple[float, float]]:
@@ -57,6 +62,10 @@ def edge_points(scene: str, a: float) -> list[tuple[float, float]]:
         c, sn, dy = np.cos(_PHI), np.sin(_PHI), 10.0 - np.sqrt(100.0 - a * a)
         pts = [(x, y) for x in (a, -a) for y in (0.0, dy)]
         return [(x * c - y * sn, x * sn + y * c) for x, y in pts]
+    if scene == "two_cylinders":
+        # The zone's one end (x = a) on the lower (R 40) and the upper (R 60) disc, twice.
+        lower, upper = (a, -40.0 + np.sqrt(1600.0 - a * a)), (a, 60.0 - np.sqrt(3600.0 - a * a))
+        return [lower, upper, lower, upper]
     y = np.sqrt(400.0 - a * a)
     return [(a, -20.0), (a, -y), (a, 20.0), (a, y)]
 
@@ -69,8 +78,8 @@ def edge_graded(scene: Path, a: float, folder: Path) -> Path:
     geo = (scene.parent / f"{scene.stem}.geo").read_text()
     d = [f"Sqrt((x - ({x:.17g}))^2 + (y - ({y:.17g}))^2)" for x, y in edge_points(scene.stem, a)]
     field = f"{EDGE_H} + {EDGE_SLOPE} * Min(Min({d[0]}, {d[1]}), Min({d[2]}, {d[3]}))"
-    top = "Background Field = 1;" if scene.stem == "rotated_hertz" else "Background Field = 7;"
-    old = 1 if scene.stem == "rotated_hertz" else 7
+    old = BACKGROUND[scene.stem]
+    top = f"Background Field = {old};"
     extra = (
         f'Field[20] = MathEval;\nField[20].F = "{field}";\n'
         f"Field[21] = Min;\nField[21].FieldsList = {{{old}, 20}};\nBackground Field = 21;"
