@@ -135,8 +135,7 @@ class _ContactFields:
     def _pair(self, sol: Solution, k: int) -> None:
         pv = sol.pairs[k]
         surf = pv.active.surface
-        p_nodes = np.zeros(surf.n_nodes)
-        p_nodes[pv.nodes] = sol.pressure[pv.rows]
+        p_nodes = pv.nodal(sol.pressure)
         normal = nodal_normals(surf)
         normal[pv.nodes] = pv.frame[0]
         gap = sol.gap[pv.rows]

@@ -86,8 +86,8 @@ MAX_HALVINGS = 3
 # And the cells within EDGE_CELLS of the level's edge cells of a zone's edge (the segment
 # the pressure falls to zero in) EDGE_HALVINGS times more: the error there is O(h) with a
 # constant set by where the edge falls in the cell, so a refined edge cell of half the
-# level's can be the unluckier one and the refined solution worse than the level's (r12
-# level 2: 1.49 % against 0.94 %; docs/adapt.md, "An edge-refined reference").
+# level's can be the unluckier one and the refined solution worse than the level's
+# (measured: docs/adapt.md, "The pre-asymptotic scatter: an edge-refined reference").
 EDGE_CELLS = 2.0
 EDGE_HALVINGS = 2
 
@@ -191,8 +191,7 @@ def _edges(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
     points, lengths = [], []
     for pv in sol.pairs:
         x, seg = pv.active.surface.x[:, :2], pv.active.surface.segments
-        p = np.zeros(len(x))
-        p[pv.nodes] = sol.pressure[pv.rows]
+        p = pv.nodal(sol.pressure)
         ends = seg[(p[seg[:, 0]] > 0) ^ (p[seg[:, 1]] > 0)]
         length = np.linalg.norm(x[ends[:, 1]] - x[ends[:, 0]], axis=1)
         points += [x[ends[:, 0]], x[ends[:, 1]]]
@@ -220,8 +219,7 @@ def _zones(sol: Solution) -> list[tuple[np.ndarray, float]]:
     out = []
     for pv in sol.pairs:
         x, seg = pv.active.surface.x[:, :2], pv.active.surface.segments
-        p = np.zeros(len(x))
-        p[pv.nodes] = sol.pressure[pv.rows]
+        p = pv.nodal(sol.pressure)
         on = (p[seg[:, 0]] > 0) | (p[seg[:, 1]] > 0)
         a, b = x[seg[on, 0]], x[seg[on, 1]]
         out.append((0.5 * (a + b), float(np.sum(np.linalg.norm(b - a, axis=1)))))
@@ -249,8 +247,7 @@ def _pressure_curve(
     x is each node's x coordinate: the radius of an axisymmetric model.
     """
     s_all = pv.arc[0]
-    p = np.zeros(len(s_all))
-    p[pv.nodes] = pressure[pv.rows]
+    p = pv.nodal(pressure)
     keep = np.isfinite(s_all)
     order = np.argsort(s_all[keep], kind="stable")
     x = pv.active.surface.x[:, 0]

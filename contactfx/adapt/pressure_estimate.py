@@ -158,8 +158,7 @@ def pressure_estimate(sol: Solution) -> PressureEstimate:
     out = []
     for pv in sol.pairs:
         surf = pv.active.surface
-        p = np.zeros(surf.n_nodes)
-        p[pv.nodes] = sol.pressure[pv.rows]
+        p = pv.nodal(sol.pressure)
         eta, edge = segment_indicators(surf.x, surf.segments, p)
         norm = l2_norm(surf.x, surf.segments, p)
         passive = pv.passive.surface if pv.passive is not None else None

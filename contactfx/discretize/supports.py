@@ -32,8 +32,8 @@ Contact = tuple[Body, Body | None, GatheredSurface]
 def body_blocks(V: fem.FunctionSpace, cells: np.ndarray) -> np.ndarray:
     """Local dof blocks (nodes, owned and ghost) of the cells `cells` (a body's), sorted.
 
-    A mask over the local blocks, not np.unique: the same sorted blocks without the hash
-    (np.unique took 2.8 s of a 2M-DOF run's setup, docs/scale.md "Setup").
+    A mask over the local blocks, not np.unique: the same sorted blocks without np.unique's
+    sort, which dominated the setup of large meshes (measured: docs/scale.md, "Setup").
     """
     im = V.dofmap.index_map
     mask = np.zeros(im.size_local + im.num_ghosts, dtype=bool)

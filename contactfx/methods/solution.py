@@ -68,6 +68,15 @@ class PairView:
         """The active-surface node of each multiplier row."""
         return np.searchsorted(self.active.gblock, self.gblock)
 
+    def nodal(self, values: np.ndarray) -> np.ndarray:
+        """`values` (one per multiplier row, e.g. the pressure) on every active-surface node.
+
+        0 on the nodes without a row of this pair.
+        """
+        out = np.zeros(self.active.surface.n_nodes)
+        out[self.nodes] = values[self.rows]
+        return out
+
     @cached_property
     def arc(self) -> tuple[np.ndarray, np.ndarray]:
         """(s, t): arc length and unit tangent at every node of the active surface."""

@@ -23,13 +23,13 @@ CONDENSED = "condensed"  # the preset `auto` falls back to
 # family from COARSE_BOUND_DOFS up (1 and 2 ranks), so the coarse estimate scaled to the
 # fine DOFs is a lower bound of the fine one (`scaled_bound`); below that size a rank's
 # fixed share can make the per-DOF figure fall. A quarter, not the predictor's 1/16: the
-# estimate per DOF is 9 % short of the fine one at 10.46M from a quarter, 19 % from 1/16,
-# which then fitted on the 23 GB machine (docs/scale.md, "The default solver").
+# bound from 1/16 falls further short of the fine estimate and did not decide where the
+# fine analysis is the long one (measured: docs/scale.md, "The default solver").
 COARSE_BOUND_FACTOR = 2.0
 COARSE_BOUND_DOFS = 400_000
 # The coarse check runs only where it could decide: where SAFETY x this much per DOF (above
-# every measured estimate per DOF, 1.19-1.74 KB) would not fit; elsewhere the fine analysis
-# decides at once (its first factorization reuses it).
+# every estimate per DOF measured in docs/scale.md, "The default solver") would not fit;
+# elsewhere the fine analysis decides at once (its first factorization reuses it).
 CHECK_KB_PER_DOF = 2.0
 
 

@@ -37,7 +37,7 @@ def known_bodies_partitioner(
     """The strips partition for cells whose bodies the caller knows (the structured grid).
 
     The same partition as `gmsh_io.balanced_partitioner`, which finds the bodies as the node
-    graph's connected components (2.6 s of 8.4 s of create_mesh at 2.67M DOFs on 2 ranks:
+    graph's connected components, a large share of create_mesh on big grids (measured:
     docs/scale.md, "Setup"). `coordinates` (n, 2+) and `cell_bodies` on the rank holding the
     cells.
     """
