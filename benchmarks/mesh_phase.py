@@ -1,10 +1,12 @@
-"""The structured Hertz grid's mesh phase in parts: the grid on rank 0, the partitioner, and
-DOLFINx's create_mesh (which calls the partitioner), seconds per rank.
+"""The structured Hertz grid's mesh phase in parts, seconds per rank: each rank's part of the
+grid (`hertz_grid_part`), DOLFINx's create_mesh (which calls the partitioner, `stay_on_rank`),
+its own timers (the topology, the dual graph, the reordering) and the facet tags (which
+create the facets).
 
     [mpirun -n 2] python benchmarks/mesh_phase.py H
 
-meshes the accurate family (`--refine H --h-far 10H`) through `build_scene` with those three
-wrapped. docs/scale.md ("Setup") cites it.
+meshes the accurate family (`--refine H --h-far 10H`) through `build_scene` with those
+wrapped, and prints each rank's peak memory (VmHWM). docs/scale.md ("Setup") cites it.
 """
 
 from __future__ import annotations
@@ -14,6 +16,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+import dolfinx_solver  # noqa: F401  (before dolfinx)
+from dolfinx.common import list_timings
 from mpi4py import MPI
 
 import contactfx.scenes.structured as structured
@@ -37,16 +41,21 @@ def timed(name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
 def main() -> None:
     """Mesh once and print each rank's parts."""
     h = float(sys.argv[1])
-    partitioner = structured.known_bodies_partitioner
-    structured.hertz_grid = timed("grid", structured.hertz_grid)
-    structured.known_bodies_partitioner = lambda *a: timed("partition", partitioner(*a))
+    structured.hertz_grid_part = timed("grid", structured.hertz_grid_part)
+    structured.stay_on_rank = timed("partition", structured.stay_on_rank)
     structured.dmesh.create_mesh = timed("create_mesh", structured.dmesh.create_mesh)
+    structured.tag_hertz_facets = timed("tags", structured.tag_hertz_facets)
     comm = MPI.COMM_WORLD
     t0 = time.perf_counter()
     scene = build_scene("hertz", HertzParams(refine=h, h_far=10 * h, mesh="structured"), comm=comm)
     T["total"] = time.perf_counter() - t0
     dofs = 2 * scene.mesh.topology.index_map(0).size_global
     print(comm.rank, dofs, {k: round(v, 2) for k, v in T.items()}, flush=True)
+    with open("/proc/self/status") as f:
+        peak = next(line.split()[1] for line in f if line.startswith("VmHWM"))
+    print(comm.rank, f"VmHWM {int(peak) // 1024} MB", flush=True)
+    comm.barrier()
+    list_timings(comm)  # DOLFINx's timers (create_mesh's parts, the facets), max over ranks
 
 
 if __name__ == "__main__":

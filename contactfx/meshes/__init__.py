@@ -8,6 +8,6 @@ ValueError for bad parameters.
 
 from .blocks import build_blocks
 from .hertz import QUAD4, build_hertz
-from .hertz_structured import hertz_grid
+from .hertz_structured import GridPart, hertz_grid, hertz_grid_part
 
-__all__ = ["QUAD4", "build_blocks", "build_hertz", "hertz_grid"]
+__all__ = ["QUAD4", "GridPart", "build_blocks", "build_hertz", "hertz_grid", "hertz_grid_part"]

@@ -13,6 +13,8 @@ scaling study needs. Far from the contact the cells are stretched (up to h_far/h
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -55,7 +57,23 @@ def _quads(ids: np.ndarray) -> np.ndarray:
     return np.stack(corners, axis=-1).reshape(-1, 4)
 
 
-def hertz_grid(
+class _Lines(NamedTuple):
+    """The 1D point distributions and the corner points the grid is built from."""
+
+    xs: np.ndarray  # block columns
+    ys: np.ndarray  # block rows
+    u: np.ndarray  # disc: along the arc of patch a and along x in the square
+    v: np.ndarray  # disc: from the square (0) to the arc (1)
+    w: np.ndarray  # disc: along the arc of patch b and along y in the square
+    yc: float
+    d: float
+    a_curves: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+    b_curves: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+    a_corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+    b_corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _lines(
     R: float,
     width: float,
     height: float,
@@ -63,17 +81,11 @@ def hertz_grid(
     r_refine: float,
     h_far: float,
     slope: float,
-) -> tuple[np.ndarray, np.ndarray, int]:
-    """Node coordinates, quad cells and the number of block cells (which come first)."""
+) -> _Lines:
     # Block [0, width] x [0, height]: fine at x = 0 along the top.
     xs = graded_points(width, h_contact, r_refine, slope, h_far)
     ys = height - graded_points(height, h_contact, 0.0, slope, h_far)[::-1]
     ys[-1] = height
-    bx, by = np.meshgrid(xs, ys, indexing="ij")
-    block_ids = np.arange(bx.size).reshape(bx.shape)
-    block_x = np.column_stack([bx.ravel(), by.ravel()])
-    block_cells = _quads(block_ids)
-
     # Quarter disc: centre C, bottom point Pb (the contact point), P45 on the arc, Pr right.
     yc = height + R
     d = _SQUARE * R
@@ -94,45 +106,71 @@ def hertz_grid(
     def arc(theta: np.ndarray) -> np.ndarray:
         return C + R * np.column_stack([np.cos(theta), np.sin(theta)])
 
-    def coons(
-        bottom: np.ndarray,
-        top: np.ndarray,
-        left: np.ndarray,
-        right: np.ndarray,
-        corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-        s: np.ndarray,
-        t: np.ndarray,
-    ) -> np.ndarray:
-        # Transfinite interpolation of four boundary curves, s along bottom/top, t along sides.
-        S, T = s[:, None, None], t[None, :, None]
-        c00, c10, c01, c11 = corners
-        edges = (
-            (1 - T) * bottom[:, None] + T * top[:, None] + (1 - S) * left[None] + S * right[None]
-        )
-        return edges - (
-            (1 - S) * (1 - T) * c00 + S * (1 - T) * c10 + (1 - S) * T * c01 + S * T * c11
-        )
-
     line = lambda a, b, s: a + s[:, None] * (b - a)  # noqa: E731
-    pa = coons(
+    # Patch a: s = u along D-F (bottom) and the arc to P45 (top), t = v along D-Pb and F-P45.
+    a_curves = (
         line(D, F, u),
         arc(-0.5 * math.pi + 0.25 * math.pi * u),
         line(D, Pb, v),
         line(F, P45, v),
-        (D, F, Pb, P45),
-        u,
-        v,
     )
-    pb = coons(
+    # Patch b: s = w along F-G and the arc from P45 to Pr, t = v along F-P45 and G-Pr.
+    b_curves = (
         line(F, G, w),
         arc(-0.25 * math.pi + 0.25 * math.pi * w),
         line(F, P45, v),
         line(G, Pr, v),
-        (F, G, P45, Pr),
-        w,
-        v,
     )
-    nu, nv = len(u) - 1, len(v) - 1
+    return _Lines(xs, ys, u, v, w, yc, d, a_curves, b_curves, (D, F, Pb, P45), (F, G, P45, Pr))
+
+
+def _coons(
+    bottom: np.ndarray,
+    top: np.ndarray,
+    left: np.ndarray,
+    right: np.ndarray,
+    corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    S: np.ndarray,
+    T: np.ndarray,
+) -> np.ndarray:
+    # Transfinite interpolation of four boundary curves, S along bottom/top, T along the
+    # sides; any shapes that broadcast (the whole patch, or a list of nodes).
+    c00, c10, c01, c11 = corners
+    edges = (1 - T) * bottom + T * top + (1 - S) * left + S * right
+    return edges - ((1 - S) * (1 - T) * c00 + S * (1 - T) * c10 + (1 - S) * T * c01 + S * T * c11)
+
+
+def hertz_grid(
+    R: float,
+    width: float,
+    height: float,
+    h_contact: float,
+    r_refine: float,
+    h_far: float,
+    slope: float,
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Node coordinates, quad cells and the number of block cells (which come first)."""
+    ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
+    u, v, w, yc, d = ln.u, ln.v, ln.w, ln.yc, ln.d
+    bx, by = np.meshgrid(ln.xs, ln.ys, indexing="ij")
+    block_ids = np.arange(bx.size).reshape(bx.shape)
+    block_x = np.column_stack([bx.ravel(), by.ravel()])
+    block_cells = _quads(block_ids)
+
+    def patch(
+        curves: tuple[np.ndarray, ...],
+        corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+        s: np.ndarray,
+    ) -> np.ndarray:
+        bottom, top, left, right = curves
+        return _coons(
+            bottom[:, None], top[:, None], left[None], right[None], corners,
+            s[:, None, None], v[None, :, None],
+        )  # fmt: skip
+
+    pa = patch(ln.a_curves, ln.a_corners, u)
+    pb = patch(ln.b_curves, ln.b_corners, w)
+    nu, nv, nw = len(u) - 1, len(v) - 1, len(w) - 1
     ida = np.arange((nu + 1) * (nv + 1)).reshape(nu + 1, nv + 1)
     n = ida.size
     idb = np.empty((nw + 1, nv + 1), dtype=np.int64)
@@ -157,3 +195,177 @@ def hertz_grid(
     disc_cells = np.vstack([_quads(ida), _quads(idb), _quads(ids)]) + len(block_x)
     x = np.vstack([block_x, disc_x])
     return x, np.vstack([block_cells, disc_cells]), len(block_cells)
+
+
+class GridPart(NamedTuple):
+    """One rank's share of `hertz_grid`: its cells and a block of the node coordinates.
+
+    Nodes keep `hertz_grid`'s numbering; `x` holds the coordinates of nodes `first_node`,
+    `first_node + 1`, ... and `cells` refer to nodes by that numbering (they may lie in
+    another part's block). The first `n_block` cells are block cells.
+    """
+
+    x: np.ndarray
+    first_node: int
+    cells: np.ndarray
+    n_block: int
+
+
+def _strip(n: int, part: int, nparts: int) -> np.ndarray:
+    # Item k goes to part (k nparts) // n: the equal-count strips of scenes/partition.py.
+    return np.arange(-(-part * n // nparts), -(-(part + 1) * n // nparts))
+
+
+def _node_block(n: int, part: int, nparts: int) -> tuple[int, int]:
+    # DOLFINx's own split of n input nodes over the ranks (the first n % nparts get one
+    # more): create_mesh first sends every input node to the rank of this split.
+    q, r = divmod(n, nparts)
+    lo = part * q + min(part, r)
+    return lo, lo + q + (part < r)
+
+
+def hertz_grid_part(
+    R: float,
+    width: float,
+    height: float,
+    h_contact: float,
+    r_refine: float,
+    h_far: float,
+    slope: float,
+    part: int,
+    nparts: int,
+) -> GridPart:
+    """Part `part` of `nparts` of `hertz_grid`'s mesh, made without the rest of the grid.
+
+    The cells of each body are cut into `nparts` equal-count strips: the block's by x (then
+    y), the very strips `scenes/partition.body_strips` gives; the disc's swept around its
+    centre from the symmetry line (patch a's columns, then patch b's, each with its share of
+    the square). Each part makes its cells and the coordinates of one block of nodes, so no
+    part holds the whole grid. With `nparts == 1`, `hertz_grid`'s arrays.
+    """
+    ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
+    u, v, w = ln.u, ln.v, ln.w
+    nx, ny = len(ln.xs) - 1, len(ln.ys) - 1
+    nu, nv, nw = len(u) - 1, len(v) - 1, len(w) - 1
+    n_bx = (nx + 1) * (ny + 1)  # block nodes; the disc's follow
+    n_a = (nu + 1) * (nv + 1)  # disc nodes of patch a, then b's w >= 1, then the square's
+    n_ab = n_a + nw * (nv + 1)
+    n_nodes = n_bx + n_ab + nu * nw
+
+    # hertz_grid's node numbers of the disc's grids ida[i, j], idb[k, j] and ids[i, k].
+    Index = np.ndarray | int
+
+    def ida(i: Index, j: Index) -> np.ndarray:
+        return np.asarray(i * (nv + 1) + j)
+
+    def idb(k: np.ndarray, j: Index) -> np.ndarray:
+        return np.where(k == 0, ida(nu, j), n_a + (k - 1) * (nv + 1) + j)
+
+    def ids(i: np.ndarray, k: np.ndarray) -> np.ndarray:
+        inner = np.where(i == nu, idb(k, 0), n_ab + i * nw + k - 1)
+        return np.where(k == 0, ida(i, 0), inner)
+
+    def quads(ids2: Callable[..., np.ndarray], i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        corners = [ids2(i, j), ids2(i + 1, j), ids2(i, j + 1), ids2(i + 1, j + 1)]
+        return np.column_stack(corners)
+
+    # Cells: block k = (column i, row j), column by column.
+    i, j = np.divmod(_strip(nx * ny, part, nparts), ny)
+    block_cells = quads(lambda a, b: a * (ny + 1) + b, i, j)
+    # The disc, swept around its centre from the symmetry line: patch a's columns u, each
+    # with the square's cells of that column below its diagonal C-F, then patch b's columns
+    # w, each with the square's cells of that row right of the diagonal. Whole square
+    # columns would make the last one border every strip of patch b; the diagonal is the
+    # index space's, (i + 1/2) / nu + (k + 1/2) / nw < 1, where a's and b's strips cross it
+    # at about equal steps (neighbours per part: docs/scale.md, "Setup").
+    m = 2 * nu * nw
+    ia, kb = np.arange(nu), np.arange(nw)
+    below = np.clip(-((nu - m + (2 * ia + 1) * nw) // (2 * nu)), 0, nw)  # per column i
+    right = nu - np.clip(-((nw - m + (2 * kb + 1) * nu) // (2 * nw)), 0, nu)  # per row k
+    a_end = np.cumsum(nv + below)
+    b_end = a_end[-1] + np.cumsum(nv + right)
+    pd = _strip(int(b_end[-1]), part, nparts)
+    in_a = pd < a_end[-1]
+    i = np.searchsorted(a_end, pd[in_a], side="right")
+    r = pd[in_a] - (a_end[i] - nv - below[i])
+    k = np.searchsorted(b_end, pd[~in_a], side="right")
+    q = pd[~in_a] - (b_end[k] - nv - right[k])
+    # The square's cells by hertz_grid's number (column-major), to keep its order.
+    sb = q >= nv
+    square = np.sort(
+        np.concatenate(
+            [i[r >= nv] * nw + r[r >= nv] - nv, (nu - right[k[sb]] + q[sb] - nv) * nw + k[sb]]
+        )
+    )
+    disc_cells = np.vstack(
+        [
+            quads(ida, i[r < nv], r[r < nv]),
+            quads(idb, k[q < nv], q[q < nv]),
+            quads(ids, *np.divmod(square, nw)),
+        ]
+    )
+    lo, hi = _node_block(n_nodes, part, nparts)
+
+    def block_rows(i: np.ndarray) -> np.ndarray:
+        return np.stack(np.broadcast_arrays(ln.xs[i][:, None], ln.ys[None, :]), axis=-1)
+
+    x = np.vstack(
+        [
+            _rows(lo, min(hi, n_bx), ny + 1, block_rows),
+            _disc_nodes(ln, max(lo, n_bx) - n_bx, hi - n_bx),
+        ]
+    )
+    return GridPart(x, lo, np.vstack([block_cells, disc_cells + n_bx]), len(block_cells))
+
+
+def _rows(lo: int, hi: int, width: int, fill: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    # Items lo .. hi - 1 of a row-major (rows, width) node grid whose rows `fill` makes.
+    if hi <= lo:
+        return np.empty((0, 2))
+    r0 = lo // width
+    grid = fill(np.arange(r0, (hi - 1) // width + 1)).reshape(-1, 2)
+    return grid[lo - r0 * width : hi - r0 * width]
+
+
+def _disc_nodes(ln: _Lines, lo: int, hi: int) -> np.ndarray:
+    # Coordinates of the disc's nodes lo .. hi - 1 (hertz_grid's disc numbering), value for
+    # value: the same expressions on the same numbers, row by row.
+    u, v, w, yc, d = ln.u, ln.v, ln.w, ln.yc, ln.d
+    nu, nv, nw = len(u) - 1, len(v) - 1, len(w) - 1
+    n_a = (nu + 1) * (nv + 1)
+    n_ab = n_a + nw * (nv + 1)
+
+    def patch(
+        curves: tuple[np.ndarray, ...], corners: Any, s: np.ndarray, i: np.ndarray
+    ) -> np.ndarray:
+        bottom, top, left, right = curves
+        return _coons(
+            bottom[i][:, None], top[i][:, None], left[None], right[None], corners,
+            s[i][:, None, None], v[None, :, None],
+        )  # fmt: skip
+
+    def a_rows(i: np.ndarray) -> np.ndarray:
+        out = patch(ln.a_curves, ln.a_corners, u, i)
+        # Patch a's last row (u = 1) is patch b's first: hertz_grid writes b's values there.
+        out[i == nu] = patch(ln.b_curves, ln.b_corners, w, np.zeros(1, dtype=np.int64))
+        out[i == 0, :, 0] = 0.0  # exactly on x = 0
+        return out
+
+    def b_rows(k: np.ndarray) -> np.ndarray:
+        out = patch(ln.b_curves, ln.b_corners, w, k + 1)  # b's rows w >= 1
+        out[k + 1 == nw, :, 1] = yc  # exactly on y = yc
+        return out
+
+    def square_rows(i: np.ndarray) -> np.ndarray:
+        out = np.stack(np.broadcast_arrays((u * d)[i][:, None], (yc - d + w * d)[None, 1:]), -1)
+        out[i == 0, :, 0] = 0.0
+        out[:, nw - 1, 1] = yc
+        return out
+
+    return np.vstack(
+        [
+            _rows(lo, min(hi, n_a), nv + 1, a_rows),
+            _rows(max(lo, n_a) - n_a, min(hi, n_ab) - n_a, nv + 1, b_rows),
+            _rows(max(lo, n_ab) - n_ab, hi - n_ab, nw, square_rows),
+        ]
+    )

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -31,25 +30,7 @@ def cell_arrays(cell_types: list[Any], cells: list[Any]) -> list[np.ndarray]:
     ]
 
 
-def known_bodies_partitioner(
-    coordinates: np.ndarray, cell_bodies: np.ndarray
-) -> Callable[..., Any]:
-    """The strips partition for cells whose bodies the caller knows (the structured grid).
-
-    The same partition as `gmsh_io.balanced_partitioner`, which finds the bodies as the node
-    graph's connected components, a large share of create_mesh on big grids (measured:
-    docs/scale.md, "Setup"). `coordinates` (n, 2+) and `cell_bodies` on the rank holding the
-    cells.
-    """
-
-    def partition(comm: MPI.Comm, nparts: int, cell_types: list[Any], cells: list[Any]) -> Any:
-        conn = cell_arrays(cell_types, cells)
-        num_cells = sum(len(c) for c in conn)
-        dest = np.zeros(num_cells, dtype=np.int32)
-        if num_cells and nparts > 1:
-            x = np.asarray(coordinates)
-            mid = np.vstack([x[c, :2].mean(axis=1) for c in conn])
-            body_strips(dest, np.asarray(cell_bodies), mid, nparts)
-        return adjacencylist(dest)._cpp_object
-
-    return partition
+def stay_on_rank(comm: MPI.Comm, nparts: int, cell_types: list[Any], cells: list[Any]) -> Any:
+    """Every cell stays on the rank that passed it to create_mesh (input made distributed)."""
+    num_cells = sum(len(c) for c in cell_arrays(cell_types, cells))
+    return adjacencylist(np.full(num_cells, comm.rank, dtype=np.int32))._cpp_object

@@ -10,8 +10,8 @@ from dolfinx.io.gmsh import MeshData, PhysicalGroup
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..meshes import hertz_grid
-from .partition import known_bodies_partitioner
+from ..meshes import hertz_grid_part
+from .partition import stay_on_rank
 
 # Physical groups, named like the gmsh scene's (the numbers themselves are free).
 TAGS = {
@@ -47,19 +47,38 @@ def build_hertz_structured(
         raise InputError("radius, block size, mesh sizes and slope must be positive")
     if not 0.0 < extent < min(width, R):
         raise InputError(f"contact_extent={extent} must lie in (0, min(width, R))")
-    if comm.rank == 0:
-        x, cells, n_block = hertz_grid(R, width, height, h_contact, r_refine, h_far, slope)
-    else:
-        x, cells, n_block = np.zeros((0, 2)), np.zeros((0, 4), dtype=np.int64), 0
-    n_block = comm.bcast(n_block, root=0)
+    part = hertz_grid_part(
+        R, width, height, h_contact, r_refine, h_far, slope, comm.rank, comm.size
+    )
     element = ufl.Mesh(basix.ufl.element("Lagrange", "quadrilateral", 1, shape=(2,)))
-    bodies = np.arange(len(cells)) >= n_block  # the grid numbers body 1's cells first
-    partitioner = known_bodies_partitioner(x, bodies)
-    msh = dmesh.create_mesh(comm, cells, element, x, partitioner=partitioner)
+    msh = dmesh.create_mesh(comm, part.cells, element, part.x, partitioner=stay_on_rank)
+    body = cell_bodies(msh, comm.allgather((len(part.cells), part.n_block)))
+    tdim = msh.topology.dim
+    cell_tags = dmesh.meshtags(msh, tdim, np.arange(len(body), dtype=np.int32), body)
+    facet_tags = tag_hertz_facets(msh, body, R, height, extent)
+    return MeshData(msh, cell_tags, facet_tags, None, None, dict(TAGS))
+
+
+def cell_bodies(msh: dmesh.Mesh, parts: list[tuple[int, int]]) -> np.ndarray:
+    """Body 1 or 2 of each local cell, from its input index (`original_cell_index`).
+
+    `parts`: (cells, block cells) that each rank passed to create_mesh, in rank order; a
+    rank's input cells are numbered after the lower ranks' and its block cells come first.
+    """
     tdim = msh.topology.dim
     ncells = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
-    body = np.where(np.asarray(msh.topology.original_cell_index)[:ncells] < n_block, 1, 2)
-    cell_tags = dmesh.meshtags(msh, tdim, np.arange(ncells, dtype=np.int32), body.astype(np.int32))
+    counts = np.array(parts, dtype=np.int64).reshape(-1, 2)
+    starts = np.concatenate([[0], np.cumsum(counts[:, 0])])
+    index = np.asarray(msh.topology.original_cell_index, dtype=np.int64)[:ncells]
+    rank = np.searchsorted(starts, index, side="right") - 1
+    return np.where(index - starts[rank] < counts[rank, 1], 1, 2).astype(np.int32)
+
+
+def tag_hertz_facets(
+    msh: dmesh.Mesh, body: np.ndarray, R: float, height: float, extent: float
+) -> dmesh.MeshTags:
+    """The facet groups of TAGS on the exterior facets, by position and body."""
+    tdim = msh.topology.dim
     msh.topology.create_connectivity(tdim - 1, tdim)
     facets = dmesh.exterior_facet_indices(msh.topology)
     f2c = msh.topology.connectivity(tdim - 1, tdim)
@@ -80,7 +99,4 @@ def build_hertz_structured(
         values[(values == 0) & in_body & cond] = TAGS[name].tag
     keep = values > 0
     order = np.argsort(facets[keep])
-    facet_tags = dmesh.meshtags(
-        msh, tdim - 1, facets[keep][order].astype(np.int32), values[keep][order]
-    )
-    return MeshData(msh, cell_tags, facet_tags, None, None, dict(TAGS))
+    return dmesh.meshtags(msh, tdim - 1, facets[keep][order].astype(np.int32), values[keep][order])

@@ -190,18 +190,53 @@ def test_balanced_partitioner_serial_is_identity() -> None:
     assert md.mesh.topology.index_map(2).size_local == 960 + 576
 
 
-@pytest.mark.parametrize("nparts", [2, 3])
-def test_known_bodies_give_the_connected_components_partition(nparts: int) -> None:
-    """The structured grid's cell bodies (block cells first) skip the component search and
-    give the very partition the node graph's connected components give."""
-    from contactfx.meshes import hertz_grid
-    from contactfx.scenes.partition import known_bodies_partitioner
+# (R, width, height, h_contact, r_refine, h_far, slope): the scene's proportions, and two
+# whose arc and top nodes do not round onto the boundary lines (hertz_grid sets them there).
+GRIDS = [
+    (60.0, 60.0, 60.0, 0.1, 2.0, 1.0, 0.1),
+    (0.37, 1.3, 0.55, 0.004, 0.01, 0.03, 0.3),
+    (0.53, 1.3, 0.37, 0.006, 0.02, 0.04, 0.3),
+]
 
-    x, cells, n_block = hertz_grid(60.0, 60.0, 60.0, 0.1, 2.0, 1.0, 0.1)
-    coords = np.column_stack([x, np.zeros(len(x))])
-    ct = [CellType.quadrilateral]
-    found = balanced_partitioner(coords)(MPI.COMM_SELF, nparts, ct, [cells.ravel()])
-    bodies = np.arange(len(cells)) >= n_block
-    known = known_bodies_partitioner(x, bodies)(MPI.COMM_SELF, nparts, ct, [cells.ravel()])
-    assert np.array_equal(found.array, known.array)
-    assert np.unique(known.array).size == nparts
+
+@pytest.mark.parametrize("grid", GRIDS)
+@pytest.mark.parametrize("nparts", [1, 2, 3, 7])
+def test_grid_parts_make_hertz_grid(grid: tuple, nparts: int) -> None:
+    """The parts' node blocks, in part order, are hertz_grid's nodes bit for bit; their cells
+    are hertz_grid's cells, each once, block cells first; one part is hertz_grid itself."""
+    from contactfx.meshes import hertz_grid, hertz_grid_part
+
+    x, cells, n_block = hertz_grid(*grid)
+    parts = [hertz_grid_part(*grid, k, nparts) for k in range(nparts)]
+    assert [p.first_node for p in parts] == list(np.cumsum([0] + [len(p.x) for p in parts])[:-1])
+    assert np.array_equal(np.vstack([p.x for p in parts]), x)
+    mine = np.vstack([p.cells for p in parts])
+    assert np.array_equal(mine[np.lexsort(mine.T[::-1])], cells[np.lexsort(cells.T[::-1])])
+    n_block_nodes = cells[:n_block].max() + 1
+    for p in parts:
+        assert (p.cells[: p.n_block] < n_block_nodes).all()
+        assert (p.cells[p.n_block :] >= n_block_nodes).all()
+    if nparts == 1:
+        assert np.array_equal(parts[0].cells, cells) and parts[0].n_block == n_block
+
+
+@pytest.mark.parametrize("nparts", [2, 3, 16])
+def test_grid_parts_are_strips_of_each_body(nparts: int) -> None:
+    """The block's parts are the partitioner's strips by x (body_strips on hertz_grid's cell
+    midpoints); the disc's parts are as equal (within one cell)."""
+    from contactfx.meshes import hertz_grid, hertz_grid_part
+    from contactfx.scenes.partition import body_strips
+
+    grid = GRIDS[0]
+    x, cells, n_block = hertz_grid(*grid)
+    mid = x[cells].mean(axis=1)
+    strips = np.zeros(len(cells), dtype=np.int32)
+    body_strips(strips, (np.arange(len(cells)) >= n_block).astype(int), mid, nparts)
+    index = {tuple(c): k for k, c in enumerate(np.sort(cells, axis=1).tolist())}
+    disc = []
+    for k in range(nparts):
+        p = hertz_grid_part(*grid, k, nparts)
+        block = [index[tuple(c)] for c in np.sort(p.cells[: p.n_block], axis=1).tolist()]
+        assert np.array_equal(np.sort(block), np.flatnonzero(strips[:n_block] == k))
+        disc.append(len(p.cells) - p.n_block)
+    assert max(disc) - min(disc) <= 1 and min(disc) > 0
