@@ -1,4 +1,8 @@
-"""Cell partitions that spread every body over all ranks: equal-count strips per body."""
+"""Cell partitions: equal-count strips per body, or every cell kept where it was made.
+
+The strips spread every body over all ranks (gmsh scenes); the structured Hertz grid is
+generated on every rank already cut so (`meshes.hertz_grid_part`) and stays.
+"""
 
 from __future__ import annotations
 
