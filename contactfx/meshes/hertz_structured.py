@@ -237,11 +237,11 @@ def hertz_grid_part(
 ) -> GridPart:
     """Part `part` of `nparts` of `hertz_grid`'s mesh, made without the rest of the grid.
 
-    The cells of each body are cut into `nparts` equal-count strips: the block's by x (then
-    y), the very strips `scenes/partition.body_strips` gives; the disc's swept around its
-    centre from the symmetry line (patch a's columns, then patch b's, each with its share of
-    the square). Each part makes its cells and the coordinates of one block of nodes, so no
-    part holds the whole grid. With `nparts == 1`, `hertz_grid`'s arrays.
+    The cells of each body are cut into `nparts` equal-count strips by cell midpoint x (then
+    y), the very strips `scenes/partition.body_strips` gives. Each part makes its cells and
+    the coordinates of one block of nodes; it holds the block's cells and nodes of its own
+    only, the disc's nodes whole (to cut the disc by x). With `nparts == 1`, `hertz_grid`'s
+    arrays.
     """
     ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
     u, v, w = ln.u, ln.v, ln.w
@@ -272,38 +272,18 @@ def hertz_grid_part(
     # Cells: block k = (column i, row j), column by column.
     i, j = np.divmod(_strip(nx * ny, part, nparts), ny)
     block_cells = quads(lambda a, b: a * (ny + 1) + b, i, j)
-    # The disc, swept around its centre from the symmetry line: patch a's columns u, each
-    # with the square's cells of that column below its diagonal C-F, then patch b's columns
-    # w, each with the square's cells of that row right of the diagonal. Whole square
-    # columns would make the last one border every strip of patch b; the diagonal is the
-    # index space's, (i + 1/2) / nu + (k + 1/2) / nw < 1, where a's and b's strips cross it
-    # at about equal steps (neighbours per part: docs/scale.md, "Setup").
-    m = 2 * nu * nw
-    ia, kb = np.arange(nu), np.arange(nw)
-    below = np.clip(-((nu - m + (2 * ia + 1) * nw) // (2 * nu)), 0, nw)  # per column i
-    right = nu - np.clip(-((nw - m + (2 * kb + 1) * nu) // (2 * nw)), 0, nu)  # per row k
-    a_end = np.cumsum(nv + below)
-    b_end = a_end[-1] + np.cumsum(nv + right)
-    pd = _strip(int(b_end[-1]), part, nparts)
-    in_a = pd < a_end[-1]
-    i = np.searchsorted(a_end, pd[in_a], side="right")
-    r = pd[in_a] - (a_end[i] - nv - below[i])
-    k = np.searchsorted(b_end, pd[~in_a], side="right")
-    q = pd[~in_a] - (b_end[k] - nv - right[k])
-    # The square's cells by hertz_grid's number (column-major), to keep its order.
-    sb = q >= nv
-    square = np.sort(
-        np.concatenate(
-            [i[r >= nv] * nw + r[r >= nv] - nv, (nu - right[k[sb]] + q[sb] - nv) * nw + k[sb]]
-        )
-    )
-    disc_cells = np.vstack(
-        [
-            quads(ida, i[r < nv], r[r < nv]),
-            quads(idb, k[q < nv], q[q < nv]),
-            quads(ids, *np.divmod(square, nw)),
-        ]
-    )
+    # The disc: the partitioner's strips by cell midpoint x (then y) too. Other cuts (swept
+    # around the centre: fewer cut facets at many parts) cost the ICC(0)-smoothed multigrid
+    # of the condensed path iterations on 2 ranks (docs/scale.md, "Setup"); this needs the
+    # disc's nodes on every part, about half the grid's coordinates.
+    i_all, j_all = np.divmod(np.arange(nu * nv), nv)
+    k_all, jb_all = np.divmod(np.arange(nw * nv), nv)
+    si, sk = np.divmod(np.arange(nu * nw), nw)
+    all_disc = np.vstack([quads(ida, i_all, j_all), quads(idb, k_all, jb_all), quads(ids, si, sk)])
+    xd = _disc_nodes(ln, 0, n_ab + nu * nw)
+    mid = xd[all_disc].mean(axis=1)
+    order = np.lexsort((mid[:, 1], mid[:, 0]))
+    disc_cells = all_disc[np.sort(order[_strip(len(all_disc), part, nparts)])]
     lo, hi = _node_block(n_nodes, part, nparts)
 
     def block_rows(i: np.ndarray) -> np.ndarray:
@@ -312,7 +292,7 @@ def hertz_grid_part(
     x = np.vstack(
         [
             _rows(lo, min(hi, n_bx), ny + 1, block_rows),
-            _disc_nodes(ln, max(lo, n_bx) - n_bx, hi - n_bx),
+            xd[max(lo, n_bx) - n_bx : max(hi - n_bx, 0)],
         ]
     )
     return GridPart(x, lo, np.vstack([block_cells, disc_cells + n_bx]), len(block_cells))
