@@ -359,6 +359,31 @@ def test_response_cache_refuses_rows_it_did_not_compute() -> None:
     assert cache.lookup(2, np.array([1]), np.array([False, True, False, False]), comm) is None
 
 
+def test_coarse_factor_keeps_the_coarse_rows_probeable(structured_pair, monkeypatch) -> None:
+    """A direct solver's coarse mesh is coarser still when the fine rows over the factor
+    exceed PROBE_ALL_ROWS (the coarse solve probes them all): the same converged answer.
+
+    PROBE_ALL_ROWS is lowered so that the 70k-DOF scene's rows over 8 exceed it.
+    """
+    from contactfx.api import solve
+    from contactfx.methods import predictor
+
+    fine, _ = structured_pair
+    rows = predictor.contact_facets(fine)
+    mumps = SOLVERS["mumps"]
+    assert predictor.coarse_factor(mumps, fine) == predictor.COARSE_FACTOR
+    limit = int(rows / 12)  # between rows / 16 and rows / 8
+    monkeypatch.setattr(predictor, "PROBE_ALL_ROWS", limit)
+    assert predictor.coarse_factor(mumps, fine) == 2 * predictor.COARSE_FACTOR
+    assert predictor.coarse_factor(SOLVERS["fieldsplit"], fine) == predictor.COARSE_FACTOR
+    plain = solve(fine, "mortar", solver="mumps", predictor="none")
+    sol = solve(fine, "mortar", solver="mumps", predictor="auto")
+    assert sum(h["probes"] for h in sol.history) < 0.5 * rows  # the band, not every row
+    assert np.array_equal(sol.active, plain.active)
+    p_max = np.abs(plain.pressure).max()
+    assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max
+
+
 @pytest.mark.parametrize("guess", ["inside", "far", "nothing"])
 def test_any_initial_set_converges_to_the_same_answer(structured_pair, guess) -> None:
     """A wrong first set (a subset, a wide superset, empty) costs iterations, not accuracy."""
