@@ -115,7 +115,9 @@ class CondensedSolver:
         """The same set solved to the final tolerance, from the last (loose) solution."""
         return self._solve(g, active, self._rtol)
 
-    def responses(self, rhs: np.ndarray, active: np.ndarray) -> np.ndarray:
+    def responses(
+        self, rhs: np.ndarray, active: np.ndarray, rows: np.ndarray | None = None
+    ) -> np.ndarray:
         """Not available: the condensed solver has no factorization (can_probe is False)."""
         raise SolverError("the condensed solver has no probe responses (it is not a factorization)")
 

@@ -61,11 +61,14 @@ class LinearSolver(Protocol):
         """`last` (a solve of this set) to the final tolerance; `last` itself if exact."""
         ...
 
-    def responses(self, rhs: np.ndarray, active: np.ndarray) -> np.ndarray:
+    def responses(
+        self, rhs: np.ndarray, active: np.ndarray, rows: np.ndarray | None = None
+    ) -> np.ndarray:
         """Multiplier responses (local rows x k) to multiplier-block right-hand sides.
 
         Column j of `rhs` (local rows x k) opens weighted gaps; the set solved last (with
-        `fresh`) is the operator. Only where `can_probe`.
+        `fresh`) is the operator. `rows` (a local mask): only these rows are needed, a
+        solver may leave the others zero (None: every active row). Only where `can_probe`.
         """
         ...
 

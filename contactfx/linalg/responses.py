@@ -52,23 +52,26 @@ def selected_responses(
     active: np.ndarray,
     comm: MPI.Comm,
     symmetric: bool = False,
+    wanted: np.ndarray | None = None,
 ) -> np.ndarray | None:
     """Responses (local rows x k) as selected entries of A^-1 from the MUMPS factor, or None.
 
     `positions`: each local multiplier row's global row in the whole system A (n x n). The
-    requested entries are the (active rows) x (probe rows) block, gathered on every rank.
+    requested entries are the (wanted rows) x (probe rows) block, gathered on every rank;
+    `wanted` (a local mask within `active`, default `active`): the other rows stay zero.
     None if a column is not a unit vector on an active row, or MUMPS refuses. `symmetric`:
     A is symmetric (half of the pairs within the columns are asked for).
     """
     col_pos = unit_columns(probes, active, positions, comm)
     if col_pos is None:
         return None
-    req = np.sort(np.concatenate(comm.allgather(positions[active])))
+    wanted = active if wanted is None else np.asarray(wanted, dtype=bool) & active
+    req = np.sort(np.concatenate(comm.allgather(positions[wanted])))
     cols, where = np.unique(col_pos, return_inverse=True)
     entries = inverse_entries(factor, req, cols, n, symmetric)
     if entries is None:
         return None
-    mine = np.flatnonzero(active)
+    mine = np.flatnonzero(wanted)
     out = np.zeros((len(active), probes.shape[1]))
     out[mine, :] = entries[where][:, np.searchsorted(req, positions[mine])].T
     return out
@@ -117,6 +120,7 @@ class ResponseCache:
     factorization: int = -1
     rows: np.ndarray | None = None  # sorted global rows of the columns
     values: np.ndarray | None = None  # (local rows x len(rows))
+    wanted: np.ndarray | None = None  # local mask of the rows computed (others are zero)
 
     def store(
         self,
@@ -126,8 +130,12 @@ class ResponseCache:
         values: np.ndarray,
         first_row: int,
         comm: MPI.Comm,
+        wanted: np.ndarray | None = None,
     ) -> None:
-        """Keep `values`, the responses to `probes` (local rows x k) on `factorization`."""
+        """Keep `values`, the responses to `probes` (local rows x k) on `factorization`.
+
+        `wanted`: the local rows they hold (None: every row); a lookup needs its rows there.
+        """
         k = values.shape[1]
         gp = np.where(active[:, None], probes, 0.0)
         nz = gp != 0.0
@@ -137,14 +145,24 @@ class ResponseCache:
         comm.Allreduce(MPI.IN_PLACE, col_row, op=MPI.MAX)
         order = np.argsort(col_row)
         self.factorization, self.rows, self.values = factorization, col_row[order], values[:, order]
+        self.wanted = None if wanted is None else np.asarray(wanted, dtype=bool).copy()
 
-    def lookup(self, factorization: int, rows: np.ndarray) -> np.ndarray | None:
-        """The kept responses to the global `rows` (sorted), if all are kept for it."""
+    def lookup(
+        self, factorization: int, rows: np.ndarray, local: np.ndarray, comm: MPI.Comm
+    ) -> np.ndarray | None:
+        """The kept responses to the global `rows` (sorted), if all are kept for it.
+
+        `local`: the same rows as a local mask; their own responses must have been computed
+        (collective: the answer is the same on every rank).
+        """
         if self.factorization != factorization or self.rows is None or self.values is None:
             return None
         if not len(self.rows):
             return None
         pos = np.minimum(np.searchsorted(self.rows, rows), len(self.rows) - 1)
+        held = self.wanted is None or bool(np.all(self.wanted[np.asarray(local, dtype=bool)]))
+        if not comm.allreduce(held, op=MPI.LAND):
+            return None
         return self.values[:, pos] if np.array_equal(self.rows[pos], rows) else None
 
 

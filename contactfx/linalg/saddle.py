@@ -209,7 +209,7 @@ class SaddleSolver:
                     m.x.set(0.0)
                 # A fresh factorization is applied once, as preonly would (GMRES's two
                 # iterations cost three back-substitutions); GMRES only if that is inexact.
-                single = refactor and self.policy.reuse and self._apply_once()
+                single = refactor and self.policy.reuse and _apply_once(self)
                 if not single:
                     ksp.setInitialGuessNonzero(refactor and self.policy.reuse)
                     ksp.solve(m.b, m.x)
@@ -239,15 +239,6 @@ class SaddleSolver:
         u, mu = m.split()
         return SaddleResult(u, mu, its, reason, refactor, changed, 0, t1 - t0, t2 - t1)
 
-    def _apply_once(self) -> bool:
-        """One back-substitution with the fresh factorization into x; True if accurate."""
-        m = self._m
-        self._ksp.getPC().apply(m.b, m.x)
-        r, rel = m.residual(m.x)
-        r.destroy()
-        self.factored.own_residual = rel
-        return rel <= _APPLY_RTOL
-
     def _solve_released(
         self, g: np.ndarray, active: np.ndarray, changed: int
     ) -> SaddleResult | None:
@@ -260,12 +251,12 @@ class SaddleSolver:
         count = self.factored.count
 
         def responses(rows: np.ndarray, local: np.ndarray) -> np.ndarray:
-            kept = self._cache.lookup(count, rows)
+            kept = self._cache.lookup(count, rows, local, self._mpi)
             if kept is not None:
                 return kept
             unit = np.zeros((len(local), len(rows)))
             unit[np.flatnonzero(local), np.arange(len(rows))[local_slice(self._mpi, local)]] = 1.0
-            return self.responses(unit, factored)
+            return self.responses(unit, factored, local)
 
         done = released_solve(
             pc.apply,
@@ -294,8 +285,13 @@ class SaddleSolver:
         """Every solve is already final: `last` itself."""
         return last
 
-    def responses(self, probes: np.ndarray, active: np.ndarray) -> np.ndarray:
-        """Multiplier responses (local rows x k) to `probes`, on the set factorized last."""
+    def responses(
+        self, probes: np.ndarray, active: np.ndarray, rows: np.ndarray | None = None
+    ) -> np.ndarray:
+        """Multiplier responses (local rows x k) to `probes`, on the set factorized last.
+
+        Selected entries are computed on `rows` only (a local mask; None: every active row).
+        """
         probes, active = np.asarray(probes, dtype=float), np.asarray(active, dtype=bool)
         k = self._mpi.allreduce(probes.shape[1] if probes.ndim == 2 else 0, op=MPI.MAX)
         if k == 0:
@@ -308,7 +304,7 @@ class SaddleSolver:
             start = m.A.getOwnershipRange()[0]
             n = m.A.getSize()[0]
             # The saddle point is symmetric whichever way it is factorized (LU or LDL^T).
-            out = selected_responses(F, m.rows_l + start, n, probes, active, self._mpi, True)
+            out = selected_responses(F, m.rows_l + start, n, probes, active, self._mpi, True, rows)
             if out is None and self._mpi.rank == 0:
                 log.info("saddle solver: no selected inverse entries: dense probe solves")
         if out is None:
@@ -317,8 +313,21 @@ class SaddleSolver:
             out = dense_responses(solve, probes, active, m.rows_u, m.rows_l, self._mpi, augment)
         if self.direct:
             r0 = m.B.getOwnershipRange()[0]
-            self._cache.store(self.factored.count, probes, active, out, r0, self._mpi)
+            self._cache.store(self.factored.count, probes, active, out, r0, self._mpi, rows)
         return out
+
+
+def _apply_once(solver: SaddleSolver) -> bool:
+    """One back-substitution with the fresh factorization into x; True if accurate.
+
+    A function of this module: the class stays within its size.
+    """
+    m = solver._m
+    solver._ksp.getPC().apply(m.b, m.x)
+    r, rel = m.residual(m.x)
+    r.destroy()
+    solver.factored.own_residual = rel
+    return rel <= _APPLY_RTOL
 
 
 def mumps_estimate(solver: SaddleSolver) -> MumpsEstimate | None:

@@ -246,8 +246,12 @@ class SchurSolver:
         """Every solve is exact."""
         return last
 
-    def responses(self, probes: np.ndarray, active: np.ndarray) -> np.ndarray:
+    def responses(
+        self, probes: np.ndarray, active: np.ndarray, rows: np.ndarray | None = None
+    ) -> np.ndarray:
         """Multiplier responses to multiplier-block right-hand sides on the last set.
+
+        Every active row's, whatever `rows` asks (the dense block holds them all).
 
         A right-hand side e_j on an active row j moves w by (S0 + D_A)^-1 e_j and B_A u by
         e_j, so mu_A = w_A + gamma B_A u by that column plus gamma e_j.

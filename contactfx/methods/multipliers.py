@@ -119,7 +119,9 @@ class MultiplierIteration:
             raise InputError(refusal(self.setup, err)) from None
         self._probes = None
         if self.probe is not None:
-            self._probes = self.solver.responses(self.state.probe_rhs(self.probe), active)
+            # The complementarity problem and a later release read only the probed rows.
+            rhs = self.state.probe_rhs(self.probe)
+            self._probes = self.solver.responses(rhs, active, rhs.any(axis=1))
         lam, gap, new_active = self._update(res.u, res.mu)
         its = res.iterations
         if not self.solver.exact and not comm.allreduce(

@@ -82,9 +82,22 @@ def predictor_solver(spec: SolverSpec, coarse: Scene) -> SolverSpec:
     return spec
 
 
-def coarse_factor(spec: SolverSpec) -> float:
-    """How much coarser the predictor's mesh is (every size times this)."""
-    return CONDENSED_COARSE_FACTOR if spec.kind.condensed else COARSE_FACTOR
+def coarse_factor(spec: SolverSpec, scene: Scene) -> float:
+    """How much coarser the predictor's mesh is (every size times this; collective).
+
+    A direct solve of the coarse mesh probes every one of its rows, which pays up to
+    PROBE_ALL_ROWS rows: COARSE_FACTOR is doubled until the coarse rows (about the fine
+    ones over the factor: the surfaces are curves) are that few; a wider fine band costs
+    its probes little (docs/scale.md#measured-constants, "Coarse factor").
+    """
+    if spec.kind.condensed:
+        return CONDENSED_COARSE_FACTOR
+    factor = COARSE_FACTOR
+    if spec.kind.factorizes_saddle:
+        rows = contact_facets(scene)
+        while rows / factor > PROBE_ALL_ROWS:
+            factor *= 2.0
+    return factor
 
 
 def coarse_margin(spec: SolverSpec) -> float:
@@ -140,7 +153,7 @@ def predict(
             log.info("coarse predictor: the scene cannot be remeshed, starting without it")
         return None
     with timers("predictor"), stage("predictor"):
-        coarse = scene.remeshed(coarse_factor(spec))
+        coarse = scene.remeshed(coarse_factor(spec, scene))
         coarse_request = replace(
             request, solver=predictor_solver(spec, coarse), reference_timing=False
         )

@@ -309,6 +309,81 @@ def test_selected_inverse_responses_equal_dense_solves(hertz_system) -> None:
     zero.destroy()
 
 
+def test_selected_responses_on_the_probed_rows_equal_dense_solves(hertz_system) -> None:
+    """Responses asked on the probed rows only: those rows equal dense solves, others zero.
+
+    The loop reads only the probed rows (its complementarity problem, a later release), so
+    MUMPS is asked for those entries alone; the reference is the same columns solved with
+    dense right-hand sides on a fresh factorization.
+    """
+    el, B, g, x = hertz_system
+    active = x < 1.6
+    rows = np.flatnonzero(active)
+    picked = rows[np.linspace(0, len(rows) - 1, 6).astype(int)]
+    probes = np.zeros((len(x), len(picked)))
+    probes[picked, np.arange(len(picked))] = 1.0
+    wanted = probes.any(axis=1)
+    zero = el.f.duplicate()
+    zero.set(0.0)
+    with _saddle(el, B, FactorizationPolicy()) as solver:
+        solver.solve(g, active, fresh=True)
+        part = solver.responses(probes, active, wanted)
+    assert not part[~wanted].any()
+    with SaddleSolver(el.K, B, zero, MUMPS, direct=True, policy=FactorizationPolicy()) as ref:
+        for j, row in enumerate(picked):
+            unit = np.zeros(len(x))
+            unit[row] = -1.0
+            dense = ref.solve(unit, active).mu
+            scale = np.abs(dense).max()
+            assert scale > 0
+            assert np.abs(part[wanted, j] - dense[wanted]).max() <= 1e-10 * scale
+    zero.destroy()
+
+
+def test_response_cache_refuses_rows_it_did_not_compute() -> None:
+    """Kept responses computed on some rows only are not read on the others (zeros there)."""
+    from contactfx.linalg.responses import ResponseCache
+
+    comm = MPI.COMM_SELF
+    probes = np.zeros((4, 2))
+    probes[1, 0] = probes[3, 1] = 1.0
+    active = np.ones(4, dtype=bool)
+    values = np.arange(8.0).reshape(4, 2)
+    cache = ResponseCache()
+    cache.store(1, probes, active, values, 0, comm, np.array([False, True, False, True]))
+    both = np.array([False, True, False, True])
+    assert np.array_equal(cache.lookup(1, np.array([1, 3]), both, comm), values)
+    cache.store(1, probes, active, values, 0, comm, np.array([False, True, False, False]))
+    assert cache.lookup(1, np.array([1, 3]), both, comm) is None
+    assert cache.lookup(1, np.array([1]), np.array([False, True, False, False]), comm) is not None
+    assert cache.lookup(2, np.array([1]), np.array([False, True, False, False]), comm) is None
+
+
+def test_coarse_factor_keeps_the_coarse_rows_probeable(structured_pair, monkeypatch) -> None:
+    """A direct solver's coarse mesh is coarser still when the fine rows over the factor
+    exceed PROBE_ALL_ROWS (the coarse solve probes them all): the same converged answer.
+
+    PROBE_ALL_ROWS is lowered so that the 70k-DOF scene's rows over 8 exceed it.
+    """
+    from contactfx.api import solve
+    from contactfx.methods import predictor
+
+    fine, _ = structured_pair
+    rows = predictor.contact_facets(fine)
+    mumps = SOLVERS["mumps"]
+    assert predictor.coarse_factor(mumps, fine) == predictor.COARSE_FACTOR
+    limit = int(rows / 12)  # between rows / 16 and rows / 8
+    monkeypatch.setattr(predictor, "PROBE_ALL_ROWS", limit)
+    assert predictor.coarse_factor(mumps, fine) == 2 * predictor.COARSE_FACTOR
+    assert predictor.coarse_factor(SOLVERS["fieldsplit"], fine) == predictor.COARSE_FACTOR
+    plain = solve(fine, "mortar", solver="mumps", predictor="none")
+    sol = solve(fine, "mortar", solver="mumps", predictor="auto")
+    assert sum(h["probes"] for h in sol.history) < 0.5 * rows  # the band, not every row
+    assert np.array_equal(sol.active, plain.active)
+    p_max = np.abs(plain.pressure).max()
+    assert np.abs(sol.pressure - plain.pressure).max() <= 1e-8 * p_max
+
+
 @pytest.mark.parametrize("guess", ["inside", "far", "nothing"])
 def test_any_initial_set_converges_to_the_same_answer(structured_pair, guess) -> None:
     """A wrong first set (a subset, a wide superset, empty) costs iterations, not accuracy."""
