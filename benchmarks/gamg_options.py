@@ -24,6 +24,7 @@ import json
 import time
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any, cast
 
 import numpy as np
@@ -32,13 +33,15 @@ from petsc4py import PETSc
 
 # benchmarks/run.py, next to this script: on sys.path as its folder.
 from run import EDGE_RATIO, refine_for
+from scaling_model import parse_log_view
 
 from contactfx.contact import Kernel
 from contactfx.discretize.setup import prepare_contact
 from contactfx.discretize.supports import rigid_body_modes
+from contactfx.linalg import condensed
 from contactfx.linalg.elimination import LocalRows, condensed_matrix, elimination_matrix
 from contactfx.linalg.nullspace import orthonormalize
-from contactfx.linalg.petsc_options import PrefixedOptions
+from contactfx.linalg.petsc_options import PrefixedOptions, global_options
 from contactfx.linalg.pivots import pivots
 from contactfx.methods.multipliers import _timed_fresh_solve
 from contactfx.options import SOLVERS, Basis, SolverSpec
@@ -91,6 +94,51 @@ SETS: dict[str, dict[str, object]] = {
         **ICC,
     },
 }
+# Issue 33's setup round: the 0.6.0 preset (ICC(0), threshold 0.05, 3 steps) and one change
+# each. A key with a leading "-" is a global (unprefixed) PETSc option: GAMG's products read
+# only those (linalg/petsc_options.py: global_options).
+ICC3: dict[str, object] = {"pc_gamg_threshold": 0.05, "mg_levels_ksp_max_it": 3, **ICC}
+ROUND2: dict[str, dict[str, object]] = {
+    "icc3": {},
+    "icc3-rap": {"-matptap_via": "rap"},
+    "icc3-coarse1k": {"pc_gamg_coarse_eq_limit": 1000},
+    "icc3-coarse3k": {"pc_gamg_coarse_eq_limit": 3000},
+    "icc3-agg0": {"pc_gamg_aggressive_coarsening": 0},
+    "icc3-agg2": {"pc_gamg_aggressive_coarsening": 2},
+    "icc3-mis2": {"pc_gamg_aggressive_square_graph": False},
+    "icc3-mindeg": {"pc_gamg_mis_k_minimum_degree_ordering": True},
+    "icc3-ns0": {"pc_gamg_agg_nsmooths": 0},
+    "icc3-esteig5": {"mg_levels_esteig_ksp_max_it": 5},
+    "icc3-lowmem": {"pc_gamg_low_memory_threshold_filter": True},
+    "icc3-w": {"pc_mg_cycle_type": "w"},
+    "icc3-w-coarse1k": {"pc_mg_cycle_type": "w", "pc_gamg_coarse_eq_limit": 1000},
+    "icc2": {"mg_levels_ksp_max_it": 2},
+    "icc3-agg2-mindeg": {
+        "pc_gamg_aggressive_coarsening": 2,
+        "pc_gamg_mis_k_minimum_degree_ordering": True,
+    },
+    "icc3-agg2-it4": {"pc_gamg_aggressive_coarsening": 2, "mg_levels_ksp_max_it": 4},
+    "icc3-agg2-mindeg-it4": {
+        "pc_gamg_aggressive_coarsening": 2,
+        "pc_gamg_mis_k_minimum_degree_ordering": True,
+        "mg_levels_ksp_max_it": 4,
+    },
+    "icc3-allatonce": {"-matptap_via": "allatonce"},
+    "icc3-scalable": {"-matptap_via": "scalable"},
+    "icc3-mindeg-coarse3k": {
+        "pc_gamg_mis_k_minimum_degree_ordering": True,
+        "pc_gamg_coarse_eq_limit": 3000,
+    },
+    "icc3-mindeg-esteig5": {
+        "pc_gamg_mis_k_minimum_degree_ordering": True,
+        "mg_levels_esteig_ksp_max_it": 5,
+    },
+    "icc3-cheb0.05": {"mg_levels_ksp_chebyshev_esteig": "0,0.05,0,1.1"},
+    "icc3-cheb0.2": {"mg_levels_ksp_chebyshev_esteig": "0,0.2,0,1.1"},
+    "icc3-thr0.1c": {"pc_gamg_threshold": "0.05,0.1,0.1,0.1,0.1,0.1,0.1,0.1,0.1,0.1"},
+    "icc3-thr0.02c": {"pc_gamg_threshold": "0.05,0.02,0.02,0.02,0.02,0.02,0.02,0.02,0.02"},
+}
+SETS.update({name: {**ICC3, **extra} for name, extra in ROUND2.items()})
 
 
 def spec_for(name: str) -> SolverSpec:
@@ -99,6 +147,13 @@ def spec_for(name: str) -> SolverSpec:
     if name == "chosen":
         return preset
     return replace(preset, petsc={**BASE, **SETS[name]}, name=f"condensed-{name}")
+
+
+def split_global(spec: SolverSpec) -> tuple[SolverSpec, dict[str, object]]:
+    """The spec without its "-key" options, and those options without the dash."""
+    local = {k: v for k, v in spec.petsc.items() if not k.startswith("-")}
+    glob = {k[1:]: v for k, v in spec.petsc.items() if k.startswith("-")}
+    return replace(spec, petsc=local), glob
 
 
 def bonded_solve(setup: Any, scene: Any, active: np.ndarray, spec: SolverSpec) -> tuple[int, float]:
@@ -150,8 +205,23 @@ def main() -> None:
     ap.add_argument("--bonded", action="store_true", help="also the Dirichlet version")
     ap.add_argument("--mumps", action="store_true", help="also the MUMPS saddle-point solve")
     ap.add_argument("--json", type=Path, default=Path("gamg_options.json"))
+    ap.add_argument(
+        "--cpu", action="store_true", help="setup and solve as this rank's CPU seconds (serial)"
+    )
+    ap.add_argument("--extra", default="", help="KEY=VALUE,... added to every set's options")
+    ap.add_argument(
+        "--log-view", type=Path, help="PETSc's -log_view here, one stage per (size, set)"
+    )
     args = ap.parse_args()
     comm = MPI.COMM_WORLD
+    extra = dict(kv.split("=", 1) for kv in args.extra.split(",") if kv)
+    if args.cpu:
+        # The solver's own setup/solve clocks read CPU time: on a shared machine the wall
+        # clock counts the other jobs' turns (serially the CPU time is this solve's work).
+        condensed.time = SimpleNamespace(perf_counter=time.process_time)  # type: ignore[assignment]
+    if args.log_view:
+        PETSc.Log.begin()
+    stages: list[tuple[dict[str, Any], str]] = []
     records: list[dict[str, Any]] = []
     if args.json.exists() and comm.rank == 0:
         records = json.loads(args.json.read_text())
@@ -175,15 +245,29 @@ def main() -> None:
             res, sec = _timed_fresh_solve(setup, SOLVERS["mumps"], scene, active)
             records.append({**common, "set": "mumps", "its": res.iterations, "seconds": sec})
             say(records[-1], comm)
-        for name in args.sets.split(","):
+        for k, name in enumerate(args.sets.split(",")):
             gc.collect()
             spec = spec_for(name)
+            if extra:
+                spec = replace(spec, petsc={**spec.petsc, **extra})
             rec: dict[str, Any] = {**common, "set": name, "options": dict(spec.petsc)}
+            stage = PETSc.Log.Stage(f"{dofs}:{k}:{name}") if args.log_view else None
+            if stage is not None:
+                stage.push()
+                stages.append((rec, stage.getName()))
             try:
-                res, sec = _timed_fresh_solve(setup, spec, scene, active)
+                local, glob = split_global(spec)
+                cpu = time.process_time()
+                with global_options(glob):
+                    res, sec = _timed_fresh_solve(setup, local, scene, active)
+                cpu = time.process_time() - cpu  # this rank's CPU: less noisy than wall time
                 rec.update(its=res.iterations, seconds=sec, setup=res.setup, solve=res.solve)
+                rec["cpu"] = cpu
             except Exception as err:  # one set's failure must not hide the others
                 rec["error"] = f"{type(err).__name__}: {err}"
+            finally:
+                if stage is not None:
+                    stage.pop()
             if args.bonded:
                 its, sec = bonded_solve(setup, scene, active, spec)
                 rec.update(bonded_its=its, bonded_seconds=sec)
@@ -193,14 +277,53 @@ def main() -> None:
                 args.json.write_text(json.dumps(records, indent=1))
         setup.destroy()
         del scene
+    if args.log_view:
+        add_setup_events(args.log_view, stages, comm)
     if comm.rank == 0:
         args.json.write_text(json.dumps(records, indent=1))
+
+
+# The setup's events in each set's stage (seconds, max over ranks): what the setup spends.
+SETUP_EVENTS = (
+    "PCSetUp",
+    "PCGAMGCreateG",
+    "GAMG Coarsen",
+    "PCGAMGProl",
+    "PCGAMGOptProl",
+    "GAMG PtAP",
+    "MatCholFctrNum",
+    "MatICCFactorSym",
+    "MatMatMultSym",
+    "MatMatMultNum",
+    "MatPtAPSymbolic",
+    "MatPtAPNumeric",
+    "MatAXPY",
+    "KSPSolve",
+    "PCApply",
+)
+
+
+def add_setup_events(path: Path, stages: list[tuple[dict[str, Any], str]], comm: MPI.Comm) -> None:
+    """Write PETSc's log to `path` and add each stage's setup events to its record."""
+
+    viewer = PETSc.Viewer().createASCII(str(path), comm=comm)
+    PETSc.Log.view(viewer)
+    viewer.destroy()
+    comm.Barrier()
+    if comm.rank != 0:
+        return
+    events = parse_log_view(path.read_text())["events"]
+    for rec, name in stages:
+        ev = events.get(name, {})
+        rec["events"] = {e: ev[e]["time"] for e in SETUP_EVENTS if e in ev}
+        print(json.dumps({"set": rec["set"], "dofs": rec["dofs"], **rec["events"]}), flush=True)
 
 
 def say(rec: dict[str, Any], comm: MPI.Comm) -> None:
     """One line per record (rank 0)."""
     if comm.rank == 0:
-        keep = ("mesh", "dofs", "set", "its", "seconds", "setup", "solve", "bonded_its", "error")
+        keep = ("mesh", "dofs", "set", "its", "seconds", "cpu", "setup", "solve", "bonded_its")
+        keep = (*keep, "error")
         print(json.dumps({k: rec[k] for k in keep if k in rec}), flush=True)
 
 
