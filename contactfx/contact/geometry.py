@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
-# Samples fetched per point in the first KD-tree round (twice that per run of grouped points);
-# multiplied by 4 for the points not settled yet.
-_FIRST_K = 12
+from .grid import PointGrid
+
+# Cell side of the search grid over the median sample spacing (docs/scale.md, "Time to the
+# first answer").
+_GRID_CELL = 1.0
 # Bound on the (points x candidates) work arrays, to keep memory flat for far-away points.
 _CHUNK_ENTRIES = 4_000_000
 # Up to this many (points x segments) pairs a search compares every point with every
-# segment (same segments and coordinates as the tree's): below it a few such searches cost
-# less than the scipy.spatial import the KD-tree needs (docs/scale.md, "Time to the first
-# answer").
+# segment (same segments and coordinates as the grid's): below it a few such searches cost
+# less than building the grid (docs/scale.md, "Time to the first answer").
 _ALL_PAIRS = 1 << 17
 
 
@@ -102,7 +102,7 @@ def nodal_normals(surface: Surface) -> np.ndarray:
 
 
 class SegmentSearch:
-    """Exact closest-segment queries on one surface (KD-tree on sample points of the segments)."""
+    """Exact closest-segment queries on one surface (a bucket grid of sample points)."""
 
     def __init__(self, surface: Surface) -> None:
         self.surface = surface
@@ -121,9 +121,10 @@ class SegmentSearch:
         frac = np.arange(len(self._owner)) - np.repeat(np.cumsum(pieces) - pieces, pieces) + 0.5
         frac /= np.repeat(pieces, pieces)
         samples = a[self._owner] + frac[:, None] * ab[self._owner]
-        self._reach = float((0.5 * length / pieces).max()) if m else 0.0
+        self._piece = np.repeat(length / pieces, pieces)
+        self._reach = float(0.5 * self._piece.max()) if m else 0.0
         self._samples = samples
-        self._kdtree: Any = None
+        self._grid: PointGrid | None = None
         # Distances within this of the minimum count as ties (e.g. a point on a shared vertex).
         self._eps = 1e-12 * max(float(length.max()) if m else 0.0, np.finfo(float).tiny)
         # Ties are broken by a rank that depends on geometry only, so that reordering or
@@ -134,69 +135,140 @@ class SegmentSearch:
         self._is_end = node_degrees(surface) == 1
 
     @property
-    def _tree(self) -> Any:
-        """The KD-tree of the samples, built at the first search that needs one."""
-        if self._kdtree is None:
-            from scipy.spatial import cKDTree  # only for larger searches (docs/scale.md)
-
-            self._kdtree = cKDTree(self._samples)
-        return self._kdtree
+    def grid(self) -> PointGrid:
+        """The bucket grid of the samples, built at the first search that needs one."""
+        if self._grid is None:
+            # Cells of the median sample spacing: about one sample per cell along the
+            # surface where most samples are (_GRID_CELL in docs/scale.md).
+            cell = _GRID_CELL * float(np.median(self._piece)) if len(self._piece) else 1.0
+            self._grid = PointGrid(self._samples, cell)
+        return self._grid
 
     def closest(
         self, points: np.ndarray, tol: float = 1e-8, group: int = 1
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Closest segment, clamped local coordinate in [0, 1] and found flag for each point."""
+        """Closest segment, clamped local coordinate in [0, 1] and found flag for each point.
+
+        `group` is accepted for the callers whose points come in runs (Gauss points); each
+        point is searched on its own, which costs about as much.
+        """
         points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
         npts, m = len(points), self.surface.n_segments
         seg = np.zeros(npts, dtype=np.int64)
         t = np.zeros(npts)
         if m == 0 or npts == 0:
             return seg, t, np.zeros(npts, dtype=bool)
-        nsamples = len(self._owner)
-        # A small search takes every segment as a candidate of every point (k = nsamples):
-        # the exact closest segment, ties broken by the same rank, as with the tree.
-        all_pairs = npts * m <= _ALL_PAIRS
-        todo = np.arange(npts)
-        if group > 1 and npts % group == 0 and 2 * _FIRST_K < nsamples and not all_pairs:
-            # Runs of nearby points (the Gauss points of one segment) share one tree query
-            # about their centre; the spread of the run widens the settling bound.
-            todo = self._grouped_round(points, group, seg, t)
-        k = nsamples if all_pairs else min(_FIRST_K, nsamples)
-        while todo.size:
-            chunk = max(1, _CHUNK_ENTRIES // k)
-            unsettled = []
-            for lo in range(0, todo.size, chunk):
-                idx = todo[lo : lo + chunk]
-                p = points[idx]
-                if k >= nsamples:
-                    cand = np.broadcast_to(np.arange(m), (len(idx), m))
-                    bound = np.full(len(idx), np.inf)
-                else:
-                    rk, near = self._tree.query(p, k=k, workers=-1)
-                    cand, bound = self._owner[near], rk[:, -1] - self._reach
-                unsettled.append(self._settle(p[:, None], cand, bound, idx, seg, t))
-            todo = np.concatenate(unsettled)
-            k = min(4 * k, nsamples)
+        if npts * m <= _ALL_PAIRS:
+            # A small search takes every segment as a candidate of every point: the exact
+            # closest segment, ties broken by the same rank, as with the grid.
+            cand = np.broadcast_to(np.arange(m), (npts, m))
+            self._settle(points[:, None], cand, np.full(npts, np.inf), np.arange(npts), seg, t)
+        else:
+            self._grid_search(points, seg, t)
         n0, n1 = self.surface.segments[seg, 0], self.surface.segments[seg, 1]
         beyond = ((t < -tol) & self._is_end[n0]) | ((t > 1.0 + tol) & self._is_end[n1])
         return seg, np.clip(t, 0.0, 1.0), ~beyond
 
-    def _grouped_round(
-        self, points: np.ndarray, group: int, seg: np.ndarray, t: np.ndarray
-    ) -> np.ndarray:
-        """First round shared by runs of `group` points; returns the unsettled point ids."""
-        k = 2 * _FIRST_K
-        centre = points.reshape(-1, group, 2).mean(axis=1)
-        spread = np.linalg.norm(points - np.repeat(centre, group, axis=0), axis=1)
-        unsettled = []
-        chunk = max(1, _CHUNK_ENTRIES // (k * group))
-        for lo in range(0, len(centre), chunk):
-            rk, near = self._tree.query(centre[lo : lo + chunk], k=k, workers=-1)
-            idx = np.arange(lo * group, min(lo + chunk, len(centre)) * group)
-            bound = np.repeat(rk[:, -1], group) - spread[idx] - self._reach
-            p = points[idx].reshape(-1, group, 2)
-            unsettled.append(self._settle(p, self._owner[near], bound, idx, seg, t))
-        return np.concatenate(unsettled)
+    def _grid_search(self, points: np.ndarray, seg: np.ndarray, t: np.ndarray) -> None:
+        """The closest segments by growing boxes of grid cells around each point."""
+        grid = self.grid
+        # The first box reaches `_reach` beyond the query's cell (every segment through it)
+        # and the nearest row of samples (a point off the surface finds some at once).
+        ring = grid.first_ring(points) + int(np.ceil(self._reach / grid.cell)) + 1
+        todo = np.arange(len(points))
+        while todo.size:
+            unsettled, dmins = [], []
+            # Chunks bound the (points x box rows) and (points x candidates) work arrays.
+            rows = np.minimum(2 * ring[todo] + 1, grid.nrow)
+            for idx in _chunks(todo, rows):
+                start, count, owner, bound = grid.box(points[idx], ring[idx])
+                # Segments outside the box are at least its bound less `_reach` away.
+                whole = np.isinf(bound)
+                bound -= self._reach
+                per_point = np.bincount(owner, weights=count, minlength=len(idx))
+                for sub in _chunks(np.arange(len(idx)), per_point):
+                    lo, hi = np.searchsorted(owner, [sub[0], sub[-1] + 1])
+                    ids = grid.expand(start[lo:hi], count[lo:hi])
+                    at = np.repeat(owner[lo:hi] - sub[0], count[lo:hi])
+                    p, b = points[idx[sub]], bound[sub]
+                    at, ids, b = self._nearby_samples(p, at, ids, b, whole[sub])
+                    left, dmin = self._settle_flat(p, at, self._owner[ids], b, idx[sub], seg, t)
+                    unsettled.append(left)
+                    dmins.append(dmin)
+            left, dmin = np.concatenate(unsettled), np.concatenate(dmins)
+            # A box of ring r reaches r cells from its point: enough rings to cover the best
+            # distance found and the reach, at least one more (twice as many if none found).
+            need = np.ceil((dmin + self._reach + 2.0 * self._eps) / grid.cell * (1 + 1e-9) + 1.0)
+            old = ring[left]
+            grown = np.where(np.isfinite(need), np.maximum(need, old + 1), 2 * old)
+            ring[left] = np.minimum(grown, 2.0**60).astype(np.int64)
+            todo = left
+
+    def _nearby_samples(
+        self, p: np.ndarray, at: np.ndarray, ids: np.ndarray, bound: np.ndarray, whole: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Drop the box's samples too far to matter; the bound drops accordingly.
+
+        The nearest sample (on a segment) is at ds; a segment none of whose samples is within
+        ds + 2 reach (+ slack) is farther than ds + reach, so it can neither win nor tie.
+        Sample distances cost a fraction of the segment distances on the rest. Points whose
+        box is the `whole` grid keep every sample (and an infinite bound): they settle.
+        """
+        dx = p[at, 0] - self._samples[ids, 0]
+        dy = p[at, 1] - self._samples[ids, 1]
+        dx *= dx
+        dy *= dy
+        dx += dy  # squared distances
+        dsmin = np.sqrt(_group_min(dx, at, len(p)))
+        slack = 4.0 * self._eps + 1e-9 * dsmin
+        keep = (dx <= ((dsmin + 2.0 * self._reach + slack) ** 2)[at]) | whole[at]
+        near = np.where(whole, bound, np.minimum(bound, dsmin + self._reach + slack))
+        return at[keep], ids[keep], near
+
+    def _settle_flat(
+        self,
+        p: np.ndarray,
+        at: np.ndarray,
+        cand: np.ndarray,
+        bound: np.ndarray,
+        idx: np.ndarray,
+        seg: np.ndarray,
+        t_out: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """`_settle` on ragged candidates: point at[j] has candidate segment cand[j].
+
+        The entries of a point are contiguous. The same arithmetic as `_settle`, so the same
+        distances, picks and t to the bit; returns the unsettled ids and their best distance
+        (inf where a point had no candidate).
+        """
+        n = len(p)
+        ax, ay, abx, aby, inv_len2 = (a[cand] for a in self._segdata)
+        dx = p[at, 0] - ax
+        dy = p[at, 1] - ay
+        t = dx * abx
+        t += dy * aby
+        t *= inv_len2
+        tc = np.clip(t, 0.0, 1.0)
+        dx -= tc * abx
+        dy -= tc * aby
+        dx *= dx
+        dy *= dy
+        d2 = dx + dy
+        dmin = np.sqrt(_group_min(d2, at, n))
+        # Among the near-ties (all one segment unless on a shared vertex or the like), the
+        # least geometric rank: `_settle`'s pick whether or not the tie has distinct segments.
+        tie = d2 <= ((dmin + self._eps) ** 2)[at]
+        big = np.iinfo(np.int64).max
+        rank = np.where(tie, self._rank[cand], big)
+        best = np.full(n, big)
+        np.minimum.at(best, at, rank)
+        win = np.flatnonzero(tie & (rank == best[at]))
+        first = np.full(n, len(cand))
+        np.minimum.at(first, at[win], win)  # the first entry of each point's winner
+        settled = (bound * (1.0 - 1e-12) > dmin + 2.0 * self._eps) & (first < len(cand))
+        seg[idx[settled]] = cand[first[settled]]
+        t_out[idx[settled]] = t[first[settled]]
+        return idx[~settled], dmin[~settled]
 
     def _settle(
         self,
@@ -238,6 +310,24 @@ class SegmentSearch:
         seg[idx[settled]] = cand[crow, pick][settled]
         t_out[idx[settled]] = t[rows, pick][settled]
         return idx[~settled]
+
+
+def _group_min(values: np.ndarray, at: np.ndarray, n: int) -> np.ndarray:
+    """Minimum of `values` per group (at sorted, groups 0..n-1); inf for empty groups."""
+    out = np.full(n, np.inf)
+    if len(at):
+        starts = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
+        out[at[starts]] = np.minimum.reduceat(values, starts)
+    return out
+
+
+def _chunks(ids: np.ndarray, weight: np.ndarray) -> list[np.ndarray]:
+    """`ids` cut into runs of about `_CHUNK_ENTRIES` total weight (one id may exceed it)."""
+    if ids.size == 0:
+        return []
+    cum = np.cumsum(weight)
+    cuts = np.searchsorted(cum, np.arange(1, int(cum[-1] // _CHUNK_ENTRIES) + 1) * _CHUNK_ENTRIES)
+    return [c for c in np.split(ids, np.unique(np.minimum(cuts + 1, ids.size))) if c.size]
 
 
 def project(
