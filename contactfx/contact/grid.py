@@ -133,13 +133,14 @@ class PointGrid:
         A lower bound on the ring a box needs to reach any point: a first ring for far queries.
         """
         q = np.asarray(queries, dtype=np.float64).reshape(-1, 2)
-        cv = np.clip(np.floor(self._cell_coords(q)[1]), -1, self.nrow).astype(np.int64)
+        cv = np.floor(self._cell_coords(q)[1])  # not clipped: a query far off the grid too
         if len(self._rows) == 0:
             return np.zeros(len(q), dtype=np.int64)
         k = np.searchsorted(self._rows, cv)
         above = self._rows[np.minimum(k, len(self._rows) - 1)] - cv
         below = cv - self._rows[np.maximum(k - 1, 0)]
         gap = np.minimum(np.where(above >= 0, above, np.inf), np.where(below >= 0, below, np.inf))
+        gap = np.minimum(gap, _MAX_RING)
         return gap.astype(np.int64)
 
     def expand(self, start: np.ndarray, count: np.ndarray) -> np.ndarray:
@@ -183,7 +184,7 @@ class PointGrid:
         if len(self.points) == 0 or len(q) == 0:
             return np.zeros(len(q), dtype=bool)
         ring = min(int(np.ceil(d / self.cell * (1 + 1e-9))) + 1, _MAX_RING)
-        start, count, owner, _ = self.box(q, np.int64(ring))
+        start, count, owner, _ = self.box(q, np.full(len(q), ring, dtype=np.int64))
         ids = self.expand(start, count)
         at = np.repeat(owner, count)
         hit = np.zeros(len(q), dtype=bool)

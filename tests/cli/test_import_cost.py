@@ -64,7 +64,7 @@ print(json.dumps(sorted(m for m in {DEFERRED!r} if m in sys.modules)))
 # passive surface) runs the grid search, and still loads no scipy.spatial (nor scipy).
 GRID_SOLVE = f"""
 import json, sys
-from contactfx.contact.geometry import SegmentSearch
+from contactfx.contact.search import SegmentSearch
 calls = []
 search = SegmentSearch._grid_search
 def spy(self, *args):

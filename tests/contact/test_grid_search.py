@@ -17,9 +17,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
-from contactfx.contact import geometry
-from contactfx.contact.geometry import SegmentSearch, Surface
+from contactfx.contact import search as search_module
+from contactfx.contact.geometry import Surface
 from contactfx.contact.grid import PointGrid
+from contactfx.contact.search import SegmentSearch
 from contactfx.methods.predictor import coarse_initial_set
 
 FAST = settings(max_examples=40, deadline=None)
@@ -113,7 +114,7 @@ def brute_force(surface: Surface, pts: np.ndarray) -> tuple[np.ndarray, np.ndarr
 def test_grid_search_is_brute_force(surface, seed):
     pts = query_points(surface, np.random.default_rng(seed))
     with pytest.MonkeyPatch.context() as m:
-        m.setattr(geometry, "_ALL_PAIRS", 0)  # every search through the grid
+        m.setattr(search_module, "_ALL_PAIRS", 0)  # every search through the grid
         search = SegmentSearch(surface)
         seg, t, found = search.closest(pts, 1e-8)
         assert search._grid is not None
@@ -122,7 +123,7 @@ def test_grid_search_is_brute_force(surface, seed):
     assert np.array_equal(t, np.clip(ref_t, 0.0, 1.0))
     small = SegmentSearch(surface).closest(pts, 1e-8)  # every pair (below _ALL_PAIRS or not)
     with pytest.MonkeyPatch.context() as m:
-        m.setattr(geometry, "_ALL_PAIRS", 1 << 62)
+        m.setattr(search_module, "_ALL_PAIRS", 1 << 62)
         small = SegmentSearch(surface).closest(pts, 1e-8)
     for a, b in zip(small, (seg, t, found), strict=True):
         assert a.dtype == b.dtype and np.array_equal(a, b)
@@ -137,7 +138,7 @@ def test_grid_search_chunks_give_the_same_answer():
     pts = np.vstack([x + rng.normal(0, 1e-4, x.shape), rng.uniform(-2, 2, (50, 2))])
     one = SegmentSearch(surface).closest(pts)
     with pytest.MonkeyPatch.context() as m:
-        m.setattr(geometry, "_CHUNK_ENTRIES", 500)
+        m.setattr(search_module, "_CHUNK_ENTRIES", 500)
         many = SegmentSearch(surface).closest(pts)
     for a, b in zip(one, many, strict=True):
         assert np.array_equal(a, b)

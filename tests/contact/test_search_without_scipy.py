@@ -17,7 +17,9 @@ from hypothesis import strategies as st
 from scipy.sparse.csgraph import connected_components, depth_first_order
 
 from contactfx.contact import geometry
-from contactfx.contact.geometry import SegmentSearch, Surface, chains
+from contactfx.contact import search as search_module
+from contactfx.contact.geometry import Surface, chains
+from contactfx.contact.search import SegmentSearch
 
 FAST = settings(max_examples=60, deadline=None)
 
@@ -120,7 +122,7 @@ def test_all_pairs_search_is_the_grid_search(surface, seed, group):
     small = search.closest(pts, 1e-8, group)  # npts * m below _ALL_PAIRS: every pair
     assert search._grid is None
     with pytest.MonkeyPatch.context() as m:
-        m.setattr(geometry, "_ALL_PAIRS", 0)
+        m.setattr(search_module, "_ALL_PAIRS", 0)
         grid = search.closest(pts, 1e-8, group)
     assert search._grid is not None
     for a, b in zip(small, grid, strict=True):
