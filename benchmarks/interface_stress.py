@@ -27,7 +27,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from contactfx import run_case
-from contactfx.contact.geometry import project
+from contactfx.contact.search import project
 from contactfx.discretize.elasticity import sigma
 from contactfx.methods.solution import Solution
 from contactfx.results.interface import resolve

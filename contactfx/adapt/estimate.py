@@ -31,7 +31,8 @@ import ufl
 from dolfinx import fem, la, mesh
 from mpi4py import MPI
 
-from ..contact.geometry import nodal_normals, project
+from ..contact.geometry import nodal_normals
+from ..contact.search import project
 from ..discretize.elasticity import energy_form, measure, radius, sigma_zz
 from ..discretize.mesh_utils import vertex_to_block
 from ..discretize.thermal import thermal_zz

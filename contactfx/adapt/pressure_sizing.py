@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..contact.geometry import project, segment_lengths
+from ..contact.geometry import segment_lengths
+from ..contact.search import project
 from .pressure_estimate import PairPressure, PressureEstimate
 
 EDGE_RATE = 1.0

@@ -1,22 +1,10 @@
-"""Contact surfaces: segment geometry, chain topology, spatial search, closest-point projection."""
+"""Contact surfaces: segment geometry and chain topology (the closest-point search: search.py)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
-
-# Samples fetched per point in the first KD-tree round (twice that per run of grouped points);
-# multiplied by 4 for the points not settled yet.
-_FIRST_K = 12
-# Bound on the (points x candidates) work arrays, to keep memory flat for far-away points.
-_CHUNK_ENTRIES = 4_000_000
-# Up to this many (points x segments) pairs a search compares every point with every
-# segment (same segments and coordinates as the tree's): below it a few such searches cost
-# less than the scipy.spatial import the KD-tree needs (docs/scale.md, "Time to the first
-# answer").
-_ALL_PAIRS = 1 << 17
 
 
 @dataclass(frozen=True)
@@ -99,153 +87,6 @@ def nodal_normals(surface: Surface) -> np.ndarray:
     out = np.zeros_like(acc)
     np.divide(acc, norm[:, None], out=out, where=norm[:, None] > 0)
     return out
-
-
-class SegmentSearch:
-    """Exact closest-segment queries on one surface (KD-tree on sample points of the segments)."""
-
-    def __init__(self, surface: Surface) -> None:
-        self.surface = surface
-        m = surface.n_segments
-        a = surface.x[surface.segments[:, 0]]
-        ab = surface.x[surface.segments[:, 1]] - a
-        length = np.hypot(ab[:, 0], ab[:, 1])
-        inv_len2 = 1.0 / np.maximum(length * length, np.finfo(float).tiny)
-        self._segdata = (a[:, 0].copy(), a[:, 1].copy(), ab[:, 0].copy(), ab[:, 1].copy(), inv_len2)
-        # Long segments are sampled at several points so that every point of every segment is
-        # within `_reach` of one of its samples; this keeps the termination test below local
-        # on graded meshes. The spacing is capped so there are at most 4 m samples in all.
-        spacing = max(np.median(length), length.sum() / (3 * m)) if m else 1.0
-        pieces = np.maximum(np.ceil(length / spacing), 1).astype(np.int64)
-        self._owner = np.repeat(np.arange(m), pieces)
-        frac = np.arange(len(self._owner)) - np.repeat(np.cumsum(pieces) - pieces, pieces) + 0.5
-        frac /= np.repeat(pieces, pieces)
-        samples = a[self._owner] + frac[:, None] * ab[self._owner]
-        self._reach = float((0.5 * length / pieces).max()) if m else 0.0
-        self._samples = samples
-        self._kdtree: Any = None
-        # Distances within this of the minimum count as ties (e.g. a point on a shared vertex).
-        self._eps = 1e-12 * max(float(length.max()) if m else 0.0, np.finfo(float).tiny)
-        # Ties are broken by a rank that depends on geometry only, so that reordering or
-        # reversing segments cannot change which segment wins.
-        mid = segment_midpoints(surface)
-        self._rank = np.empty(m, dtype=np.int64)
-        self._rank[np.lexsort((mid[:, 1], mid[:, 0]))] = np.arange(m)
-        self._is_end = node_degrees(surface) == 1
-
-    @property
-    def _tree(self) -> Any:
-        """The KD-tree of the samples, built at the first search that needs one."""
-        if self._kdtree is None:
-            from scipy.spatial import cKDTree  # only for larger searches (docs/scale.md)
-
-            self._kdtree = cKDTree(self._samples)
-        return self._kdtree
-
-    def closest(
-        self, points: np.ndarray, tol: float = 1e-8, group: int = 1
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Closest segment, clamped local coordinate in [0, 1] and found flag for each point."""
-        points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-        npts, m = len(points), self.surface.n_segments
-        seg = np.zeros(npts, dtype=np.int64)
-        t = np.zeros(npts)
-        if m == 0 or npts == 0:
-            return seg, t, np.zeros(npts, dtype=bool)
-        nsamples = len(self._owner)
-        # A small search takes every segment as a candidate of every point (k = nsamples):
-        # the exact closest segment, ties broken by the same rank, as with the tree.
-        all_pairs = npts * m <= _ALL_PAIRS
-        todo = np.arange(npts)
-        if group > 1 and npts % group == 0 and 2 * _FIRST_K < nsamples and not all_pairs:
-            # Runs of nearby points (the Gauss points of one segment) share one tree query
-            # about their centre; the spread of the run widens the settling bound.
-            todo = self._grouped_round(points, group, seg, t)
-        k = nsamples if all_pairs else min(_FIRST_K, nsamples)
-        while todo.size:
-            chunk = max(1, _CHUNK_ENTRIES // k)
-            unsettled = []
-            for lo in range(0, todo.size, chunk):
-                idx = todo[lo : lo + chunk]
-                p = points[idx]
-                if k >= nsamples:
-                    cand = np.broadcast_to(np.arange(m), (len(idx), m))
-                    bound = np.full(len(idx), np.inf)
-                else:
-                    rk, near = self._tree.query(p, k=k, workers=-1)
-                    cand, bound = self._owner[near], rk[:, -1] - self._reach
-                unsettled.append(self._settle(p[:, None], cand, bound, idx, seg, t))
-            todo = np.concatenate(unsettled)
-            k = min(4 * k, nsamples)
-        n0, n1 = self.surface.segments[seg, 0], self.surface.segments[seg, 1]
-        beyond = ((t < -tol) & self._is_end[n0]) | ((t > 1.0 + tol) & self._is_end[n1])
-        return seg, np.clip(t, 0.0, 1.0), ~beyond
-
-    def _grouped_round(
-        self, points: np.ndarray, group: int, seg: np.ndarray, t: np.ndarray
-    ) -> np.ndarray:
-        """First round shared by runs of `group` points; returns the unsettled point ids."""
-        k = 2 * _FIRST_K
-        centre = points.reshape(-1, group, 2).mean(axis=1)
-        spread = np.linalg.norm(points - np.repeat(centre, group, axis=0), axis=1)
-        unsettled = []
-        chunk = max(1, _CHUNK_ENTRIES // (k * group))
-        for lo in range(0, len(centre), chunk):
-            rk, near = self._tree.query(centre[lo : lo + chunk], k=k, workers=-1)
-            idx = np.arange(lo * group, min(lo + chunk, len(centre)) * group)
-            bound = np.repeat(rk[:, -1], group) - spread[idx] - self._reach
-            p = points[idx].reshape(-1, group, 2)
-            unsettled.append(self._settle(p, self._owner[near], bound, idx, seg, t))
-        return np.concatenate(unsettled)
-
-    def _settle(
-        self,
-        p: np.ndarray,
-        cand: np.ndarray,
-        bound: np.ndarray,
-        idx: np.ndarray,
-        seg: np.ndarray,
-        t_out: np.ndarray,
-    ) -> np.ndarray:
-        """Closest of the candidate segments; store it where settled, return unsettled ids."""
-        # p: (n, g, 2), runs of g points sharing the candidates cand (n, k); bound (n * g,):
-        # every segment outside `cand` is farther than this from the point.
-        n, g, k = p.shape[0], p.shape[1], cand.shape[1]
-        ax, ay, abx, aby, inv_len2 = (a[cand][:, None, :] for a in self._segdata)
-        dx = p[:, :, :1] - ax
-        dy = p[:, :, 1:] - ay
-        t = dx * abx
-        t += dy * aby
-        t *= inv_len2
-        tc = np.clip(t, 0.0, 1.0)
-        dx -= tc * abx
-        dy -= tc * aby
-        dx *= dx
-        dy *= dy
-        d2 = (dx + dy).reshape(n * g, k)
-        t = t.reshape(n * g, k)
-        rows = np.arange(n * g)
-        crow = rows // g  # the candidate row of each point
-        pick = np.argmin(d2, axis=1)
-        dmin = np.sqrt(d2[rows, pick])
-        # Resolve near-ties between distinct segments by the geometric rank.
-        tie = d2 <= ((dmin + self._eps) ** 2)[:, None]
-        multi = np.flatnonzero((tie & (cand[crow] != cand[crow, pick][:, None])).any(axis=1))
-        if multi.size:
-            rank = np.where(tie[multi], self._rank[cand[crow[multi]]], np.iinfo(np.int64).max)
-            pick[multi] = np.argmin(rank, axis=1)
-        settled = bound * (1.0 - 1e-12) > dmin + 2.0 * self._eps
-        seg[idx[settled]] = cand[crow, pick][settled]
-        t_out[idx[settled]] = t[rows, pick][settled]
-        return idx[~settled]
-
-
-def project(
-    points: np.ndarray, passive: Surface, tol: float = 1e-8, group: int = 1
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Closest-point projection onto the passive polyline: (segment, xi in [0, 1], found)."""
-    # group > 1 only speeds up the search when points come in runs of `group` close together.
-    return SegmentSearch(passive).closest(points, tol, group)
 
 
 @dataclass(frozen=True)

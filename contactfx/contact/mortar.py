@@ -42,8 +42,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .geometry import Surface, chains, nodal_normals, project, radial_weight, segment_lengths
+from .geometry import Surface, chains, nodal_normals, radial_weight, segment_lengths
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
+from .search import project
 
 if TYPE_CHECKING:
     import scipy.sparse as sp

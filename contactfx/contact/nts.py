@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import Surface, project
+from .geometry import Surface
 from .mortar import overlap_weights
 from .operator import ContactOperator, assemble, linear_shape
+from .search import project
 
 # Active nodes beyond the passive surface's end by more than this (in passive segment lengths)
 # get no constraint.

@@ -25,7 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import SegmentSearch, Surface, nodal_normals
+from .geometry import Surface, nodal_normals
+from .search import SegmentSearch
 
 # Points within this of an open polyline's end (in lengths of the end segment) still count as
 # facing it (the tolerance of the body pairs' projection).

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import Surface, project, radial_weight, segment_lengths
+from .geometry import Surface, radial_weight, segment_lengths
 from .operator import ContactOperator, assemble, gauss_unit, linear_shape
+from .search import project
 
 GAUSS_POINTS = 4
 # Gauss points beyond the passive surface's end by more than this (in passive segment lengths)

@@ -8,7 +8,8 @@ import numpy as np
 from dolfinx import fem
 
 from ..contact import ContactOperator, Surface
-from ..contact.geometry import nodal_normals, project, segment_lengths
+from ..contact.geometry import nodal_normals, segment_lengths
+from ..contact.search import project
 from ..errors import GeometryError, MeshError
 from ..scenes import Model, Scene
 from .mesh_utils import owned_facets, vertex_coordinates, vertex_to_block

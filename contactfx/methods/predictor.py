@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..contact.grid import PointGrid
 from ..discretize.mesh_utils import owned_facets, scene_dofs
 from ..errors import InputError
 from ..logs import stage
@@ -117,23 +118,26 @@ def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0)
     inwards: a coarse node-to-segment zone overshoots the fine one by up to two elements).
     The coarse element size is the largest node spacing in the coarse contact zone.
     """
-    from scipy.spatial import cKDTree  # scipy.spatial only when the coarse predictor runs
-
     x = np.asarray(coarse.layout.x)[:, :2]
     act = np.asarray(coarse.active, dtype=bool)
     if not act.any():
         return InitialSet(lambda p: np.zeros(len(p), dtype=bool))
-    spacing = cKDTree(x).query(x[act], k=2)[0][:, 1] if len(x) > 1 else np.zeros(1)
+    # Bucket grids instead of scipy.spatial's KD-trees: its import costs more than this whole
+    # predictor on a 45k-DOF solve (docs/scale.md, "Time to the first answer").
+    extent = float(np.ptp(x, axis=0).max()) if len(x) > 1 else 0.0
+    grid = PointGrid(x, extent / max(len(x), 1))  # about the spacing of points on a curve
+    spacing = grid.nearest(x[act], np.flatnonzero(act)) if len(x) > 1 else np.zeros(1)
     r = margin * float(spacing.max())
-    tree_a = cKDTree(x[act])
-    tree_i = cKDTree(x[~act]) if (~act).any() else None
+    r_band = r * band / margin
+    grid_a = PointGrid(x[act], r)
+    grid_i = PointGrid(x[~act], r_band) if (~act).any() else None
 
-    def near(tree: cKDTree | None, p: np.ndarray, d: float) -> np.ndarray:
-        if tree is None or len(p) == 0:
+    def near(grid: PointGrid | None, p: np.ndarray, d: float) -> np.ndarray:
+        if grid is None or len(p) == 0:
             return np.zeros(len(p), dtype=bool)
-        return tree.query(np.asarray(p)[:, :2], distance_upper_bound=d * (1 + 1e-9))[0] <= d
+        return grid.any_within(np.asarray(p)[:, :2], d)
 
-    return InitialSet(lambda p: near(tree_a, p, r), lambda p: near(tree_i, p, r * band / margin))
+    return InitialSet(lambda p: near(grid_a, p, r), lambda p: near(grid_i, p, r_band))
 
 
 def predict(

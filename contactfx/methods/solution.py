@@ -10,7 +10,8 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from ..contact.geometry import arc_length, nodal_normals, project
+from ..contact.geometry import arc_length, nodal_normals
+from ..contact.search import project
 from ..contact.sparse import CSR
 from ..discretize.coupling import Multipliers
 from ..discretize.pairs import PairData

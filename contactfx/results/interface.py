@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..contact.geometry import project
+from ..contact.search import project
 from ..methods.solution import Solution
 from .records import ContactSummary
 from .stress import nodal_stress, surface_stress

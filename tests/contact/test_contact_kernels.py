@@ -219,7 +219,7 @@ def test_overhang(method):
 
 
 def test_project_ends_and_tolerance():
-    from contactfx.contact.geometry import project
+    from contactfx.contact.search import project
 
     _active, passive, _ = pair([0.0, 0.5, 1.0], [0, 0, 0], [0.0, 1.0], [0.0, 0.0])
     pts = np.array([[-1e-10, 0.3], [-1e-3, 0.3], [0.25, -0.2], [1.0 + 1e-3, 0.0], [0.5, 0.1]])

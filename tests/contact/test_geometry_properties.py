@@ -6,8 +6,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from contactfx.contact import OPERATORS, Surface
-from contactfx.contact.geometry import nodal_normals, project
+from contactfx.contact.geometry import nodal_normals
 from contactfx.contact.mortar import mortar_matrices, overlap_weights, subsegments
+from contactfx.contact.search import project
 
 FAST = settings(max_examples=40, deadline=None)
 

@@ -1,9 +1,10 @@
 """The search and chain code without scipy.spatial / csgraph gives scipy's answers exactly.
 
-A small search compares every point with every segment instead of querying the KD-tree, and
+A small search compares every point with every segment instead of querying the grid, and
 the chains are walked without scipy.sparse.csgraph (docs/scale.md, "Time to the first
 answer"). References: scipy's connected_components and depth_first_order (the previous
-implementation, kept here), and the KD-tree path of the same search.
+implementation, kept here), and the grid path of the same search (test_grid_search.py: both
+against brute force).
 """
 
 from __future__ import annotations
@@ -16,7 +17,9 @@ from hypothesis import strategies as st
 from scipy.sparse.csgraph import connected_components, depth_first_order
 
 from contactfx.contact import geometry
-from contactfx.contact.geometry import SegmentSearch, Surface, chains
+from contactfx.contact import search as search_module
+from contactfx.contact.geometry import Surface, chains
+from contactfx.contact.search import SegmentSearch
 
 FAST = settings(max_examples=60, deadline=None)
 
@@ -109,7 +112,7 @@ def test_component_labels_are_scipys(surface):
 
 @FAST
 @given(polylines(), st.integers(0, 2**32 - 1), st.sampled_from([1, 4]))
-def test_all_pairs_search_is_the_tree_search(surface, seed, group):
+def test_all_pairs_search_is_the_grid_search(surface, seed, group):
     rng = np.random.default_rng(seed)
     lo, hi = surface.x.min(axis=0) - 1.0, surface.x.max(axis=0) + 1.0
     # Random points, the nodes themselves (ties between two segments) and runs of 4.
@@ -117,12 +120,12 @@ def test_all_pairs_search_is_the_tree_search(surface, seed, group):
     pts = pts[: len(pts) // 4 * 4]
     search = SegmentSearch(surface)
     small = search.closest(pts, 1e-8, group)  # npts * m below _ALL_PAIRS: every pair
-    assert search._kdtree is None
+    assert search._grid is None
     with pytest.MonkeyPatch.context() as m:
-        m.setattr(geometry, "_ALL_PAIRS", 0)
-        tree = search.closest(pts, 1e-8, group)
-    assert search._kdtree is not None or len(search._owner) <= geometry._FIRST_K
-    for a, b in zip(small, tree, strict=True):
+        m.setattr(search_module, "_ALL_PAIRS", 0)
+        grid = search.closest(pts, 1e-8, group)
+    assert search._grid is not None
+    for a, b in zip(small, grid, strict=True):
         assert a.dtype == b.dtype and np.array_equal(a, b)
 
 
