@@ -23,6 +23,25 @@ _CHUNK_ENTRIES = 4_000_000
 _ALL_PAIRS = 1 << 17
 
 
+def _distance2(
+    dx: np.ndarray, dy: np.ndarray, abx: np.ndarray, aby: np.ndarray, inv_len2: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(squared distance, unclamped t) of points at offsets (dx, dy) from segments' starts.
+
+    Works in place on dx and dy; one arithmetic for every search, so that all give the same
+    distances and t to the bit.
+    """
+    t = dx * abx
+    t += dy * aby
+    t *= inv_len2
+    tc = np.clip(t, 0.0, 1.0)
+    dx -= tc * abx
+    dy -= tc * aby
+    dx *= dx
+    dy *= dy
+    return dx + dy, t
+
+
 class SegmentSearch:
     """Exact closest-segment queries on one surface (a bucket grid of sample points)."""
 
@@ -165,17 +184,7 @@ class SegmentSearch:
         """
         n = len(p)
         ax, ay, abx, aby, inv_len2 = (a[cand] for a in self._segdata)
-        dx = p[at, 0] - ax
-        dy = p[at, 1] - ay
-        t = dx * abx
-        t += dy * aby
-        t *= inv_len2
-        tc = np.clip(t, 0.0, 1.0)
-        dx -= tc * abx
-        dy -= tc * aby
-        dx *= dx
-        dy *= dy
-        d2 = dx + dy
+        d2, t = _distance2(p[at, 0] - ax, p[at, 1] - ay, abx, aby, inv_len2)
         dmin = np.sqrt(_group_min(d2, at, n))
         # Among the near-ties (all one segment unless on a shared vertex or the like), the
         # least geometric rank: `_settle`'s pick whether or not the tie has distinct segments.
@@ -206,18 +215,8 @@ class SegmentSearch:
         # every segment outside `cand` is farther than this from the point.
         n, g, k = p.shape[0], p.shape[1], cand.shape[1]
         ax, ay, abx, aby, inv_len2 = (a[cand][:, None, :] for a in self._segdata)
-        dx = p[:, :, :1] - ax
-        dy = p[:, :, 1:] - ay
-        t = dx * abx
-        t += dy * aby
-        t *= inv_len2
-        tc = np.clip(t, 0.0, 1.0)
-        dx -= tc * abx
-        dy -= tc * aby
-        dx *= dx
-        dy *= dy
-        d2 = (dx + dy).reshape(n * g, k)
-        t = t.reshape(n * g, k)
+        d2, t = _distance2(p[:, :, :1] - ax, p[:, :, 1:] - ay, abx, aby, inv_len2)
+        d2, t = d2.reshape(n * g, k), t.reshape(n * g, k)
         rows = np.arange(n * g)
         crow = rows // g  # the candidate row of each point
         pick = np.argmin(d2, axis=1)
