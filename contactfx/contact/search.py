@@ -86,13 +86,9 @@ class SegmentSearch:
         return self._grid
 
     def closest(
-        self, points: np.ndarray, tol: float = 1e-8, group: int = 1
+        self, points: np.ndarray, tol: float = 1e-8
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Closest segment, clamped local coordinate in [0, 1] and found flag for each point.
-
-        `group` is accepted for the callers whose points come in runs (Gauss points); each
-        point is searched on its own, which costs about as much.
-        """
+        """Closest segment, clamped local coordinate in [0, 1] and found flag for each point."""
         points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
         npts, m = len(points), self.surface.n_segments
         seg = np.zeros(npts, dtype=np.int64)
@@ -102,8 +98,8 @@ class SegmentSearch:
         if npts * m <= _ALL_PAIRS:
             # A small search takes every segment as a candidate of every point: the exact
             # closest segment, ties broken by the same rank, as with the grid.
-            cand = np.broadcast_to(np.arange(m), (npts, m))
-            self._settle(points[:, None], cand, np.full(npts, np.inf), np.arange(npts), seg, t)
+            at, cand = np.repeat(np.arange(npts), m), np.tile(np.arange(m), npts)
+            self._settle(points, at, cand, np.full(npts, np.inf), np.arange(npts), seg, t)
         else:
             self._grid_search(points, seg, t)
         n0, n1 = self.surface.segments[seg, 0], self.surface.segments[seg, 1]
@@ -133,7 +129,7 @@ class SegmentSearch:
                     at = np.repeat(owner[lo:hi] - sub[0], count[lo:hi])
                     p, b = points[idx[sub]], bound[sub]
                     at, ids, b = self._nearby_samples(p, at, ids, b, whole[sub])
-                    left, dmin = self._settle_flat(p, at, self._owner[ids], b, idx[sub], seg, t)
+                    left, dmin = self._settle(p, at, self._owner[ids], b, idx[sub], seg, t)
                     unsettled.append(left)
                     dmins.append(dmin)
             left, dmin = np.concatenate(unsettled), np.concatenate(dmins)
@@ -166,7 +162,7 @@ class SegmentSearch:
         near = np.where(whole, bound, np.minimum(bound, dsmin + self._reach + slack))
         return at[keep], ids[keep], near
 
-    def _settle_flat(
+    def _settle(
         self,
         p: np.ndarray,
         at: np.ndarray,
@@ -176,18 +172,18 @@ class SegmentSearch:
         seg: np.ndarray,
         t_out: np.ndarray,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """`_settle` on ragged candidates: point at[j] has candidate segment cand[j].
+        """Closest of the candidate segments; store it where settled.
 
-        The entries of a point are contiguous. The same arithmetic as `_settle`, so the same
-        distances, picks and t to the bit; returns the unsettled ids and their best distance
-        (inf where a point had no candidate).
+        Point at[j] has candidate segment cand[j] (a point's entries contiguous); `bound`:
+        every segment outside a point's candidates is farther than this. Returns the
+        unsettled ids and their best distance (inf where a point had no candidate).
         """
         n = len(p)
         ax, ay, abx, aby, inv_len2 = (a[cand] for a in self._segdata)
         d2, t = _distance2(p[at, 0] - ax, p[at, 1] - ay, abx, aby, inv_len2)
         dmin = np.sqrt(_group_min(d2, at, n))
         # Among the near-ties (all one segment unless on a shared vertex or the like), the
-        # least geometric rank: `_settle`'s pick whether or not the tie has distinct segments.
+        # least geometric rank, so that reordering segments cannot change the pick.
         tie = d2 <= ((dmin + self._eps) ** 2)[at]
         big = np.iinfo(np.int64).max
         rank = np.where(tie, self._rank[cand], big)
@@ -200,37 +196,6 @@ class SegmentSearch:
         seg[idx[settled]] = cand[first[settled]]
         t_out[idx[settled]] = t[first[settled]]
         return idx[~settled], dmin[~settled]
-
-    def _settle(
-        self,
-        p: np.ndarray,
-        cand: np.ndarray,
-        bound: np.ndarray,
-        idx: np.ndarray,
-        seg: np.ndarray,
-        t_out: np.ndarray,
-    ) -> np.ndarray:
-        """Closest of the candidate segments; store it where settled, return unsettled ids."""
-        # p: (n, g, 2), runs of g points sharing the candidates cand (n, k); bound (n * g,):
-        # every segment outside `cand` is farther than this from the point.
-        n, g, k = p.shape[0], p.shape[1], cand.shape[1]
-        ax, ay, abx, aby, inv_len2 = (a[cand][:, None, :] for a in self._segdata)
-        d2, t = _distance2(p[:, :, :1] - ax, p[:, :, 1:] - ay, abx, aby, inv_len2)
-        d2, t = d2.reshape(n * g, k), t.reshape(n * g, k)
-        rows = np.arange(n * g)
-        crow = rows // g  # the candidate row of each point
-        pick = np.argmin(d2, axis=1)
-        dmin = np.sqrt(d2[rows, pick])
-        # Resolve near-ties between distinct segments by the geometric rank.
-        tie = d2 <= ((dmin + self._eps) ** 2)[:, None]
-        multi = np.flatnonzero((tie & (cand[crow] != cand[crow, pick][:, None])).any(axis=1))
-        if multi.size:
-            rank = np.where(tie[multi], self._rank[cand[crow[multi]]], np.iinfo(np.int64).max)
-            pick[multi] = np.argmin(rank, axis=1)
-        settled = bound * (1.0 - 1e-12) > dmin + 2.0 * self._eps
-        seg[idx[settled]] = cand[crow, pick][settled]
-        t_out[idx[settled]] = t[rows, pick][settled]
-        return idx[~settled]
 
 
 def _group_min(values: np.ndarray, at: np.ndarray, n: int) -> np.ndarray:
@@ -252,8 +217,7 @@ def _chunks(ids: np.ndarray, weight: np.ndarray) -> list[np.ndarray]:
 
 
 def project(
-    points: np.ndarray, passive: Surface, tol: float = 1e-8, group: int = 1
+    points: np.ndarray, passive: Surface, tol: float = 1e-8
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Closest-point projection onto the passive polyline: (segment, xi in [0, 1], found)."""
-    # group > 1 only speeds up the search when points come in runs of `group` close together.
-    return SegmentSearch(passive).closest(points, tol, group)
+    return SegmentSearch(passive).closest(points, tol)

@@ -30,7 +30,7 @@ def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOp
     """STS operator: row j = sum_gp w N_j n . (e_active(gp) - sum_A N_A(xi_gp) e_A)."""
     w, na, nodes = gauss_points(active)
     points = np.einsum("pk,pkd->pd", na, active.x[nodes])
-    seg, eta, found = project(points, passive, TOL, group=GAUSS_POINTS)
+    seg, eta, found = project(points, passive, TOL)
     # No cutting at passive nodes: a segment straddling a passive node or kink is integrated
     # as if the integrand were smooth (the method's known source of oscillations).
     f = np.flatnonzero(found)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 
@@ -151,11 +151,18 @@ def hertz_grid(
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Node coordinates, quad cells and the number of block cells (which come first)."""
     ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
-    u, v, w, yc, d = ln.u, ln.v, ln.w, ln.yc, ln.d
     bx, by = np.meshgrid(ln.xs, ln.ys, indexing="ij")
     block_ids = np.arange(bx.size).reshape(bx.shape)
     block_x = np.column_stack([bx.ravel(), by.ravel()])
     block_cells = _quads(block_ids)
+    disc_x, disc_cells = _disc(ln)
+    x = np.vstack([block_x, disc_x])
+    return x, np.vstack([block_cells, disc_cells + len(block_x)]), len(block_cells)
+
+
+def _disc(ln: _Lines) -> tuple[np.ndarray, np.ndarray]:
+    """The quarter disc's node coordinates and cells, numbered from 0 (patch a, b, square)."""
+    u, v, w, yc, d = ln.u, ln.v, ln.w, ln.yc, ln.d
 
     def patch(
         curves: tuple[np.ndarray, ...],
@@ -192,9 +199,7 @@ def hertz_grid(
     disc_x[ids[0], 0] = 0.0
     disc_x[ids[:, nw], 1] = yc
     disc_x[idb[nw], 1] = yc
-    disc_cells = np.vstack([_quads(ida), _quads(idb), _quads(ids)]) + len(block_x)
-    x = np.vstack([block_x, disc_x])
-    return x, np.vstack([block_cells, disc_cells]), len(block_cells)
+    return disc_x, np.vstack([_quads(ida), _quads(idb), _quads(ids)])
 
 
 class GridPart(NamedTuple):
@@ -244,47 +249,21 @@ def hertz_grid_part(
     arrays.
     """
     ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
-    u, v, w = ln.u, ln.v, ln.w
     nx, ny = len(ln.xs) - 1, len(ln.ys) - 1
-    nu, nv, nw = len(u) - 1, len(v) - 1, len(w) - 1
     n_bx = (nx + 1) * (ny + 1)  # block nodes; the disc's follow
-    n_a = (nu + 1) * (nv + 1)  # disc nodes of patch a, then b's w >= 1, then the square's
-    n_ab = n_a + nw * (nv + 1)
-    n_nodes = n_bx + n_ab + nu * nw
-
-    # hertz_grid's node numbers of the disc's grids ida[i, j], idb[k, j] and ids[i, k].
-    Index = np.ndarray | int
-
-    def ida(i: Index, j: Index) -> np.ndarray:
-        return np.asarray(i * (nv + 1) + j)
-
-    def idb(k: np.ndarray, j: Index) -> np.ndarray:
-        return np.where(k == 0, ida(nu, j), n_a + (k - 1) * (nv + 1) + j)
-
-    def ids(i: np.ndarray, k: np.ndarray) -> np.ndarray:
-        inner = np.where(i == nu, idb(k, 0), n_ab + i * nw + k - 1)
-        return np.where(k == 0, ida(i, 0), inner)
-
-    def quads(ids2: Callable[..., np.ndarray], i: np.ndarray, j: np.ndarray) -> np.ndarray:
-        corners = [ids2(i, j), ids2(i + 1, j), ids2(i, j + 1), ids2(i + 1, j + 1)]
-        return np.column_stack(corners)
-
-    # Cells: block k = (column i, row j), column by column.
+    # Block cells k = (column i, row j), column by column: the strips by x (then y).
     i, j = np.divmod(_strip(nx * ny, part, nparts), ny)
-    block_cells = quads(lambda a, b: a * (ny + 1) + b, i, j)
+    corners = [(i + a) * (ny + 1) + j + b for b in (0, 1) for a in (0, 1)]
+    block_cells = np.column_stack(corners)
     # The disc: the partitioner's strips by cell midpoint x (then y) too. Other cuts (swept
     # around the centre: fewer cut facets at many parts) cost the ICC(0)-smoothed multigrid
     # of the condensed path iterations on 2 ranks (docs/scale.md, "Setup"); this needs the
     # disc's nodes on every part, about half the grid's coordinates.
-    i_all, j_all = np.divmod(np.arange(nu * nv), nv)
-    k_all, jb_all = np.divmod(np.arange(nw * nv), nv)
-    si, sk = np.divmod(np.arange(nu * nw), nw)
-    all_disc = np.vstack([quads(ida, i_all, j_all), quads(idb, k_all, jb_all), quads(ids, si, sk)])
-    xd = _disc_nodes(ln, 0, n_ab + nu * nw)
+    xd, all_disc = _disc(ln)
     mid = xd[all_disc].mean(axis=1)
     order = np.lexsort((mid[:, 1], mid[:, 0]))
     disc_cells = all_disc[np.sort(order[_strip(len(all_disc), part, nparts)])]
-    lo, hi = _node_block(n_nodes, part, nparts)
+    lo, hi = _node_block(n_bx + len(xd), part, nparts)
 
     def block_rows(i: np.ndarray) -> np.ndarray:
         return np.stack(np.broadcast_arrays(ln.xs[i][:, None], ln.ys[None, :]), axis=-1)
@@ -305,47 +284,3 @@ def _rows(lo: int, hi: int, width: int, fill: Callable[[np.ndarray], np.ndarray]
     r0 = lo // width
     grid = fill(np.arange(r0, (hi - 1) // width + 1)).reshape(-1, 2)
     return grid[lo - r0 * width : hi - r0 * width]
-
-
-def _disc_nodes(ln: _Lines, lo: int, hi: int) -> np.ndarray:
-    # Coordinates of the disc's nodes lo .. hi - 1 (hertz_grid's disc numbering), value for
-    # value: the same expressions on the same numbers, row by row.
-    u, v, w, yc, d = ln.u, ln.v, ln.w, ln.yc, ln.d
-    nu, nv, nw = len(u) - 1, len(v) - 1, len(w) - 1
-    n_a = (nu + 1) * (nv + 1)
-    n_ab = n_a + nw * (nv + 1)
-
-    def patch(
-        curves: tuple[np.ndarray, ...], corners: Any, s: np.ndarray, i: np.ndarray
-    ) -> np.ndarray:
-        bottom, top, left, right = curves
-        return _coons(
-            bottom[i][:, None], top[i][:, None], left[None], right[None], corners,
-            s[i][:, None, None], v[None, :, None],
-        )  # fmt: skip
-
-    def a_rows(i: np.ndarray) -> np.ndarray:
-        out = patch(ln.a_curves, ln.a_corners, u, i)
-        # Patch a's last row (u = 1) is patch b's first: hertz_grid writes b's values there.
-        out[i == nu] = patch(ln.b_curves, ln.b_corners, w, np.zeros(1, dtype=np.int64))
-        out[i == 0, :, 0] = 0.0  # exactly on x = 0
-        return out
-
-    def b_rows(k: np.ndarray) -> np.ndarray:
-        out = patch(ln.b_curves, ln.b_corners, w, k + 1)  # b's rows w >= 1
-        out[k + 1 == nw, :, 1] = yc  # exactly on y = yc
-        return out
-
-    def square_rows(i: np.ndarray) -> np.ndarray:
-        out = np.stack(np.broadcast_arrays((u * d)[i][:, None], (yc - d + w * d)[None, 1:]), -1)
-        out[i == 0, :, 0] = 0.0
-        out[:, nw - 1, 1] = yc
-        return out
-
-    return np.vstack(
-        [
-            _rows(lo, min(hi, n_a), nv + 1, a_rows),
-            _rows(max(lo, n_a) - n_a, min(hi, n_ab) - n_a, nv + 1, b_rows),
-            _rows(max(lo, n_ab) - n_ab, hi - n_ab, nw, square_rows),
-        ]
-    )

@@ -111,19 +111,18 @@ def test_component_labels_are_scipys(surface):
 
 
 @FAST
-@given(polylines(), st.integers(0, 2**32 - 1), st.sampled_from([1, 4]))
-def test_all_pairs_search_is_the_grid_search(surface, seed, group):
+@given(polylines(), st.integers(0, 2**32 - 1))
+def test_all_pairs_search_is_the_grid_search(surface, seed):
     rng = np.random.default_rng(seed)
     lo, hi = surface.x.min(axis=0) - 1.0, surface.x.max(axis=0) + 1.0
-    # Random points, the nodes themselves (ties between two segments) and runs of 4.
+    # Random points, the nodes themselves (ties between two segments) and a near-node point.
     pts = np.vstack([rng.uniform(lo, hi, (40, 2)), surface.x, surface.x[:1] + 1e-3])
-    pts = pts[: len(pts) // 4 * 4]
     search = SegmentSearch(surface)
-    small = search.closest(pts, 1e-8, group)  # npts * m below _ALL_PAIRS: every pair
+    small = search.closest(pts, 1e-8)  # npts * m below _ALL_PAIRS: every pair
     assert search._grid is None
     with pytest.MonkeyPatch.context() as m:
         m.setattr(search_module, "_ALL_PAIRS", 0)
-        grid = search.closest(pts, 1e-8, group)
+        grid = search.closest(pts, 1e-8)
     assert search._grid is not None
     for a, b in zip(small, grid, strict=True):
         assert a.dtype == b.dtype and np.array_equal(a, b)
