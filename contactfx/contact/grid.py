@@ -1,12 +1,14 @@
 """A uniform bucket grid over 2D points: box and nearest-point queries in numpy only.
 
 The closest-segment search and the coarse predictor used scipy.spatial's KD-tree, whose
-import alone costs more than a fresh factorization of a 45k-DOF Hertz mesh (docs/scale.md,
-"Time to the first answer"). Here the points are sorted by the key row * ncol + col of their
-cell; the cells of one row of a box are consecutive keys, so a box is one `np.searchsorted`
-range per row holding points, vectorized over the query points. Only the sorted keys are stored
-(O(points) whatever the cell size). Rows run across the shorter side of the bounding box, so
-a tall box costs at most that many ranges.
+import is a fixed cost of every solve that searches (measured against the solve itself:
+docs/scale.md, "Time to the first answer").
+
+Here the points are sorted by the key row * ncol + col of their cell; the cells of one row of a
+box are consecutive keys, so a box is one `np.searchsorted` range per row holding points,
+vectorized over the query points. Only the sorted keys are stored (O(points) whatever the cell
+size). Rows run across the shorter side of the bounding box, so a tall box costs at most that
+many ranges.
 
 A query returns every point of the box of cells within ring r of the query's cell and a
 lower bound on the distance to every point outside it: the exact answers follow from

@@ -2,12 +2,13 @@
 
 The contact operators, the pair views and the load-path check need a handful of operations
 (build from point contributions with duplicates summed, row selection, column slices and
-masks, products with vectors and with a narrow sparse matrix, transpose, stacking); holding
-them in numpy arrays keeps `import scipy.sparse` (most of it scipy's own import-time work)
-off a plain solve (docs/scale.md, "Time to the first answer"). `to_scipy()` hands a
-scipy matrix to the paths that really need one (sparse LU, LP). The sums run in the order
-scipy's kernels use (entries of a row in column order, rows in order), so products equal
-scipy's bit for bit; only duplicates of one entry may be summed in another order.
+masks, products with vectors and with a narrow sparse matrix, transposed products, stacking);
+holding them in numpy arrays keeps `import scipy.sparse` (most of it scipy's own import-time
+work) off a plain solve (docs/scale.md, "Time to the first answer"). `to_scipy()` gives the
+same matrix to scipy (the tests' reference). The sums run in the order scipy's kernels use
+(entries of a row in column order, rows in order), so products equal scipy's up to its
+kernels' rounding (bit for bit where they keep separate multiplies and adds); duplicates of
+one entry may be summed in another order.
 """
 
 from __future__ import annotations
@@ -90,13 +91,14 @@ class CSR:
         return int(self.indices.size)
 
     @cached_property
-    def _entry_rows(self) -> np.ndarray:
+    def entry_rows(self) -> np.ndarray:
+        """The row of each stored entry (computed once; do not modify)."""
         return np.repeat(np.arange(self.shape[0], dtype=np.int64), np.diff(self.indptr))
 
     def _select(self, keep: np.ndarray) -> CSR:
         """The matrix with the stored entries where `keep` (one bool per entry)."""
         indptr = np.zeros_like(self.indptr)
-        np.cumsum(np.bincount(self.entry_rows()[keep], minlength=self.shape[0]), out=indptr[1:])
+        np.cumsum(np.bincount(self.entry_rows[keep], minlength=self.shape[0]), out=indptr[1:])
         return CSR(indptr, self.indices[keep], self.data[keep], self.shape)
 
     def rows(self, idx: np.ndarray) -> CSR:
@@ -114,27 +116,22 @@ class CSR:
         out = self._select(keep)
         return CSR(out.indptr, out.indices - lo, out.data, (self.shape[0], hi - lo))
 
-    def entry_rows(self) -> np.ndarray:
-        """The row of each stored entry (computed once; do not modify)."""
-        return self._entry_rows
-
     def without_columns(self, drop: np.ndarray) -> CSR:
         """Entries in the columns where `drop` (bool, one per column) and exact zeros left out."""
         return self._select(~drop[self.indices] & (self.data != 0.0))
 
-    def without_zeros(self) -> CSR:
-        """The stored exact zeros left out."""
-        return self._select(self.data != 0.0)
-
-    @property
-    def T(self) -> CSR:
-        """The transpose."""
-        return CSR.from_coo(self.indices, self.entry_rows(), self.data, self.shape[::-1])
+    def transpose_matmul(self, y: np.ndarray) -> np.ndarray:
+        """A^T @ y for a dense vector (m,), each column's sum in row order (as scipy's)."""
+        y = np.asarray(y)
+        if y.shape != (self.shape[0],):
+            raise ValueError(f"transpose_matmul: shape {self.shape} against {y.shape}")
+        w = self.data * y[self.entry_rows]
+        return np.bincount(self.indices, weights=w, minlength=self.shape[1])
 
     def row_max_abs(self) -> np.ndarray:
         """max_j |A_ij| of every row (0 for an empty row)."""
         out = np.zeros(self.shape[0])
-        np.maximum.at(out, self.entry_rows(), np.abs(self.data))
+        np.maximum.at(out, self.entry_rows, np.abs(self.data))
         return out
 
     def __matmul__(self, x: np.ndarray) -> np.ndarray:
@@ -142,7 +139,7 @@ class CSR:
         x = np.asarray(x)
         if x.shape[0] != self.shape[1]:
             raise ValueError(f"matmul: shape {self.shape} against {x.shape}")
-        r = self.entry_rows()
+        r = self.entry_rows
         if x.ndim == 1:
             return np.bincount(r, weights=self.data * x[self.indices], minlength=self.shape[0])
         out = np.zeros((self.shape[0], *x.shape[1:]), dtype=np.result_type(self.data, x))
@@ -162,7 +159,7 @@ class CSR:
         out = np.zeros((self.shape[0], other.shape[1]))
         np.add.at(
             out,
-            (self.entry_rows()[left], other.indices[right]),
+            (self.entry_rows[left], other.indices[right]),
             self.data[left] * other.data[right],
         )
         return out
@@ -170,7 +167,7 @@ class CSR:
     def toarray(self) -> np.ndarray:
         """The dense (m, n) array."""
         out = np.zeros(self.shape)
-        out[self.entry_rows(), self.indices] = self.data
+        out[self.entry_rows, self.indices] = self.data
         return out
 
     def to_scipy(self) -> sp.csr_matrix:

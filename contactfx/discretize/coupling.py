@@ -50,17 +50,15 @@ def constrained_rows(op: ContactOperator, dirichlet: np.ndarray, rtol: float = 1
     saddle point singular. "Only" is up to round-off: with the dual basis a pinned node
     facing a locally matching mesh keeps free entries of 1e-17 (biorthogonality).
     """
-    cols = np.zeros(op.B.shape[1], dtype=bool)
-    cols[dirichlet[dirichlet < op.B.shape[1]]] = True
-    row = op.B.entry_rows()
-    n = op.B.shape[0]
-    size = np.abs(op.B.data)
-    whole = np.zeros(n)
-    np.maximum.at(whole, row, size)
-    free = np.zeros(n)
-    keep = ~cols[op.B.indices]
-    np.maximum.at(free, row[keep], size[keep])
-    return free > rtol * whole
+    free = op.B.without_columns(column_mask(dirichlet, op.B.shape[1])).row_max_abs()
+    return free > rtol * op.B.row_max_abs()
+
+
+def column_mask(dofs: np.ndarray, n: int) -> np.ndarray:
+    """A bool mask of n columns, True on `dofs` (those beyond n, other ranks' columns, left)."""
+    mask = np.zeros(n, dtype=bool)
+    mask[dofs[dofs < n]] = True
+    return mask
 
 
 def multiplier_layout(
@@ -98,8 +96,7 @@ def petsc_constraint(
     imap = V.dofmap.index_map
     bs = V.dofmap.index_map_bs
     n_local, n_global = imap.size_local * bs, imap.size_global * bs
-    drop = np.zeros(op.B.shape[1], dtype=bool)
-    drop[dirichlet[dirichlet < op.B.shape[1]]] = True
+    drop = column_mask(dirichlet, op.B.shape[1])
     rows = op.B.rows(order[layout.mine]).without_columns(drop)  # column indices sorted
     m = rows.shape[0]
     B = PETSc.Mat().createAIJ(

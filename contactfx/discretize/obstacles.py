@@ -15,6 +15,7 @@ from ..contact import ContactOperator, Kernel, rigid_operator
 from ..contact.rigid_kernels import facing_angle
 from ..errors import GeometryError
 from ..scenes import Body, ContactPair, Obstacle, Scene
+from .coupling import column_mask
 from .pairs import PairData
 from .surfaces import GatheredSurface, gather_surface
 
@@ -107,15 +108,14 @@ def node_free_rows(
     passive body's dofs take up the slack.
     """
     keep = np.ones(op.B.shape[0], dtype=bool)
-    fixed = np.zeros(op.B.shape[1], dtype=bool)
-    fixed[dirichlet[dirichlet < op.B.shape[1]]] = True
+    fixed = column_mask(dirichlet, op.B.shape[1])
     for p in pairs:
         if p.obstacle is None:
             continue
         rows = np.arange(p.first_row, p.first_row + p.active.surface.n_nodes)
         sub = op.B.rows(rows)
         whole = sub.row_max_abs()
-        r = sub.entry_rows()
+        r = sub.entry_rows
         own = np.zeros(len(rows))
         for c in (0, 1):
             dof = node_dofs[rows, c]

@@ -54,9 +54,11 @@ class DenseLU:
             self._lu = scipy.linalg.lu_factor(a, check_finite=False)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
-        """a^-1 b (np.linalg.LinAlgError if numpy finds `a` singular)."""
+        """a^-1 b; np.linalg.LinAlgError if `a` is singular (an exact zero pivot), as numpy's."""
         if self._lu is None:
             return np.linalg.solve(self._a, b)
+        if not np.all(np.diagonal(self._lu[0])):  # scipy only warns and returns inf / nan
+            raise np.linalg.LinAlgError("Singular matrix")
         import scipy.linalg  # imported by __init__ already: a dict look-up
 
         return scipy.linalg.lu_solve(self._lu, b)

@@ -122,8 +122,8 @@ def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0)
     act = np.asarray(coarse.active, dtype=bool)
     if not act.any():
         return InitialSet(lambda p: np.zeros(len(p), dtype=bool))
-    # Bucket grids instead of scipy.spatial's KD-trees: its import costs more than this whole
-    # predictor on a 45k-DOF solve (docs/scale.md, "Time to the first answer").
+    # Bucket grids instead of scipy.spatial's KD-trees: a plain solve then never imports
+    # scipy.spatial, whose import is a fixed cost (docs/scale.md, "Time to the first answer").
     extent = float(np.ptp(x, axis=0).max()) if len(x) > 1 else 0.0
     grid = PointGrid(x, extent / max(len(x), 1))  # about the spacing of points on a curve
     spacing = grid.nearest(x[act], np.flatnonzero(act)) if len(x) > 1 else np.zeros(1)

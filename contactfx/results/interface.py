@@ -86,10 +86,10 @@ def pair_forces(sol: Solution, k: int) -> tuple[np.ndarray, np.ndarray]:
     """Total contact force (fx, fy) on pair k's active body and on its passive body."""
     pv = sol.pairs[k]
     # B^T lambda: the multipliers' nodal forces (compression positive pushes the bodies apart).
-    nodal = pv.B.T @ sol.pressure[pv.rows]
+    nodal = pv.B.transpose_matmul(sol.pressure[pv.rows])
     fa = np.array([nodal[pv.active.surface.dofs[:, c]].sum() for c in (0, 1)])
     if pv.motion is not None:  # a rigid obstacle: its force is its columns' share
-        return fa, pv.motion.T @ sol.pressure[pv.rows]
+        return fa, pv.motion.transpose_matmul(sol.pressure[pv.rows])
     assert pv.passive is not None  # a body pair has a passive surface
     fp = np.array([nodal[pv.passive.surface.dofs[:, c]].sum() for c in (0, 1)])
     return fa, fp

@@ -71,7 +71,7 @@ def test_refined_field_refines_the_zone_edge_further() -> None:
     field = refined_field(sol, edge=0.125)
     ratio = field.sizes / plain.sizes
     assert ratio.min() == pytest.approx(0.25, rel=1e-5)  # the edge's 0.125 over the band's 0.5
-    # Where the sizes changed: around x = a (the zone's edge, Hertz a = 1.44), within
+    # Where the sizes changed: around x = a (the zone's edge, Hertz's exact a below), within
     # EDGE_CELLS of the edge segment's length (0.2 here) of its ends, and a vertex more.
     changed = field.quads[np.any(np.abs(ratio - 1.0) > 1e-9, axis=1)].reshape(-1, 2)
     assert changed.size

@@ -60,8 +60,8 @@ print(json.dumps(sorted(m for m in {DEFERRED!r} if m in sys.modules)))
 """
 
 
-# A solve whose searches are above `_ALL_PAIRS` (24k DOFs, mortar: 461 points against the
-# passive surface) runs the grid search, and still loads no scipy.spatial (nor scipy).
+# A solve whose searches are above `_ALL_PAIRS` (the spy below asserts it did search so)
+# runs the grid search, and still loads no scipy.spatial (nor scipy).
 GRID_SOLVE = f"""
 import json, sys
 from contactfx.contact.search import SegmentSearch

@@ -1,9 +1,10 @@
 """contact.sparse.CSR against scipy.sparse (the container it replaces on the solve path).
 
-Reference: scipy.sparse on the same entries. Products sum in scipy's order, so they must be
-equal bit for bit on canonical matrices; duplicates of one entry may be summed in another
+Reference: scipy.sparse on the same entries. Products sum in scipy's order: equal up to the
+rounding of one sum (bit for bit unless scipy's kernels fuse multiply-adds), checked against a
+bound of a few ulps of the sum of |terms|; duplicates of one entry may be summed in another
 order than scipy's (its per-row sort is not stable), so the values built from duplicates are
-compared to a few ulps.
+compared to a few ulps too.
 """
 
 from __future__ import annotations
@@ -55,19 +56,32 @@ def test_entries_in_input_order_without_duplicates_are_exact() -> None:
     np.testing.assert_array_equal(a.data, reference(r, c, v, (23, 41)).data)
 
 
+def assert_same_sums(got: np.ndarray, want: np.ndarray, magnitude: np.ndarray) -> None:
+    """Equal up to the rounding of either sum: a few ulps of the sum of |terms|.
+
+    Bit for bit where scipy's compiled kernels keep separate multiplies and adds; a kernel
+    built with fused multiply-adds rounds each term once less, which this bound allows.
+    """
+    assert np.all(np.abs(got - want) <= 4 * np.finfo(float).eps * magnitude)
+
+
 @pytest.mark.parametrize("seed", range(3))
-def test_products_equal_scipys_bit_for_bit(seed: int) -> None:
+def test_products_equal_scipys(seed: int) -> None:
     r, c, v = random_coo(seed)
     a = CSR.from_coo(r, c, v, (23, 41), drop_zeros=True)
     s = a.to_scipy()
+    size = abs(s)
     rng = np.random.default_rng(100 + seed)
     x, y, X = rng.standard_normal(41), rng.standard_normal(23), rng.standard_normal((41, 3))
-    np.testing.assert_array_equal(a @ x, s @ x)
-    np.testing.assert_array_equal(a.T @ y, s.T @ y)
-    np.testing.assert_allclose(a @ X, s @ X, rtol=1e-14, atol=1e-14)
+    assert_same_sums(a @ x, s @ x, size @ np.abs(x))
+    assert_same_sums(a.transpose_matmul(y), s.T @ y, size.T @ np.abs(y))
+    assert_same_sums(a @ X, s @ X, size @ np.abs(X))
     r2, c2, v2 = random_coo(seed + 50, m=41, n=4, k=60)
     b = CSR.from_coo(r2, c2, v2, (41, 4), drop_zeros=True)
-    np.testing.assert_array_equal(a.dense_product(b), (s @ b.to_scipy()).toarray())
+    want = (s @ b.to_scipy()).toarray()
+    assert_same_sums(a.dense_product(b), want, (size @ abs(b.to_scipy())).toarray())
+    with pytest.raises(ValueError, match="transpose_matmul"):
+        a.transpose_matmul(x)
 
 
 def test_selections_are_scipys() -> None:
@@ -88,7 +102,6 @@ def test_selections_are_scipys() -> None:
     np.testing.assert_array_equal(a.row_max_abs(), np.abs(s.toarray()).max(axis=1))
     both = CSR.vstack([a, a.rows(idx)])
     np.testing.assert_array_equal(both.toarray(), sp.vstack([s, s[idx]]).toarray())
-    np.testing.assert_array_equal(a.T.toarray(), s.T.toarray())
 
 
 def test_bad_shapes_are_refused() -> None:

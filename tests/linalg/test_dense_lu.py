@@ -34,10 +34,19 @@ def test_solves_equal_scipys_lu(monkeypatch: pytest.MonkeyPatch, numpy_rows: int
     np.testing.assert_allclose(lu.solve(b), x, rtol=1e-12, atol=1e-13)
 
 
-def test_non_finite_and_singular_matrices_raise() -> None:
+@pytest.mark.parametrize("numpy_rows", [1000, 0])  # both paths refuse alike
+def test_non_finite_and_singular_matrices_raise(
+    monkeypatch: pytest.MonkeyPatch, numpy_rows: int
+) -> None:
+    monkeypatch.setattr(capacitance, "NUMPY_ROWS", numpy_rows)
     a = system(5)[0]
     a[2, 3] = np.nan
     with pytest.raises(ValueError, match="non-finite"):
         DenseLU(a)
     with pytest.raises(np.linalg.LinAlgError):
         DenseLU(np.zeros((3, 3))).solve(np.ones(3))
+    # An exact zero pivot in column 2 (zero column): refused on both paths, not inf / nan.
+    a = system(3)[0]
+    a[:, 1] = 0.0
+    with pytest.raises(np.linalg.LinAlgError):
+        DenseLU(a).solve(np.ones(3))

@@ -240,11 +240,11 @@ def test_release_solve_stops_at_the_first_solves_accuracy(small_hertz, monkeypat
 
 def test_condensed_preset_on_stretched_cells(small_hertz) -> None:
     """The `condensed` preset on cells of aspect up to 10 (issue 33): a fresh solve of the
-    Hertz zone from zero to the final 1e-9 in at most 30 CG iterations (measured on these
-    50k DOFs: 20; 0.6.0's preset 21, the Chebyshev/Jacobi one before it 85: docs/scale.md,
-    "GAMG on stretched cells"), on a hierarchy whose fine level is in 2x2 blocks (the
-    displacement components) and whose coarse levels are in 3x3 blocks (the three rigid
-    modes of the near-nullspace).
+    Hertz zone from zero to the final 1e-9 in at most 30 CG iterations, the issue's bound
+    (the counts of this and earlier presets: docs/scale.md, "GAMG on stretched cells"; a
+    point smoother needs several times more here), on a hierarchy whose fine level is in
+    2x2 blocks (the displacement components) and whose coarse levels are in 3x3 blocks (the
+    three rigid modes of the near-nullspace).
     """
     setup, solver = _condensed_solver(small_hertz, reuse=False)
     x = setup.layout.x[setup.layout.mine, 0]

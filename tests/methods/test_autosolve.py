@@ -17,6 +17,7 @@ from mpi4py import MPI
 
 from contactfx import run_scene
 from contactfx.api import as_request
+from contactfx.discretize.mesh_utils import scene_dofs
 from contactfx.errors import InputError
 from contactfx.methods.solver_choice import (
     SAFETY,
@@ -25,7 +26,6 @@ from contactfx.methods.solver_choice import (
     choose,
     mem_available_mb,
     node_budget,
-    scaled_bound,
 )
 from contactfx.options import SOLVERS, SolverKind
 from contactfx.request import SolveRequest
@@ -113,9 +113,8 @@ def test_auto_refuses_where_nothing_fits(scene, caplog) -> None:
     assert "solver: mumps, although MUMPS needs" in caplog.text
 
 
-def test_scaled_bound_and_its_reason() -> None:
-    """The coarse estimate scales with the DOFs, and the log says it is a scaled lower bound."""
-    assert scaled_bound(981.0, 695_006, 10_455_512) == pytest.approx(981.0 * 15.0439, rel=1e-4)
+def test_coarse_bound_reason() -> None:
+    """The log says the coarse estimate is a scaled lower bound, with the coarse DOFs."""
     record = SolverChoice("condensed", 14_760.0, 15_000.0, 5.0, coarse_dofs=695_006)
     assert record.reason == (
         "MUMPS would need >= 14.76 GB (analysis of the 695,006-DOF coarse system, scaled), "
@@ -157,7 +156,7 @@ def test_auto_coarse_bound(scene, monkeypatch, available: float, preset: str) ->
     ref, _ = _run(scene, preset)
     choice = data.to_json()["solver_choice"]
     assert choice["ran"] == preset
-    dofs = 2 * scene.mesh.topology.index_map(0).size_global
+    dofs = scene_dofs(scene)
     fine = [n for n in seen if n >= dofs]
     assert meshes[0] == 2.0  # the coarse check's mesh: a quarter of the DOFs
     assert seen and seen[0] < dofs / 2  # its analysis comes first
@@ -184,7 +183,6 @@ def test_auto_coarse_check_only_where_it_could_decide(scene, monkeypatch) -> Non
     monkeypatch.setattr(autosolve, "mumps_estimate", lambda lin: calls.append(1) or estimate(lin))
     _, data = _run(scene, "auto", 1e9)
     assert len(calls) == 1 and data.to_json()["solver_choice"]["coarse_dofs"] is None
-    calls.clear()
     _, data = _run(scene, "auto", 1.0)  # no room even at CHECK_KB_PER_DOF: the check runs
     assert data.to_json()["solver_choice"]["coarse_dofs"] is not None
 
