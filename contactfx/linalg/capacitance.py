@@ -13,6 +13,7 @@ level; if not, the caller refactors.
 from __future__ import annotations
 
 import logging
+import warnings
 from collections.abc import Callable
 
 import numpy as np
@@ -51,7 +52,9 @@ class DenseLU:
         if len(a) > NUMPY_ROWS:
             import scipy.linalg  # only for a large released set (docs/scale.md)
 
-            self._lu = scipy.linalg.lu_factor(a, check_finite=False)
+            with warnings.catch_warnings():  # a zero pivot is refused in solve, as numpy's
+                warnings.simplefilter("ignore", scipy.linalg.LinAlgWarning)
+                self._lu = scipy.linalg.lu_factor(a, check_finite=False)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """a^-1 b; np.linalg.LinAlgError if `a` is singular (an exact zero pivot), as numpy's."""
