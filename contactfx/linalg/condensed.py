@@ -28,7 +28,7 @@ from .elimination import (
 )
 from .nullspace import orthonormalize
 from .petsc_options import PrefixedOptions, global_options, petsc_error_message, reason_name
-from .pivots import pivots
+from .pivots import Pivots, pivots
 from .policy import Decision, FactorizationPolicy
 from .protocol import SaddleResult
 
@@ -148,7 +148,7 @@ class CondensedSolver:
         ksp = self._ksp
         try:
             with self._options.inserted():  # read lazily at setup and solve (GAMG levels)
-                A = self._operator(reuse, E, d, piv)
+                A = self._operator(reuse, E, d, pv)
                 ksp.getPC().setReusePreconditioner(reuse)
                 ksp.setInitialGuessNonzero(True)
                 ksp.setTolerances(rtol=self._relative_to_b(A, v, b, rtol))
@@ -199,7 +199,7 @@ class CondensedSolver:
         n_piv = self._mpi.allreduce(len(piv))
         return changed <= max(REBUILD_FRACTION * n_piv, REBUILD_CHANGES)
 
-    def _operator(self, reuse: bool, E: PETSc.Mat, d: PETSc.Vec, piv: np.ndarray) -> PETSc.Mat:
+    def _operator(self, reuse: bool, E: PETSc.Mat, d: PETSc.Vec, pv: Pivots) -> PETSc.Mat:
         """The KSP's operator: matrix-free on the kept multigrid, or a new matrix and setup."""
         ksp = self._ksp
         if reuse:
@@ -210,7 +210,8 @@ class CondensedSolver:
             assert self._A is not None
             ksp.setOperators(A, self._A)
             return A
-        A = condensed_matrix(self._K, E, piv, self._diag)
+        piv = pv.dofs
+        A = condensed_matrix(self._K, pv.e_rows, self._r0, piv, self._diag)
         if self._modes:
             A.setNearNullSpace(self._near_nullspace(piv))
         ksp.setOperators(A)

@@ -68,28 +68,29 @@ def elimination_matrix(
     return M
 
 
-def condensed_matrix(K: PETSc.Mat, E: PETSc.Mat, piv: np.ndarray, k_diag: PETSc.Vec) -> PETSc.Mat:
-    """T^T K T + P = K + E^T K + K E + E^T K E (E = T - I, nonzero on pivot rows only).
+def condensed_matrix(
+    K: PETSc.Mat, prows: PivotRows, r0: int, piv: np.ndarray, k_diag: PETSc.Vec
+) -> PETSc.Mat:
+    """T^T K T + P = K + C, C = E^T K + K E + E^T K E (E = T - I: this rank's `prows`).
 
-    A general PtAP costs several passes over K and leaves the pivot rows without a diagonal
-    (inserting one reallocates the matrix, once per row). Here E^T K is a few rows of K (the
-    pivots' neighbourhoods); only the final sum passes over K once, into a new matrix: the
-    small coupling C plus K, not a copy of K plus C (which held two copies of K at once;
-    docs/scale.md, "Memory of the condensed path").
+    E is nonzero on the pivot rows only, so C touches the pivots' neighbourhoods: it is
+    summed here from the pivots' rows of K as coordinates (`coupling`) and added to K in
+    one pass, into a new matrix (K itself is kept; the union pattern is allocated once).
+    PETSc's products E^T K and their transposes cost passes over all rows, which grew
+    faster than the DOFs (docs/scale.md, "The condensed matrix").
     """
-    ip: Any = piv.astype(PETSc.IntType)
-    diff = cast(Any, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    Et = E.transpose(PETSc.Mat())  # without `out` petsc4py transposes in place
-    EtK = Et.matMult(K)
-    A = EtK.transpose(PETSc.Mat())  # K E (K is symmetric)
-    A.axpy(1.0, EtK, structure=diff)
-    EtKE = EtK.matMult(E)
-    A.axpy(1.0, EtKE, structure=diff)
-    for obj in (Et, EtK, EtKE):
-        obj.destroy()
-    A.axpy(1.0, K, structure=diff)  # the union pattern, allocated once
+    comm = K.getComm()
+    i, j, v = coupling(K, prows, r0, comm.tompi4py())
+    A = PETSc.Mat().create(comm)
+    A.setSizes(cast(Any, K.getSizes()))
+    A.setType(PETSc.Mat.Type.AIJ)
+    A.setPreallocationCOO(cast(Any, i.astype(PETSc.IntType)), cast(Any, j.astype(PETSc.IntType)))
+    A.setValuesCOO(cast(Any, v.astype(PETSc.ScalarType)), cast(Any, PETSc.InsertMode.ADD_VALUES))
+    A.assemble()
+    A.axpy(1.0, K, structure=cast(Any, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN))
     # Round-off leaves ~1e-16 on the pivot rows and columns: zero them, with K_pp on the
     # diagonal (the decoupled v_p = 0).
+    ip: Any = piv.astype(PETSc.IntType)
     A.zeroRowsColumns(ip, diag=1.0)
     diag = A.getDiagonal()
     diag.setValues(ip, cast(Any, k_diag.getValues(ip)))
@@ -100,6 +101,43 @@ def condensed_matrix(K: PETSc.Mat, E: PETSc.Mat, piv: np.ndarray, k_diag: PETSc.
     # Symmetric positive definite: what a Cholesky factorization (MUMPS SYM=1) needs to know.
     A.setOption(cast(PETSc.Mat.Option, PETSc.Mat.Option.SPD), True)
     return A
+
+
+def coupling(
+    K: PETSc.Mat, prows: PivotRows, r0: int, comm: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """C = E^T K + K E + E^T K E as global coordinates (duplicates to be summed).
+
+    With K symmetric, (E^T K)[c, :] sums E[p, c] K[p, :] over the pivots p and K E is its
+    transpose; E^T K E needs, for each pivot column of a pivot's row of K, that pivot's row
+    of E, which may live on another rank: the pivot rows of E are gathered (a few per
+    contact node).
+    """
+    every = [
+        e for part in comm.allgather([(r0 + r, c, v) for r, (c, v) in prows.items()]) for e in part
+    ]
+    e_rows = {int(p): (c, v) for p, c, v in every}
+    ii: list[np.ndarray] = []
+    jj: list[np.ndarray] = []
+    vv: list[np.ndarray] = []
+    for r, (c, v) in prows.items():
+        kc, kv = K.getRow(r0 + r)
+        kc = np.asarray(kc, dtype=np.int64)
+        kv = np.asarray(kv, dtype=float)
+        etk = np.outer(v, kv).ravel()  # row c, column kc: (E^T K)
+        rows, cols = np.repeat(c, len(kc)), np.tile(kc, len(c))
+        ii += [rows, cols]
+        jj += [cols, rows]
+        vv += [etk, etk]
+        for q, kq in zip(kc, kv, strict=True):
+            e = e_rows.get(int(q))
+            if e is not None:  # K[p, q] couples two pivots: (E^T K E)[c, c_q]
+                ii.append(np.repeat(c, len(e[0])))
+                jj.append(np.tile(e[0], len(c)))
+                vv.append(np.outer(v, kq * e[1]).ravel())
+    if not ii:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(ii), np.concatenate(jj), np.concatenate(vv)
 
 
 def t_mult(E: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
