@@ -32,6 +32,10 @@ COARSE_PREDICTOR_DOFS = 200_000
 # Mesh sizes of the coarse solve relative to the fine one (1/64 of the DOFs): its zone edge
 # is good to a coarse element, which the band probes cover.
 COARSE_FACTOR = 8.0
+# A direct solver probes the fine band (selected inverse entries): a band twice as wide costs
+# it less than the coarse solve saves at x16 (docs/scale.md#measured-constants, "Coarse
+# factor").
+DIRECT_COARSE_FACTOR = 16.0
 # The condensed loop pays a whole solve per ring of nodes it adds or releases: a sharper
 # prediction (1/16 of the DOFs) pays for itself.
 CONDENSED_COARSE_FACTOR = 4.0
@@ -39,9 +43,12 @@ CONDENSED_COARSE_FACTOR = 4.0
 
 # A direct solver's probes are selected entries of the inverse, whose cost grows with the
 # candidates: up to this many rows the loop starts from every row and probes them all, above
-# it from the coarse solve, probing only its uncertain band (about 20 rows); the crossover is
+# it from the coarse solve, probing only its uncertain band (about 40 rows); the crossover is
 # measured in docs/scale.md#measured-constants ("Probe every row up to").
-PROBE_ALL_ROWS = 500
+PROBE_ALL_ROWS = 300
+# The coarse solve itself starts from every row and probes them all: its mesh is coarsened
+# until it has at most this many (docs/scale.md#measured-constants, "Coarse factor").
+COARSE_ROWS = 500
 
 
 def contact_facets(scene: Scene) -> int:
@@ -86,18 +93,19 @@ def predictor_solver(spec: SolverSpec, coarse: Scene) -> SolverSpec:
 def coarse_factor(spec: SolverSpec, scene: Scene) -> float:
     """How much coarser the predictor's mesh is (every size times this; collective).
 
-    A direct solve of the coarse mesh probes every one of its rows, which pays up to
-    PROBE_ALL_ROWS rows: COARSE_FACTOR is doubled until the coarse rows (about the fine
-    ones over the factor: the surfaces are curves) are that few; a wider fine band costs
-    its probes little (docs/scale.md#measured-constants, "Coarse factor").
+    Direct solvers: DIRECT_COARSE_FACTOR, doubled until the coarse rows (about the fine ones
+    over the factor: the surfaces are curves) are at most COARSE_ROWS, since the coarse solve
+    probes them all; a wider fine band costs its probes little
+    (docs/scale.md#measured-constants, "Coarse factor"). Others: COARSE_FACTOR.
     """
     if spec.kind.condensed:
         return CONDENSED_COARSE_FACTOR
-    factor = COARSE_FACTOR
-    if spec.kind.factorizes_saddle:
-        rows = contact_facets(scene)
-        while rows / factor > PROBE_ALL_ROWS:
-            factor *= 2.0
+    if not spec.kind.factorizes_saddle:
+        return COARSE_FACTOR
+    factor = DIRECT_COARSE_FACTOR
+    rows = contact_facets(scene)
+    while rows / factor > COARSE_ROWS:
+        factor *= 2.0
     return factor
 
 

@@ -361,9 +361,11 @@ def test_response_cache_refuses_rows_it_did_not_compute() -> None:
 
 def test_coarse_factor_keeps_the_coarse_rows_probeable(structured_pair, monkeypatch) -> None:
     """A direct solver's coarse mesh is coarser still when the fine rows over the factor
-    exceed PROBE_ALL_ROWS (the coarse solve probes them all): the same converged answer.
+    exceed COARSE_ROWS (the coarse solve probes them all): the same converged answer.
 
-    PROBE_ALL_ROWS is lowered so that the 70k-DOF scene's rows over 8 exceed it.
+    The 70k-DOF scene (121 rows) is too small for x32: the direct factor is set to 8 and
+    COARSE_ROWS lowered so that its rows over 8 exceed it (x16, a 16-row coarse mesh);
+    PROBE_ALL_ROWS too, so that auto starts from the coarse solve.
     """
     from contactfx.api import solve
     from contactfx.methods import predictor
@@ -371,10 +373,12 @@ def test_coarse_factor_keeps_the_coarse_rows_probeable(structured_pair, monkeypa
     fine, _ = structured_pair
     rows = predictor.contact_facets(fine)
     mumps = SOLVERS["mumps"]
-    assert predictor.coarse_factor(mumps, fine) == predictor.COARSE_FACTOR
+    assert predictor.coarse_factor(mumps, fine) == predictor.DIRECT_COARSE_FACTOR
+    monkeypatch.setattr(predictor, "DIRECT_COARSE_FACTOR", 8.0)
     limit = int(rows / 12)  # between rows / 16 and rows / 8
-    monkeypatch.setattr(predictor, "PROBE_ALL_ROWS", limit)
-    assert predictor.coarse_factor(mumps, fine) == 2 * predictor.COARSE_FACTOR
+    monkeypatch.setattr(predictor, "COARSE_ROWS", limit)
+    monkeypatch.setattr(predictor, "PROBE_ALL_ROWS", limit)  # auto: the coarse start
+    assert predictor.coarse_factor(mumps, fine) == 16.0
     assert predictor.coarse_factor(SOLVERS["fieldsplit"], fine) == predictor.COARSE_FACTOR
     plain = solve(fine, "mortar", solver="mumps", predictor="none")
     sol = solve(fine, "mortar", solver="mumps", predictor="auto")
