@@ -14,7 +14,7 @@ import numpy as np
 
 from ..contact.grid import PointGrid
 from ..discretize.mesh_utils import owned_facets, scene_dofs
-from ..errors import InputError
+from ..errors import InputError, MeshError
 from ..logs import stage
 from ..options import SOLVERS, Predictor, SolverKind, SolverSpec
 from ..request import SolveRequest
@@ -148,6 +148,23 @@ def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0)
     return InitialSet(lambda p: near(grid_a, p, r), lambda p: near(grid_i, p, r_band))
 
 
+def _remeshed(scene: Scene, factor: float) -> Scene:
+    """The scene remeshed `factor` times coarser, or less coarse where gmsh cannot mesh it.
+
+    A user's .geo may have curves with a few elements, which x16 leaves unmeshable (gmsh:
+    "1D mesh cannot be divided by 2"): the factor halves down to COARSE_FACTOR.
+    """
+    while True:
+        try:
+            return scene.remeshed(factor)
+        except MeshError:
+            if factor <= COARSE_FACTOR:
+                raise
+            factor /= 2.0
+            if scene.comm.rank == 0:
+                log.info("coarse predictor: gmsh cannot mesh it that coarse, trying x%g", factor)
+
+
 def predict(
     scene: Scene, request: SolveRequest, aso: ActiveSetOptions, timers: Timers
 ) -> InitialSet | None:
@@ -165,7 +182,7 @@ def predict(
             log.info("coarse predictor: the scene cannot be remeshed, starting without it")
         return None
     with timers("predictor"), stage("predictor"):
-        coarse = scene.remeshed(coarse_factor(spec, scene))
+        coarse = _remeshed(scene, coarse_factor(spec, scene))
         coarse_request = replace(
             request, solver=predictor_solver(spec, coarse), reference_timing=False
         )
