@@ -37,7 +37,7 @@ COARSE_FACTOR = 8.0
 # prediction (1/16 of the DOFs) pays for itself.
 CONDENSED_COARSE_FACTOR = 4.0
 # The condensed first set reaches this many fine elements past each estimated zone edge
-# (issue 33: measured in docs/scale.md, "The 10.46M default command").
+# (issue 33: fitted on the cases of docs/scale.md, "An exact first set").
 EDGE_MARGIN = 0.17
 
 
