@@ -13,6 +13,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..contact.grid import PointGrid
+from ..contact.zone import covered, edge_distances
 from ..discretize.mesh_utils import owned_facets, scene_dofs
 from ..errors import InputError, MeshError
 from ..logs import stage
@@ -39,6 +40,9 @@ DIRECT_COARSE_FACTOR = 16.0
 # The condensed loop pays a whole solve per ring of nodes it adds or releases: a sharper
 # prediction (1/16 of the DOFs) pays for itself.
 CONDENSED_COARSE_FACTOR = 4.0
+# The condensed first set reaches this many fine elements past each estimated zone edge
+# (issue 33: fitted on the cases of docs/scale.md, "An exact first set").
+EDGE_MARGIN = 0.17
 
 
 # A direct solver's probes are selected entries of the inverse, whose cost grows with the
@@ -118,6 +122,18 @@ def coarse_margin(spec: SolverSpec) -> float:
     return 0.5 if spec.kind.condensed else 1.5
 
 
+def _coarse_radius(coarse: Solution, margin: float) -> float:
+    """`margin` coarse elements: the largest node spacing in the coarse contact zone."""
+    x = np.asarray(coarse.layout.x)[:, :2]
+    act = np.asarray(coarse.active, dtype=bool)
+    # Bucket grids instead of scipy.spatial's KD-trees: a plain solve then never imports
+    # scipy.spatial, whose import is a fixed cost (docs/scale.md, "Time to the first answer").
+    extent = float(np.ptp(x, axis=0).max()) if len(x) > 1 else 0.0
+    grid = PointGrid(x, extent / max(len(x), 1))  # about the spacing of points on a curve
+    spacing = grid.nearest(x[act], np.flatnonzero(act)) if len(x) > 1 else np.zeros(1)
+    return margin * float(spacing.max())
+
+
 def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0) -> InitialSet:
     """An InitialSet from the solution of the same scene on a coarser mesh.
 
@@ -130,12 +146,7 @@ def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0)
     act = np.asarray(coarse.active, dtype=bool)
     if not act.any():
         return InitialSet(lambda p: np.zeros(len(p), dtype=bool))
-    # Bucket grids instead of scipy.spatial's KD-trees: a plain solve then never imports
-    # scipy.spatial, whose import is a fixed cost (docs/scale.md, "Time to the first answer").
-    extent = float(np.ptp(x, axis=0).max()) if len(x) > 1 else 0.0
-    grid = PointGrid(x, extent / max(len(x), 1))  # about the spacing of points on a curve
-    spacing = grid.nearest(x[act], np.flatnonzero(act)) if len(x) > 1 else np.zeros(1)
-    r = margin * float(spacing.max())
+    r = _coarse_radius(coarse, margin)
     r_band = r * band / margin
     grid_a = PointGrid(x[act], r)
     grid_i = PointGrid(x[~act], r_band) if (~act).any() else None
@@ -148,21 +159,61 @@ def coarse_initial_set(coarse: Solution, margin: float = 1.5, band: float = 2.0)
     return InitialSet(lambda p: near(grid_a, p, r), lambda p: near(grid_i, p, r_band))
 
 
-def _remeshed(scene: Scene, factor: float) -> Scene:
-    """The scene remeshed `factor` times coarser, or less coarse where gmsh cannot mesh it.
+def _remeshed(scene: Scene, factor: float) -> tuple[Scene, float]:
+    """The scene remeshed `factor` times coarser, or less where gmsh cannot, and the factor.
 
     A user's .geo may have curves with a few elements, which x16 leaves unmeshable (gmsh:
     "1D mesh cannot be divided by 2"): the factor halves down to COARSE_FACTOR.
     """
     while True:
         try:
-            return scene.remeshed(factor)
+            return scene.remeshed(factor), factor
         except MeshError:
             if factor <= COARSE_FACTOR:
                 raise
             factor /= 2.0
             if scene.comm.rank == 0:
                 log.info("coarse predictor: gmsh cannot mesh it that coarse, trying x%g", factor)
+
+
+def sharp_initial_set(
+    coarse: Solution, factor: float, margin: float = 0.5, edge_margin: float = EDGE_MARGIN
+) -> InitialSet:
+    """An InitialSet for the condensed loop: the coarse zone with each edge estimated.
+
+    Along each pair's coarse active surface, the zone covers the segments between active
+    nodes and, past its last active node, reaches the edge estimated from the coarse
+    pressures plus `edge_margin` fine elements (a coarse segment over `factor`); where no
+    smooth edge is resolved, `margin` coarse elements as `coarse_initial_set`
+    (`contact.zone.edge_distances`). A fine node is in contact if it lies on the covered part.
+    """
+    act = np.asarray(coarse.active, dtype=bool)
+    if not act.any():
+        return InitialSet(lambda p: np.zeros(len(p), dtype=bool))
+    r = _coarse_radius(coarse, margin)
+    parts = []
+    for pv in coarse.pairs:
+        surf = pv.active.surface
+        on = np.zeros(surf.n_nodes, dtype=bool)
+        on[pv.nodes] = act[pv.rows]
+        p = pv.nodal(coarse.pressure)
+        parts.append((surf, *edge_distances(surf.x, surf.segments, on, p, r, edge_margin / factor)))
+
+    def active(p: np.ndarray) -> np.ndarray:
+        pts = np.asarray(p)[:, :2]
+        out = np.zeros(len(pts), dtype=bool)
+        for surf, from_a, from_b in parts:
+            out |= covered(pts, surf, from_a, from_b, r)
+        return out
+
+    return InitialSet(active)
+
+
+def initial_set(coarse: Solution, spec: SolverSpec, factor: float) -> InitialSet:
+    """The first set from the coarse solution: sharp for the condensed kinds (no probes)."""
+    if spec.kind.condensed:
+        return sharp_initial_set(coarse, factor, coarse_margin(spec))
+    return coarse_initial_set(coarse, margin=coarse_margin(spec))
 
 
 def predict(
@@ -182,9 +233,9 @@ def predict(
             log.info("coarse predictor: the scene cannot be remeshed, starting without it")
         return None
     with timers("predictor"), stage("predictor"):
-        coarse = _remeshed(scene, coarse_factor(spec, scene))
+        coarse, factor = _remeshed(scene, coarse_factor(spec, scene))
         coarse_request = replace(
             request, solver=predictor_solver(spec, coarse), reference_timing=False
         )
         sol = solve_contact(coarse, coarse_request, aso=aso, label="predictor")
-        return coarse_initial_set(sol, margin=coarse_margin(spec))
+        return initial_set(sol, spec, factor)

@@ -268,15 +268,19 @@ for _solver, _refine, _h_far, _tol in (
 
 
 def condensed_nts() -> tuple[Solution, Arrays]:
-    """The condensed solver (CG-GAMG), NTS, structured Hertz: active flags and pressures."""
+    """The condensed solver (CG-GAMG), NTS, structured Hertz: active flags and pressures, and
+    the size of the coarse predictor's first set (the edges estimated from its pressures)."""
     sol = solve(hertz(HertzParams(refine=0.08, h_far=0.8, mesh="structured")), "nts",
                 solver="condensed")  # fmt: skip
     order = np.lexsort(sol.layout.x.T[::-1])
-    return sol, {"act": sol.active[order], "p": sol.pressure[order]}
+    first = np.array([sol.history[0]["active"]])
+    return sol, {"act": sol.active[order], "p": sol.pressure[order], "first": first}
 
 
 # CG to rtol 1e-9 on the residual: 1e-6 on the pressures.
-CASES["hertz-condensed-nts"] = Case(condensed_nts, {"act": Exact(), "p": Rel(1e-6)})
+CASES["hertz-condensed-nts"] = Case(
+    condensed_nts, {"act": Exact(), "p": Rel(1e-6), "first": Exact()}
+)
 
 
 def auto_condensed() -> tuple[Solution, Arrays]:

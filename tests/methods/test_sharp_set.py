@@ -1,0 +1,71 @@
+"""The condensed solver's first set from the coarse predictor: zone edges from the pressures.
+
+Issue 33: the former rule (every fine node within half a coarse element of a coarse active
+node) left the zone 1-2 rows too wide or narrow at each edge, a whole CG solve per row; the
+sharp rule estimates each edge from the coarse pressures (docs/scale.md, "An exact first
+set").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from contactfx import solve
+from contactfx.methods.multipliers import solve_contact
+from contactfx.methods.predictor import (
+    CONDENSED_COARSE_FACTOR,
+    coarse_initial_set,
+    sharp_initial_set,
+)
+from contactfx.request import SolveRequest
+from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
+
+
+def coarse_and_fine(scene, method: str, basis: str):
+    """The coarse predictor's MUMPS solution and the condensed solve of `scene`."""
+    coarse = scene.remeshed(CONDENSED_COARSE_FACTOR)
+    request = SolveRequest.parse(method, basis=basis, solver="mumps")
+    coarse_sol = solve_contact(coarse, request)
+    fine = solve(scene, method, basis=basis, solver="condensed")
+    return coarse_sol, fine
+
+
+@pytest.mark.parametrize(("method", "basis"), [("mortar", "dual"), ("nts", "standard")])
+def test_structured_hertz_first_set_is_the_converged_one(method: str, basis: str) -> None:
+    """Structured Hertz, 140k DOFs: the former rule's set was 2 rows wide (35 for 33, three
+    solves); the sharp one is the converged set, and the loop takes one solve."""
+    scene = hertz(HertzParams(refine=0.045, h_far=0.45, mesh="structured"))
+    coarse, fine = coarse_and_fine(scene, method, basis)
+    x = fine.layout.x
+    sharp = sharp_initial_set(coarse, CONDENSED_COARSE_FACTOR).active(x)
+    former = coarse_initial_set(coarse, margin=0.5).active(x)
+    assert np.array_equal(sharp, fine.active)
+    assert int(former.sum()) == int(fine.active.sum()) + 2
+    assert not (fine.active & ~former).any()  # a superset: rows to release
+    assert fine.iterations == 1
+
+
+@pytest.mark.parametrize(
+    ("params", "rows"),
+    [(HertzParams(refine=0.031734, h_far=0.31734), 56), (HertzParams(refine=0.005), 289)],
+)
+def test_exact_start_on_gmsh_hertz_does_not_cycle(params: HertzParams, rows: int) -> None:
+    """gmsh Hertz, 136k / 23k DOFs, dual basis: from the exact set a loose solve added a row
+    whose penetration is within its error (8e-4 / 0.02 of the largest traction) and the next
+    removed it again (a cycle error; the 23k one failed so from the former rule's set too);
+    the polish decides it: one solve. (The former rule at 136k: 64 rows, six solves.)"""
+    sol = solve(hertz(params), "mortar", basis="dual", solver="condensed")
+    assert int(sol.active.sum()) == rows
+    assert sol.iterations == 1
+
+
+@pytest.mark.parametrize("name", ["S1", "S4"])
+def test_corner_edges_keep_their_step_count(name: str) -> None:
+    """Flat blocks, whose zone edges are corners (the pressure rises towards them): the
+    former rule's reach is kept there, and the loop still takes one solve."""
+    scene = build_scene("blocks", BLOCK_SCENES[name])
+    sol = solve(scene, "mortar", basis="dual", solver="condensed")
+    ref = solve(scene, "mortar", basis="dual", solver="mumps")
+    assert np.array_equal(sol.active, ref.active)
+    assert sol.iterations == 1
