@@ -4,7 +4,7 @@
 [--variants full,blr:1e-8:2,...] [--repeats R]` meshes once, then solves the scene (mortar,
 `--reference-timing`: the fresh LDL^T and LU stay full rank) with each variant in turn, R
 rounds, so old and new alternate in one process. A variant is `full` (the `mumps` preset) or
-`blr:CNTL7:ICNTL35` (`mumps-blr` with that threshold and variant). Prints per solve the
+`blr:CNTL7:ICNTL35[:ICNTL36]` (`mumps-blr` with that threshold and variants). Prints per solve the
 contact solve time, the fresh LDL^T / LU, the steps and linear iterations, and against the
 first `full` solve: the largest pressure and displacement differences relative to their
 maxima, whether the active set is the same, the force and Hertz a / p0 / L2 errors.
@@ -30,8 +30,10 @@ def variant(name: str) -> SolverSpec:
     """The spec of a variant name: `full` or `blr:CNTL7:ICNTL35`."""
     if name == "full":
         return solver_spec("mumps")
-    _, tol, icntl = name.split(":")
-    return replace(solver_spec("mumps-blr"), low_rank=LowRank(0, float(tol), int(icntl)))
+    _, tol, icntl, *ufcs = name.split(":")
+    spec = replace(solver_spec("mumps-blr"), low_rank=LowRank(0, float(tol), int(icntl)))
+    # ICNTL(36): 0 UFSC (MUMPS' default), 1 UCFS (compress before the solve, cheaper).
+    return spec.with_petsc([f"mat_mumps_icntl_36={u}" for u in ufcs])
 
 
 def largest(comm: MPI.Comm, a: np.ndarray) -> float:
@@ -72,10 +74,12 @@ def main() -> None:
                 same = bool(np.array_equal(sol.active, ref[2]))
             t, h = d["times"], d.get("hertz", {})
             its = [s["linear_iterations"] for s in d["active_set"]]
+            steps = [round(s["solve_time"], 2) for s in d["active_set"]]
             if comm.rank == 0:
                 print(
                     f"{name:>14} dofs {d['dofs']} solve {t['solve']:.2f} "
-                    f"ldlt {t['reference_ldlt']:.2f} lu {t['reference_lu']:.2f} "
+                    f"fresh {t['reference_solve']:.2f} ldlt {t['reference_ldlt']:.2f} "
+                    f"lu {t['reference_lu']:.2f} step times {steps} "
                     f"wall {wall:.1f} steps {len(its)} its {its} "
                     f"dp {dp:.2e} du {du:.2e} same_set {same} "
                     f"force {d['contact_force']:.10g} hertz {h}",

@@ -39,8 +39,8 @@ _APPLY_RTOL = 1e-7
 # Block low-rank factors (MUMPS ICNTL(35), CNTL(7) > 0) are approximate: 1e-7 is then no
 # test of accuracy (a compressed back-substitution passed it at 3.95M DOFs with the force
 # balance 0.07 % off; docs/scale.md, "Block low-rank factorization"). With them no single
-# back-substitution is an answer: every solve is GMRES (or a refined capacitance solve) to
-# this relative residual, GMRES's own rtol below.
+# back-substitution is an answer: every solve is GMRES to this relative residual (GMRES's
+# own rtol below), on a fresh factorization or a lagged one.
 APPROX_RTOL = 1e-13
 # GMRES around the factorization: one iteration with a fresh one, a few with a lagged one
 # (the change is low-rank); right preconditioning tests the true residual, modified
@@ -180,7 +180,10 @@ class SaddleSolver:
         self._m.update(g, active)
         self._configure()
         changed, subset = self.factored.changed(active, self._mpi)
-        decision = self.policy.decide(changed, subset, fresh, release=self.gamma == 0.0)
+        # Approximate (block low-rank) factors: no capacitance solve (its refinement stalls
+        # near 3e-11, short of APPROX_RTOL: docs/scale.md, "Block low-rank factorization").
+        release = self.gamma == 0.0 and not self.approximate
+        decision = self.policy.decide(changed, subset, fresh, release=release)
         if decision is Decision.RELEASED:
             released = self._solve_released(g, active, changed)
             if released is not None:
@@ -283,7 +286,6 @@ class SaddleSolver:
             self._mpi,
             self.factored.solution_for(g),
             self.factored.own_residual,
-            target=APPROX_RTOL if self.approximate else None,
         )
         if done is None:
             return None
