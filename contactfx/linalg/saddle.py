@@ -127,11 +127,7 @@ class SaddleSolver:
 
     @property
     def cheap_responses(self) -> bool:
-        """Whether responses are MUMPS' selected inverse entries (MUMPS, plain K).
-
-        petsc4py does not wrap MatMumpsGetInverse; it is called through ctypes
-        (linalg/mumps.py), on one rank or several.
-        """
+        """Whether responses are MUMPS' selected inverse entries (linalg/mumps.py; plain K)."""
         if not (self.direct and self.gamma == 0.0):
             return False
         self._configure()
@@ -190,12 +186,11 @@ class SaddleSolver:
                 return released
             decision = self.policy.decide(changed, subset, fresh, release=False)
         result = self._solve_factored(g, active, decision is Decision.REFACTOR, changed)
-        if result is None:
-            # The lagged factorization was not good enough: refactor and solve again.
-            log.info("saddle solver: GMRES on the lagged factorization failed: refactoring")
+        if result is None:  # the lagged (or compressed) factorization was not good enough
+            log.info("saddle solver: GMRES on the factorization failed: refactoring")
             self.factored.active = None
             result = self._solve_factored(g, active, True, -1)
-            assert result is not None  # a fresh factorization raises instead
+            assert result is not None  # a fresh full-rank factorization raises instead
         return result
 
     def _solve_factored(
@@ -244,6 +239,8 @@ class SaddleSolver:
         self.stats["setup_time"] += t1 - t0
         if not (reason > 0 and np.isfinite(m.x.norm())):
             if self.policy.reuse and not refactor:
+                return None
+            if refactor and _to_full_rank(self):
                 return None
             raise SolverError(
                 f"linear solve ({ksp.getType()}) did not converge: PETSc reason "
@@ -345,6 +342,18 @@ def _apply_once(solver: SaddleSolver) -> bool:
     return rel <= _APPLY_RTOL
 
 
+def _to_full_rank(solver: SaddleSolver) -> bool:
+    """Compressed factors too coarse for GMRES: full rank (CNTL(7) = 0) from the next setup.
+
+    False if the factors were not compressed.
+    """
+    if not solver.approximate:
+        return False
+    solver._ksp.getPC().getFactorMatrix().setMumpsCntl(7, 0.0)
+    solver._m.A.assemble()  # a new state: the next setup refactors
+    return True
+
+
 def _check_compressed(solver: SaddleSolver) -> None:
     """After a factorization: whether its factors are block low-rank (approximate).
 
@@ -359,6 +368,8 @@ def _check_compressed(solver: SaddleSolver) -> None:
     if ksp.getType() != "gmres":
         ksp.setType("gmres")
         ksp.setPCSide(cast(PETSc.PC.Side, PETSc.PC.Side.RIGHT))
+        # preonly's norm is none: GMRES must test the true residual.
+        ksp.setNormType(cast(PETSc.KSP.NormType, PETSc.KSP.NormType.UNPRECONDITIONED))
         ksp.setGMRESRestart(_MAX_IT)
     ksp.setTolerances(rtol=APPROX_RTOL, atol=0.0, max_it=_MAX_IT)
     ksp.setUp()

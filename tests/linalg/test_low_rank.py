@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from contactfx import solve
-from contactfx.linalg.saddle import APPROX_RTOL, SaddleSolver
+from contactfx.linalg.saddle import SaddleSolver
 from contactfx.methods.multipliers import floor_spec
 from contactfx.methods.solvers import BLR_KEYS, with_low_rank
 from contactfx.options import SOLVERS, LowRank
@@ -48,30 +48,39 @@ def _first_step_iterations(sol) -> int:
 
 
 @pytest.mark.parametrize("tolerance", [1e-8, 1e-2])
-def test_low_rank_gives_the_full_rank_answer(scene, full, tolerance) -> None:
+def test_low_rank_gives_the_full_rank_answer(scene, full, tolerance, caplog) -> None:
     """BLR at the preset's threshold and at a deliberately loose one: the full-rank answer.
 
-    The loose factors are far from exact (GMRES needs many iterations where the full-rank
-    factorization needs one), yet nothing inaccurate is accepted.
+    At 1e-8 the compressed factors need GMRES iterations that exact ones do not (the
+    full-rank step takes one back-substitution; GMRES from zero on exact factors two). At
+    1e-2 GMRES does not converge on them: the solver refactors at full rank, and says so.
     """
     spec = replace(SOLVERS["mumps-blr"], low_rank=LowRank(0, tolerance))
-    sol = solve(scene, "mortar", solver=spec)
+    with caplog.at_level("INFO", logger="contactfx"):
+        sol = solve(scene, "mortar", solver=spec)
     _same_answer(sol, full)
     assert _first_step_iterations(full) == 1
-    if tolerance == 1e-2:
-        assert _first_step_iterations(sol) > 3
+    fell_back = "GMRES on the factorization failed" in caplog.text
+    assert fell_back is (tolerance == 1e-2)
+    if not fell_back:
+        assert _first_step_iterations(sol) > 2
 
 
 def test_low_rank_by_petsc_options_is_refined_too(scene, full) -> None:
     """BLR asked for by PETSc options on the default (the lead's run): read from the factor."""
-    spec = SOLVERS["mumps"].with_petsc(["mat_mumps_icntl_35=2", "mat_mumps_cntl_7=1e-2"])
+    spec = SOLVERS["mumps"].with_petsc(["mat_mumps_icntl_35=2", "mat_mumps_cntl_7=1e-6"])
     sol = solve(scene, "mortar", solver=spec)
     _same_answer(sol, full)
-    assert _first_step_iterations(sol) > 3
+    assert _first_step_iterations(sol) > 2
 
 
 def test_a_throwaway_solver_on_compressed_factors_runs_gmres(scene) -> None:
-    """A solver without reuse (preonly) on BLR factors switches to GMRES to APPROX_RTOL."""
+    """A solver without reuse (preonly) on BLR factors switches to GMRES.
+
+    Its true residual reaches the full-rank back-substitution's (round-off: eps |A| |x|,
+    far above GMRES's own estimate of 1e-13), where the compressed factors alone leave one
+    far above it.
+    """
     from contactfx.contact import Kernel
     from contactfx.discretize.setup import prepare_contact
     from contactfx.methods.active_set import ActiveSetOptions
@@ -79,17 +88,20 @@ def test_a_throwaway_solver_on_compressed_factors_runs_gmres(scene) -> None:
 
     setup = prepare_contact(scene, Kernel.MORTAR, ActiveSetOptions().penetration_tol, Timers())
     el, every = setup.elasticity, np.ones(len(setup.g), dtype=bool)
-    results = {}
-    for name, extra in (("full", {}), ("blr", {BLR_KEYS[0]: 2, BLR_KEYS[1]: 1e-2})):
+    results, residual = {}, {}
+    for name, extra in (("full", {}), ("blr", {BLR_KEYS[0]: 2, BLR_KEYS[1]: 1e-6})):
         options = {**SOLVERS["mumps"].petsc, **extra}
         with SaddleSolver(el.K, setup.B, el.f, options, direct=True) as solver:
-            res = solver.solve(setup.g, every)
+            results[name] = solver.solve(setup.g, every)
             assert solver.approximate is (name == "blr")
             assert solver._ksp.getType() == ("gmres" if name == "blr" else "preonly")
-            if name == "blr":
-                _, rel = solver._m.residual(solver._m.x)
-                assert rel <= APPROX_RTOL and res.iterations > 3
-            results[name] = res
+            m = solver._m
+            residual[name] = m.residual(m.x)[1]
+            if name == "blr":  # one back-substitution with the compressed factors
+                solver._ksp.getPC().apply(m.b, m.x)
+                residual["single"] = m.residual(m.x)[1]
+    assert residual["blr"] <= 2.0 * residual["full"] < residual["single"]
+    assert results["blr"].iterations > 2
     dmu = np.abs(results["blr"].mu - results["full"].mu).max()
     assert dmu <= 1e-8 * np.abs(results["full"].mu).max()
     setup.destroy()
