@@ -37,11 +37,13 @@ log = logging.getLogger("contactfx")
 # GMRES (rtol 1e-13) takes over from that solution.
 _APPLY_RTOL = 1e-7
 # Block low-rank factors (MUMPS ICNTL(35), CNTL(7) > 0) are approximate: 1e-7 is then no
-# test of accuracy (a compressed back-substitution passed it at 3.95M DOFs with the force
-# balance 0.07 % off; docs/scale.md, "Block low-rank factorization"). With them no single
-# back-substitution is an answer: every solve is GMRES to this relative residual (GMRES's
-# own rtol below), on a fresh factorization or a lagged one.
+# test of accuracy (one compressed back-substitution passed it at 3.95M DOFs with the force
+# balance 0.07 % off). With them no single back-substitution is an answer: every solve is
+# GMRES to this rtol (its own estimate; the true residual then stops where a full-rank
+# back-substitution's does, at round-off), on a fresh or a lagged factorization
+# (docs/scale.md, "Block low-rank factorization").
 APPROX_RTOL = 1e-13
+_ROUNDOFF = 2.0  # a capacitance solve on them: to this multiple of its true residual
 # GMRES around the factorization: one iteration with a fresh one, a few with a lagged one
 # (the change is low-rank); right preconditioning tests the true residual, modified
 # Gram-Schmidt keeps the basis orthogonal down to round-off.
@@ -176,10 +178,7 @@ class SaddleSolver:
         self._m.update(g, active)
         self._configure()
         changed, subset = self.factored.changed(active, self._mpi)
-        # Approximate (block low-rank) factors: no capacitance solve (its refinement stalls
-        # near 3e-11, short of APPROX_RTOL: docs/scale.md, "Block low-rank factorization").
-        release = self.gamma == 0.0 and not self.approximate
-        decision = self.policy.decide(changed, subset, fresh, release=release)
+        decision = self.policy.decide(changed, subset, fresh, release=self.gamma == 0.0)
         if decision is Decision.RELEASED:
             released = self._solve_released(g, active, changed)
             if released is not None:
@@ -247,6 +246,8 @@ class SaddleSolver:
                 f"{reason} ({reason_name(reason)}) after {its} iterations"
             )
         if self.direct:
+            if refactor and self.approximate:  # the floor of later capacitance solves
+                self.factored.own_residual = _true_residual(m)
             self.factored.keep(active, g, m.x.array_r)
         u, mu = m.split()
         return SaddleResult(u, mu, its, reason, refactor, changed, 0, t1 - t0, t2 - t1)
@@ -283,6 +284,8 @@ class SaddleSolver:
             self._mpi,
             self.factored.solution_for(g),
             self.factored.own_residual,
+            # Approximate factors: to their fresh GMRES solve's round-off, not their own.
+            _ROUNDOFF * self.factored.own_residual if self.approximate else None,
         )
         if done is None:
             return None
@@ -340,6 +343,13 @@ def _apply_once(solver: SaddleSolver) -> bool:
     r.destroy()
     solver.factored.own_residual = rel
     return rel <= _APPLY_RTOL
+
+
+def _true_residual(m: SaddleBlocks) -> float:
+    """The relative residual of m.x."""
+    r, rel = m.residual(m.x)
+    r.destroy()
+    return rel
 
 
 def _to_full_rank(solver: SaddleSolver) -> bool:
