@@ -11,6 +11,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
 from types import MappingProxyType
+from typing import Self
 
 from .contact import Kernel
 from .errors import InputError
@@ -22,7 +23,22 @@ def _unknown(enum: type[StrEnum], value: object, what: str) -> InputError:
     return InputError(f"unknown {what} '{value}' (choose {choices})")
 
 
-class Discretization(StrEnum):
+_WHAT = {"Basis": "multiplier basis"}  # in the errors; otherwise the class name
+
+
+class _Choice(StrEnum):
+    """A user's choice by name: `parse` refuses other names, listing the members."""
+
+    @classmethod
+    def parse(cls, value: Self | str) -> Self:
+        """The member named `value`."""
+        try:
+            return cls(value)
+        except ValueError:
+            raise _unknown(cls, value, _WHAT.get(cls.__name__, cls.__name__.lower())) from None
+
+
+class Discretization(_Choice):
     """The discrete contact operator (B, weighted gap): which kernel builds it."""
 
     NTS = "nts"
@@ -34,14 +50,6 @@ class Discretization(StrEnum):
         """The kernel of contactfx/contact that assembles this discretization."""
         return _KERNELS[self]
 
-    @classmethod
-    def parse(cls, value: Discretization | str) -> Discretization:
-        """The discretization named `value`."""
-        try:
-            return cls(value)
-        except ValueError:
-            raise _unknown(cls, value, "discretization") from None
-
 
 _KERNELS: Mapping[Discretization, Kernel] = MappingProxyType(
     {
@@ -52,23 +60,15 @@ _KERNELS: Mapping[Discretization, Kernel] = MappingProxyType(
 )
 
 
-class Enforcement(StrEnum):
+class Enforcement(_Choice):
     """How the contact constraint is enforced on a discretization."""
 
     MULTIPLIERS = "multipliers"  # Lagrange multipliers: saddle points in an active-set loop
     PENALTY = "penalty"  # a normal stiffness on the penetrating rows, no multipliers
     SCHWARZ = "schwarz"  # Dirichlet-Neumann iteration between the two bodies
 
-    @classmethod
-    def parse(cls, value: Enforcement | str) -> Enforcement:
-        """The enforcement named `value`."""
-        try:
-            return cls(value)
-        except ValueError:
-            raise _unknown(cls, value, "enforcement") from None
 
-
-class Method(StrEnum):
+class Method(_Choice):
     """The names of --method: a discretization, or an alias of a (discretization, enforcement).
 
     The JSON key "method" holds these names; `pair` is the alias table.
@@ -95,14 +95,6 @@ class Method(StrEnum):
         """Whether the method solves saddle points with Lagrange multipliers."""
         return self.pair[1] is Enforcement.MULTIPLIERS
 
-    @classmethod
-    def parse(cls, value: Method | str) -> Method:
-        """The method named `value` (InputError listing the methods otherwise)."""
-        try:
-            return cls(value)
-        except ValueError:
-            raise _unknown(cls, value, "method") from None
-
 
 _ALIASES: Mapping[Method, tuple[Discretization, Enforcement]] = MappingProxyType(
     {
@@ -116,35 +108,19 @@ _ALIASES: Mapping[Method, tuple[Discretization, Enforcement]] = MappingProxyType
 )
 
 
-class Basis(StrEnum):
+class Basis(_Choice):
     """Mortar multiplier bases: the shape functions N_j, or the biorthogonal (dual) ones."""
 
     STANDARD = "standard"
     DUAL = "dual"
 
-    @classmethod
-    def parse(cls, value: Basis | str) -> Basis:
-        """The basis named `value`."""
-        try:
-            return cls(value)
-        except ValueError:
-            raise _unknown(cls, value, "multiplier basis") from None
 
-
-class Predictor(StrEnum):
+class Predictor(_Choice):
     """Where the active-set loop starts: a coarser solve of the same scene, or not."""
 
     AUTO = "auto"  # the policy of methods/predictor.py decides
     COARSE = "coarse"
     NONE = "none"
-
-    @classmethod
-    def parse(cls, value: Predictor | str) -> Predictor:
-        """The predictor named `value`."""
-        try:
-            return cls(value)
-        except ValueError:
-            raise _unknown(cls, value, "predictor") from None
 
 
 class SolverKind(StrEnum):
@@ -186,6 +162,19 @@ SCHUR_KEY = "pc_fieldsplit_schur_precondition"
 
 
 @dataclass(frozen=True)
+class LowRank:
+    """MUMPS' block low-rank factorization of a direct saddle point from `from_dofs` DOFs.
+
+    CNTL(7) = `tolerance`, ICNTL(35) = `variant`: the factors are approximate, so every solve
+    on them is GMRES to full-rank accuracy (linalg/saddle.py: APPROX_RTOL).
+    """
+
+    from_dofs: int = 0
+    tolerance: float = 1e-8
+    variant: int = 2  # ICNTL(35): 1 automatic, 2 factors and solve compressed, 3 factors only
+
+
+@dataclass(frozen=True)
 class SolverSpec:
     """A linear solver: its kind, its PETSc options and the tolerances the code applies.
 
@@ -202,6 +191,7 @@ class SolverSpec:
     name: str = "custom"
     schur: SchurPre | None = None
     free_products: bool = False  # GAMG's setup frees its products' data (methods/solvers.py)
+    low_rank: LowRank | None = None  # a direct solver's BLR factorization (methods/solvers.py)
 
     def __post_init__(self) -> None:
         self._check()
@@ -238,6 +228,8 @@ class SolverSpec:
                 f"solver '{self.name}' ({self.kind.value}): PETSc option pc_type={pc} "
                 f"contradicts it: {fix}; choose the solver with --solver instead"
             )
+        if self.low_rank is not None and not 0.0 < self.low_rank.tolerance < 1.0:
+            raise InputError(f"solver '{self.name}': the low-rank tolerance must lie in (0, 1)")
         if not (0.0 < self.rtol < 1.0) or (
             self.loose_rtol is not None and not 0.0 < self.loose_rtol < 1.0
         ):
@@ -296,6 +288,11 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
         "auto": SolverSpec(SolverKind.AUTO, _MUMPS_LDLT, name="auto"),  # docs/scale.md
         "mumps": SolverSpec(SolverKind.DIRECT, _MUMPS_LDLT, name="mumps"),
         "mumps-lu": SolverSpec(SolverKind.DIRECT, _MUMPS_LU, name="mumps-lu"),
+        # Opt-in: MUMPS' block low-rank LDL^T, every solve refined by GMRES to full-rank
+        # accuracy (docs/scale.md, "Block low-rank factorization").
+        "mumps-blr": SolverSpec(
+            SolverKind.DIRECT, _MUMPS_LDLT, name="mumps-blr", low_rank=LowRank()
+        ),
         # Opt-in (docs/scale.md, "The Schur route, measured"): MUMPS' Schur complement of
         # every multiplier row, one factorization, each set a dense solve. Serial only: on
         # several ranks the `mumps` path runs instead.

@@ -29,6 +29,8 @@ log = logging.getLogger("contactfx")
 RELEASED_RTOL = 1e-8
 # Refinement steps before giving up (each costs two back-substitutions).
 REFINEMENTS = 2
+# With approximate (block low-rank) factors each step gains about their accuracy.
+APPROX_REFINEMENTS = 8
 # Up to this many released rows numpy's gesv refactors the capacitance matrix for each solve
 # instead of keeping scipy.linalg's LU: a plain solve then never imports scipy.linalg, and a
 # refactorization costs less than the import up to here (docs/scale.md, "Time to the first
@@ -84,6 +86,7 @@ def released_solve(
     comm: MPI.Comm,
     first: np.ndarray | None,
     floor: float = 0.0,
+    target: float | None = None,
 ) -> tuple[int, float, int] | None:
     """Solve the new system (right-hand side `b_new`, set `active`) into x, or None.
 
@@ -91,8 +94,10 @@ def released_solve(
     system's residual and its relative norm; `responses(rows, local_mask)` the multiplier
     responses to unit shifts of the global `rows`; `first`, if given, the factorized set's
     own solution for these gaps (saves a back-substitution); `floor` the relative residual of
-    the factorization's own back-substitution. Returns (back-substitutions, relative
-    residual, released rows), or None where the caller must refactor (a log line says why).
+    the factorization's own back-substitution; `target`, if given, the residual to reach
+    instead, in up to APPROX_REFINEMENTS steps (approximate factors). Returns
+    (back-substitutions, relative residual, released rows), or None where the caller must
+    refactor (a log line says why).
     """
     released = factored & ~active
     rel_global = np.flatnonzero(_gathered(comm, released))
@@ -102,7 +107,8 @@ def released_solve(
     b_new.copy(b)
     b.array[rows_l] = np.where(factored, -g, 0.0)
     applies = 1
-    target = max(RELEASED_RTOL, floor)
+    steps = REFINEMENTS if target is None else APPROX_REFINEMENTS
+    target = max(RELEASED_RTOL, floor) if target is None else target
     try:
         if first is not None:
             x.array[:] = first
@@ -116,7 +122,7 @@ def released_solve(
         apply(b, x)
         x.array[rows_r] = 0.0
         r, res = residual(x)
-        for _ in range(REFINEMENTS):
+        for _ in range(steps):
             if res <= target:
                 break
             # The correction solves the new system with the residual as right-hand side: the

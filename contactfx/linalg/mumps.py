@@ -112,6 +112,18 @@ def analyze(F: PETSc.Mat, A: PETSc.Mat, cholesky: bool) -> MumpsEstimate | None:
     )
 
 
+def compressed(pc: PETSc.PC) -> bool:
+    """Whether the PC's factorization is MUMPS' block low-rank one with a nonzero threshold.
+
+    Read from the factor itself (ICNTL(35) in 1-3 and CNTL(7) > 0, however they were set):
+    its factors are approximate, so no single back-substitution with them is an answer.
+    """
+    if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
+        return False
+    F = pc.getFactorMatrix()
+    return F.getMumpsIcntl(35) in (1, 2, 3) and F.getMumpsCntl(7) > 0.0
+
+
 def _pattern(rows: np.ndarray, cols: np.ndarray, symmetric: bool) -> list[np.ndarray]:
     """The rows requested in each column: all of `rows`, or only half of the pairs in `cols`.
 

@@ -34,7 +34,7 @@ from .active_set import (
 )
 from .autosolve import Prepared, prepare_solver, warn_if_too_big
 from .solution import Solution, finish
-from .solvers import setup_solver
+from .solvers import BLR_KEYS, setup_solver
 
 log = logging.getLogger("contactfx")
 
@@ -254,6 +254,17 @@ def _timed_fresh_solve(
         fresh.destroy()
 
 
+def floor_spec(spec: SolverSpec, pc: str) -> SolverSpec:
+    """The plain direct factorization (`pc`: lu or cholesky) with the spec's other options.
+
+    Full rank always: a floor is an exact factorization, whatever the spec compresses (its
+    low-rank choice, or MUMPS' BLR keys given as PETSc options).
+    """
+    petsc = {**{k: v for k, v in spec.petsc.items() if k not in BLR_KEYS}, "pc_type": pc}
+    name = f"{spec.name}:{pc}"
+    return replace(spec, kind=SolverKind.DIRECT, petsc=petsc, name=name, low_rank=None)
+
+
 def reference_solve(
     setup: ContactSetup, spec: SolverSpec, scene: Scene, active: np.ndarray, timers: Timers
 ) -> SaddleResult:
@@ -268,9 +279,8 @@ def reference_solve(
     if spec.kind.factorizes_saddle:
         # The plain factorizations (a Schur-complement solver's floor too).
         for key, pc in (("reference_lu", "lu"), ("reference_ldlt", "cholesky")):
-            petsc = {**spec.petsc, "pc_type": pc}
-            floor = replace(spec, kind=SolverKind.DIRECT, petsc=petsc, name=f"{spec.name}:{pc}")
-            same = floor.petsc == spec.petsc and spec.kind is SolverKind.DIRECT
+            floor = floor_spec(spec, pc)
+            same = floor == replace(spec, name=floor.name)
             timers.seconds[key] = (
                 seconds if same else _timed_fresh_solve(setup, floor, scene, active)[1]
             )

@@ -17,7 +17,7 @@ from ..linalg.policy import FactorizationPolicy
 from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
 from ..linalg.schur import SchurSolver, schur_available
-from ..options import SchurPre, SolverKind, SolverSpec
+from ..options import LowRank, SchurPre, SolverKind, SolverSpec
 from ..request import direct_path
 from ..scenes import Scene
 
@@ -52,11 +52,32 @@ def with_ordering(petsc: Mapping[str, object], ndofs: int) -> Mapping[str, objec
     return {**petsc, ORDERING_KEY: AMD if ndofs < PORD_FROM_DOFS else PORD}
 
 
-def direct_options(petsc: Mapping[str, object], K: PETSc.Mat) -> Mapping[str, object]:
-    """A direct saddle-point solver's options: its ordering and, on several ranks, analysis."""
-    return with_sequential_analysis(
-        with_ordering(petsc, K.getSize()[0]), K.getComm().tompi4py().size
-    )
+BLR_KEYS = ("mat_mumps_icntl_35", "mat_mumps_cntl_7")
+
+
+def with_low_rank(
+    petsc: Mapping[str, object], low_rank: LowRank | None, ndofs: int
+) -> Mapping[str, object]:
+    """A MUMPS factorization's options with the spec's block low-rank choice for `ndofs`.
+
+    Options that name ICNTL(35) or CNTL(7) themselves are left as they are (the solver reads
+    the factor's own settings: linalg/mumps.py `compressed`).
+    """
+    if (
+        low_rank is None
+        or ndofs < low_rank.from_dofs
+        or petsc.get("pc_factor_mat_solver_type") != "mumps"
+        or any(k in petsc for k in BLR_KEYS)
+    ):
+        return petsc
+    return {**petsc, BLR_KEYS[0]: low_rank.variant, BLR_KEYS[1]: low_rank.tolerance}
+
+
+def direct_options(spec: SolverSpec, K: PETSc.Mat) -> Mapping[str, object]:
+    """A direct saddle-point solver's options: ordering, low rank, on several ranks analysis."""
+    n = K.getSize()[0]
+    petsc = with_low_rank(with_ordering(spec.petsc, n), spec.low_rank, n)
+    return with_sequential_analysis(petsc, K.getComm().tompi4py().size)
 
 
 # GAMG recomputes a kept hierarchy from its products' data when asked to reuse the
@@ -128,7 +149,7 @@ def make_solver(
         K,
         B,
         f,
-        direct_options(spec.petsc, K) if direct else spec.petsc,
+        direct_options(spec, K) if direct else spec.petsc,
         direct=direct,
         gamma=augmentation(spec, e_max, h),
         nullspace=nullspace,
