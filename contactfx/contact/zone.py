@@ -18,8 +18,8 @@ from .geometry import Surface
 from .search import SegmentSearch
 
 # The two extrapolated zeros of a resolved smooth edge agree within this many elements of
-# the coarse mesh (Hertz meshes of 9.6k-10M DOFs: at most 0.16; the small scene files'
-# zones of 11-12 coarse nodes: 0.37-1.16; docs/scale.md, "An exact first set").
+# the coarse mesh; a zone of a few coarse nodes disagrees by more (both measured in
+# docs/scale.md, "An exact first set").
 AGREE = 0.25
 
 

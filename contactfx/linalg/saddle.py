@@ -37,8 +37,8 @@ log = logging.getLogger("contactfx")
 # GMRES (rtol 1e-13) takes over from that solution.
 _APPLY_RTOL = 1e-7
 # Block low-rank factors (MUMPS ICNTL(35), CNTL(7) > 0) are approximate: 1e-7 is then no
-# test of accuracy (one compressed back-substitution passed it at 3.95M DOFs with the force
-# balance 0.07 % off). With them no single back-substitution is an answer: every solve is
+# test of accuracy (a compressed back-substitution passed it with the force balance off:
+# docs/scale.md). With them no single back-substitution is an answer: every solve is
 # GMRES to this rtol (its own estimate; the true residual then stops where a full-rank
 # back-substitution's does, at round-off), on a fresh or a lagged factorization
 # (docs/scale.md, "Block low-rank factorization").

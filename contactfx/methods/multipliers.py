@@ -158,9 +158,8 @@ class MultiplierIteration:
         When it keeps the set, and after a given first set when it only adds rows that
         penetrate by less than LOOSE_PENETRATION of the largest traction (c g against
         lambda): from a coarse prediction such a row's sign is within the loose solve's
-        error (the exact set cycled 56 -> 57 -> 56 on gmsh's 136k Hertz mesh with the dual
-        basis, its row at 8e-4, and 289 -> 290 -> 289 with `--refine 0.005`, at 0.02; rows
-        that truly entered: 0.47-0.62; docs/scale.md, "An exact first set").
+        error, and adding it made the exact set cycle; rows that truly enter penetrate
+        several times more (docs/scale.md, "An exact first set").
         """
         comm = self.setup.comm
         entering = new_active & ~active

@@ -47,7 +47,7 @@ EDGE_MARGIN = 0.17
 
 # A direct solver's probes are selected entries of the inverse, whose cost grows with the
 # candidates: up to this many rows the loop starts from every row and probes them all, above
-# it from the coarse solve, probing only its uncertain band (about 40 rows); the crossover is
+# it from the coarse solve, probing only its uncertain band; the crossover is
 # measured in docs/scale.md#measured-constants ("Probe every row up to").
 PROBE_ALL_ROWS = 300
 # The coarse solve itself starts from every row and probes them all: its mesh is coarsened
@@ -117,7 +117,7 @@ def coarse_margin(spec: SolverSpec) -> float:
     """Coarse elements of margin around the coarse zone.
 
     A direct solver probes the uncertain band, so a generous superset costs it nothing; the
-    condensed loop pays a solve per ring it must release (463k DOFs: 6 -> 4 steps).
+    condensed loop pays a solve per ring it must release (docs/scale.md, "Coarse predictor").
     """
     return 0.5 if spec.kind.condensed else 1.5
 

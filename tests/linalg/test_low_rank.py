@@ -100,7 +100,10 @@ def test_a_throwaway_solver_on_compressed_factors_runs_gmres(scene) -> None:
             if name == "blr":  # one back-substitution with the compressed factors
                 solver._ksp.getPC().apply(m.b, m.x)
                 residual["single"] = m.residual(m.x)[1]
-    assert residual["blr"] <= 2.0 * residual["full"] < residual["single"]
+    # Round-off class, with room for another BLAS; one compressed back-substitution is
+    # orders of magnitude above it (docs/scale.md, "Block low-rank factorization").
+    assert residual["blr"] <= 10.0 * residual["full"]
+    assert residual["single"] >= 1e4 * residual["blr"]
     assert results["blr"].iterations > 2
     dmu = np.abs(results["blr"].mu - results["full"].mu).max()
     assert dmu <= 1e-8 * np.abs(results["full"].mu).max()
