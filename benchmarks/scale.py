@@ -76,7 +76,7 @@ def case(
 
 
 def linear_its(r: dict[str, Any]) -> list[int]:
-    """The linear iterations of each active-set step (the last one includes its polish)."""
+    """The linear iterations of each active-set step (the last one solves to the end)."""
     return [int(h["linear_iterations"]) for h in r.get("history", [])]
 
 

@@ -41,14 +41,19 @@ def owned_facets(scene: Scene, name: str) -> np.ndarray:
     return facets[facets < msh.topology.index_map(tdim - 1).size_local]
 
 
-def vertex_coordinates(msh: dolfinx.mesh.Mesh) -> np.ndarray:
-    """Coordinates (x, y) of every local vertex."""
+def cell_vertices(msh: dolfinx.mesh.Mesh, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (n, 4) of `cells` and their coordinates (n, 4, 2).
+
+    Only these cells are read: a surface's few thousand, not every vertex of the mesh (that
+    cost seconds per call at 10M DOFs: docs/scale.md, "One CG run per stationary set").
+    """
     tdim = msh.topology.dim
-    nv = msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts
     msh.topology.create_connectivity(tdim, 0)
-    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)
-    geo = msh.geometry.dofmaps[0]
-    xv = np.zeros((nv, 2))
+    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)[cells]
     # Q1 geometry: the cell's geometry nodes are its vertices, in the same order.
-    xv[c2v.ravel()] = msh.geometry.x[geo[: c2v.shape[0]].ravel(), :2]
-    return xv
+    return c2v, msh.geometry.x[msh.geometry.dofmaps[0][cells], :2]
+
+
+def facet_columns(c2v: np.ndarray, f2v: np.ndarray) -> np.ndarray:
+    """For each facet (its two vertices `f2v`) the columns of its vertices in its cell's `c2v`."""
+    return np.column_stack([np.argmax(c2v == f2v[:, [k]], axis=1) for k in range(2)])

@@ -12,7 +12,7 @@ from ..contact.geometry import nodal_normals, segment_lengths
 from ..contact.search import project
 from ..errors import GeometryError, MeshError
 from ..scenes import Model, Scene
-from .mesh_utils import owned_facets, vertex_coordinates, vertex_to_block
+from .mesh_utils import cell_vertices, facet_columns, owned_facets
 
 
 @dataclass(frozen=True)
@@ -34,22 +34,24 @@ def gather_surface(scene: Scene, V: fem.FunctionSpace, name: str) -> GatheredSur
     facets = owned_facets(scene, name)
     f2v = msh.topology.connectivity(tdim - 1, 0)
     f2c = msh.topology.connectivity(tdim - 1, tdim)
-    c2v = msh.topology.connectivity(tdim, 0)
-    xv = vertex_coordinates(msh)
-    v2b = vertex_to_block(V)
     imap = V.dofmap.index_map
     nloc = imap.size_local
     owners_ghost = imap.owners
 
     fv = f2v.array.reshape(-1, 2)[facets]
     cells = f2c.array[f2c.offsets[facets]]
-    cell_mid = xv[c2v.array.reshape(-1, 4)[cells]].mean(axis=1)
-    x0, x1 = xv[fv[:, 0]], xv[fv[:, 1]]
+    c2v, cx = cell_vertices(msh, cells)
+    col = facet_columns(c2v, fv)
+    at = np.arange(len(facets))
+    cell_mid = cx.mean(axis=1)
+    x0, x1 = cx[at, col[:, 0]], cx[at, col[:, 1]]
     t = x1 - x0
     normal = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
     flip = np.einsum("ij,ij->i", normal, 0.5 * (x0 + x1) - cell_mid) < 0
     normal[flip] *= -1
-    blocks = v2b[fv]
+    # For Q1 the dofs of a cell are listed in the order of its vertices.
+    cell_blocks = V.dofmap.list[cells]
+    blocks = np.column_stack([cell_blocks[at, col[:, 0]], cell_blocks[at, col[:, 1]]])
     gblocks = imap.local_to_global(blocks.ravel()).reshape(-1, 2)
     owner = np.concatenate([np.full(nloc, comm.rank, dtype=np.int64), owners_ghost])[blocks]
 

@@ -4,14 +4,18 @@ The elimination itself is `linalg/elimination.py`. The first set builds T^T K T 
 it, with the rigid modes of all bodies (zero on the pivots) as near-nullspace. Later sets
 differ from it by a few pivots, a low-rank change: CG keeps that multigrid and applies the
 new operator matrix-free, from the last displacement, until the pivots have moved too far.
-The loop's solves stop at a loose tolerance (only signs decide the set); the stationary set
-is polished to the final one (`polish`), so the answer does not depend on the loose one.
+The loop's solves stop at a loose tolerance (only signs decide the set): there the loop's
+`stationary` test reads the loose answer inside the CG run (a convergence test), and on a
+stationary set the same run goes on to the final tolerance, so the answer does not depend on
+the loose one and CG keeps its Krylov space (a restarted polish lost it: docs/scale.md,
+"One CG run per stationary set").
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from typing import Any, cast
 
 import numpy as np
@@ -30,7 +34,7 @@ from .nullspace import orthonormalize
 from .petsc_options import PrefixedOptions, global_options, petsc_error_message, reason_name
 from .pivots import Pivots, pivots
 from .policy import Decision, FactorizationPolicy
-from .protocol import SaddleResult
+from .protocol import LoopTest, SaddleResult
 
 # Pivot changes since the multigrid was built (summed over ranks) below which it is reused,
 # or below this fraction of the pivots. Each changed pivot costs the kept cycle about one
@@ -44,11 +48,34 @@ REBUILD_FRACTION = 0.05
 WARM_REDUCTION = 0.1
 
 
+@dataclass
+class _Checkpoint:
+    """The loop's question inside a CG run: asked once, when the residual norm reaches `at`."""
+
+    at: float = 0.0
+    ask: Callable[[PETSc.Vec, int], bool] | None = None  # (iterate, its) -> go on; None: asked
+    go_on: bool = False
+    error: BaseException | None = None
+
+    def test(self, ksp: PETSc.KSP, its: int, rnorm: float) -> int:
+        """A KSP convergence test run before PETSc's default one (0: the default decides)."""
+        ask = self.ask
+        if ask is None or rnorm > self.at:
+            return 0
+        self.ask = None
+        try:
+            self.go_on = ask(ksp.getSolution(), its)
+        except BaseException as err:  # raised again after KSPSolve, on every rank alike
+            self.error = err
+            return int(PETSc.KSP.ConvergedReason.DIVERGED_BREAKDOWN)
+        return 0 if self.go_on else int(PETSc.KSP.ConvergedReason.CONVERGED_RTOL)
+
+
 class CondensedSolver:
     """Solve K u + B^T mu = f, B_A u = -g_A by elimination: a LinearSolver without probes.
 
     `node_dofs` (m, 2): global dofs of each owned row's active node. `rtol`: the final
-    tolerance (`polish`); `loose_rtol`: the relative reduction of the loop's solves.
+    tolerance; `loose_rtol`: the relative reduction of the loop's solves.
     `reuse` False: a throwaway solver (a new preconditioner for every set). `policy`: the
     preconditioner is a factorization, kept while that is cheaper than a new one.
     `free_products`: the preconditioner's setup frees its matrix products' intermediate data
@@ -93,8 +120,10 @@ class CondensedSolver:
         self._setup_options: dict[str, object] = (
             {"mat_product_clear": True} if free_products else {}
         )
+        self._check = _Checkpoint()  # the loop's question during a solve
+        self._tested = False  # its convergence test is in the KSP (petsc4py adds one)
 
-    exact = False  # the loop's solves stop at loose_rtol: a stationary set is polished
+    exact = False  # the loop's solves stop at loose_rtol, a stationary set's go on
     can_probe = False  # no factorization: no exact responses
     cheap_responses = False
 
@@ -104,16 +133,18 @@ class CondensedSolver:
             if obj is not None:
                 obj.destroy()
 
-    def solve(self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False) -> SaddleResult:
+    def solve(
+        self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False, stationary: LoopTest = None
+    ) -> SaddleResult:
         """Displacements and multipliers (owned parts), at the loose tolerance of the loop.
 
-        A throwaway solver (`reuse` False: a reference solve) solves to the final one.
+        With `stationary` the loose answer is asked inside the CG run; where it says True
+        the run goes on to the final tolerance (`final`). A throwaway solver (`reuse`
+        False: a reference solve) solves to the final one.
         """
-        return self._solve(g, active, self._loose_rtol if self.reuse else self._rtol)
-
-    def polish(self, g: np.ndarray, active: np.ndarray, last: SaddleResult) -> SaddleResult:
-        """The same set solved to the final tolerance, from the last (loose) solution."""
-        return self._solve(g, active, self._rtol)
+        if not self.reuse:
+            return self._solve(g, active, self._rtol)
+        return self._solve(g, active, self._loose_rtol, stationary)
 
     def responses(
         self, rhs: np.ndarray, active: np.ndarray, rows: np.ndarray | None = None
@@ -121,12 +152,18 @@ class CondensedSolver:
         """Not available: the condensed solver has no factorization (can_probe is False)."""
         raise SolverError("the condensed solver has no probe responses (it is not a factorization)")
 
-    def _solve(self, g: np.ndarray, active: np.ndarray, rtol: float) -> SaddleResult:
+    def _solve(
+        self,
+        g: np.ndarray,
+        active: np.ndarray,
+        rtol: float,
+        stationary: LoopTest | None = None,
+    ) -> SaddleResult:
         t0 = time.perf_counter()
         nglob = self._K.getSize()[0]
         mask = np.asarray(active, dtype=bool)
         pv = pivots(self._rows, mask, self._mpi, self._r0, nglob)
-        rows, piv, prows = pv.rows, pv.dofs, pv.e_rows
+        piv, prows = pv.dofs, pv.e_rows
         # petsc4py's stubs type indices and values as Sequences; numpy arrays work as well.
         ip: Any = piv.astype(PETSc.IntType)
         # E = T - I: the pivot rows only (T itself would hold a row per dof).
@@ -145,32 +182,41 @@ class CondensedSolver:
         v.setValues(ip, cast(Any, np.zeros(len(piv))))
         v.assemble()
         reuse = self._keeps_multigrid(piv)
-        ksp = self._ksp
+        ksp, check = self._ksp, self._check
+        check.go_on, check.error = False, None
         try:
             with self._options.inserted():  # read lazily at setup and solve (GAMG levels)
                 A = self._operator(reuse, E, d, pv)
                 ksp.getPC().setReusePreconditioner(reuse)
                 ksp.setInitialGuessNonzero(True)
-                ksp.setTolerances(rtol=self._relative_to_b(A, v, b, rtol))
+                loose = self._relative_to_b(A, v, b, rtol)
+                if stationary is not None and loose > self._rtol:
+
+                    def ask(w: PETSc.Vec, its: int) -> bool:
+                        u, mu = self._answer(E, w, t, r, pv, len(active))
+                        return stationary(SaddleResult(u, mu, its, 0, not reuse, final=False))
+
+                    check.at, check.ask = loose * float(cast(Any, b.norm())), ask
+                    loose = self._rtol  # the run's own end; the checkpoint may stop it first
+                ksp.setTolerances(rtol=loose)
                 with global_options({} if reuse else self._setup_options):
                     ksp.setUp()
                 t1 = time.perf_counter()
                 ksp.solve(b, v)
         except PETSc.Error as err:
-            raise SolverError(petsc_error_message(err, "condensed solve")) from None
+            raise check.error or SolverError(petsc_error_message(err, "condensed solve")) from None
+        finally:
+            check.ask = None
         reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
+        if check.error is not None:
+            raise check.error
         if reason <= 0 or not np.isfinite(v.norm()):
             raise SolverError(
                 f"condensed solve ({ksp.getType()}) did not converge: PETSc "
                 f"reason {reason} ({reason_name(reason)}) after {its} iterations"
             )
-        t_mult(E, v, self._u)
-        self._u.axpy(1.0, t)
-        self._K.mult(self._u, r)
-        r.aypx(-1.0, self._f)  # f - K u: the contact force on the pivots
-        mu = np.zeros(len(active))
-        mu[rows] = pv.multipliers(r.getValues(ip))
-        u = self._u.array.copy()
+        final = rtol <= self._rtol or check.go_on
+        u, mu = self._answer(E, v, t, r, pv, len(active))
         t2 = time.perf_counter()
         for obj in (E, d, t, r, b, v):
             obj.destroy()
@@ -181,7 +227,19 @@ class CondensedSolver:
             self.policy.applied(t2 - t1, max(its, 1))
         self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
-        return SaddleResult(u, mu, its, reason, not reuse, -1, 0, t1 - t0, t2 - t1)
+        return SaddleResult(u, mu, its, reason, not reuse, -1, 0, t1 - t0, t2 - t1, final=final)
+
+    def _answer(
+        self, E: PETSc.Mat, v: PETSc.Vec, t: PETSc.Vec, r: PETSc.Vec, pv: Pivots, n: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(u, mu) of the condensed iterate v: u = T v + t, mu from f - K u on the pivots."""
+        t_mult(E, v, self._u)
+        self._u.axpy(1.0, t)
+        self._K.mult(self._u, r)
+        r.aypx(-1.0, self._f)  # f - K u: the contact force on the pivots
+        mu = np.zeros(n)
+        mu[pv.rows] = pv.multipliers(r.getValues(cast(Any, pv.dofs.astype(PETSc.IntType))))
+        return self._u.array.copy(), mu
 
     def _keeps_multigrid(self, piv: np.ndarray) -> bool:
         """Whether the multigrid of an earlier set still preconditions this one.
@@ -216,6 +274,9 @@ class CondensedSolver:
             A.setNearNullSpace(self._near_nullspace(piv))
         ksp.setOperators(A)
         ksp.setFromOptions()
+        if not self._tested:  # before PETSc's default test, once (after the type is set)
+            ksp.addConvergenceTest(cast(Any, self._check.test), prepend=True)
+            self._tested = True
         if self._A is not None:
             self._A.destroy()
         self._A = A

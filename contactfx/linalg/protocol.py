@@ -2,7 +2,8 @@
 
 The loop never asks which solver it has: it asks the solver. `exact` says whether the
 answers are exact solves of the set's system (a factorization) or stop at a loose
-tolerance (then `polish` finishes the set the loop calls stationary); `can_probe` whether
+tolerance (then they ask the loop's `stationary` test and go on to the final one on a
+stationary set); `can_probe` whether
 `responses` (multiplier responses to unit gap openings, the probe step's data) is
 available, and `cheap_responses` whether they cost a few selected entries of the inverse
 rather than one back-substitution per column.
@@ -10,6 +11,7 @@ rather than one back-substitution per column.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -30,6 +32,11 @@ class SaddleResult:
     setup: float = 0.0  # seconds of numeric setup (factorization, multigrid)
     solve: float = 0.0  # seconds of the solve proper
     residual: float | None = None  # relative residual, where the solver measured it
+    final: bool = True  # solved to the final tolerance (False: a loose solve of the loop)
+
+
+# The loop's test of a loose answer (True: the set is stationary, solve on to the end), or None.
+LoopTest = Callable[[SaddleResult], bool] | None
 
 
 class LinearSolver(Protocol):
@@ -37,7 +44,7 @@ class LinearSolver(Protocol):
 
     @property
     def exact(self) -> bool:
-        """Whether `solve` answers exactly (else `polish` must finish a stationary set)."""
+        """Whether `solve` answers exactly (else it asks `stationary` at its loose tolerance)."""
         ...
 
     @property
@@ -50,15 +57,15 @@ class LinearSolver(Protocol):
         """Whether `responses` come from selected entries of the inverse (serial MUMPS)."""
         ...
 
-    def solve(self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False) -> SaddleResult:
+    def solve(
+        self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False, stationary: LoopTest = None
+    ) -> SaddleResult:
         """Solve with the rows of `active` enforced as equalities and mu = 0 elsewhere.
 
-        `fresh`: factorize this very set (what `responses` needs afterwards).
+        `fresh`: factorize this very set (what `responses` needs afterwards). `stationary`:
+        an inexact solver asks it at its loose tolerance and, where it says True, goes on
+        in the same Krylov run to the final one (`final`); exact solvers never call it.
         """
-        ...
-
-    def polish(self, g: np.ndarray, active: np.ndarray, last: SaddleResult) -> SaddleResult:
-        """`last` (a solve of this set) to the final tolerance; `last` itself if exact."""
         ...
 
     def responses(

@@ -26,7 +26,7 @@ from .capacitance import released_solve
 from .mumps import MumpsEstimate, analyze_pc, compressed, petsc_library
 from .petsc_options import PrefixedOptions, petsc_error_message, reason_name
 from .policy import Decision, Factored, FactorizationPolicy
-from .protocol import SaddleResult
+from .protocol import LoopTest, SaddleResult
 from .responses import ResponseCache, dense_responses, local_slice, selected_responses
 
 log = logging.getLogger("contactfx")
@@ -169,10 +169,13 @@ class SaddleSolver:
             ksp.setInitialGuessNonzero(not self.direct)
         self._configured = True
 
-    def solve(self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False) -> SaddleResult:
+    def solve(
+        self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False, stationary: LoopTest = None
+    ) -> SaddleResult:
         """Solve with the rows of `active` enforced as equalities and mu = 0 elsewhere.
 
-        `fresh`: factorize this very set (the probe step's responses need it).
+        `fresh`: factorize this very set (the probe step's responses need it). Exact: it
+        never asks `stationary`.
         """
         active = np.asarray(active, dtype=bool)
         self._m.update(g, active)
@@ -295,10 +298,6 @@ class SaddleSolver:
         return SaddleResult(
             u, mu, applies, 1, False, changed, n_released, 0.0, time.perf_counter() - t0, res
         )
-
-    def polish(self, g: np.ndarray, active: np.ndarray, last: SaddleResult) -> SaddleResult:
-        """Every solve is already final: `last` itself."""
-        return last
 
     def responses(
         self, probes: np.ndarray, active: np.ndarray, rows: np.ndarray | None = None

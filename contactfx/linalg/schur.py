@@ -39,7 +39,7 @@ if TYPE_CHECKING:
 from ..errors import SolverError
 from .blocks import diagonal_matrix
 from .petsc_options import PrefixedOptions, petsc_error_message
-from .protocol import SaddleResult
+from .protocol import LoopTest, SaddleResult
 
 log = logging.getLogger("contactfx")
 
@@ -218,7 +218,9 @@ class SchurSolver:
         w = scipy.linalg.lu_solve(lu, r + self._c)
         return w, lu
 
-    def solve(self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False) -> SaddleResult:
+    def solve(
+        self, g: np.ndarray, active: np.ndarray, *, fresh: bool = False, stationary: LoopTest = None
+    ) -> SaddleResult:
         """The set's solution: a dense solve on the Schur block, u by one solve with the factor."""
         active = np.asarray(active, dtype=bool)
         setup = self._setup()
@@ -241,10 +243,6 @@ class SchurSolver:
         return SaddleResult(
             u, mu, 1, 1, refactored, -1 if refactored else 0, 0, setup, time.perf_counter() - t0
         )
-
-    def polish(self, g: np.ndarray, active: np.ndarray, last: SaddleResult) -> SaddleResult:
-        """Every solve is exact."""
-        return last
 
     def responses(
         self, probes: np.ndarray, active: np.ndarray, rows: np.ndarray | None = None

@@ -12,6 +12,7 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 from dolfinx import fem
@@ -39,7 +40,7 @@ from .solvers import BLR_KEYS, setup_solver
 log = logging.getLogger("contactfx")
 
 # A row that a loose solve adds to a given first set with a penetration c g below this
-# fraction of the largest traction is decided by the polish (`_polish_first`).
+# fraction of the largest traction is decided at the final tolerance (`_stationary`).
 LOOSE_PENETRATION = 0.1
 
 
@@ -118,7 +119,12 @@ class MultiplierIteration:
         comm = self.setup.comm
         g = self.setup.g
         try:
-            res = self.solver.solve(g, active, fresh=self.probe is not None)
+            res = self.solver.solve(
+                g,
+                active,
+                fresh=self.probe is not None,
+                stationary=None if self.solver.exact else partial(self._stationary, active),
+            )
         except EliminationError as err:
             raise InputError(refusal(self.setup, err)) from None
         self._probes = None
@@ -128,12 +134,6 @@ class MultiplierIteration:
             self._probes = self.solver.responses(rhs, active, rhs.any(axis=1))
         lam, gap, new_active = self._update(res.u, res.mu)
         its = res.iterations
-        if not self.solver.exact and self._polish_first(active, new_active, lam, gap):
-            # The loose solve says the set is stationary: only a solve to the final
-            # tolerance may say so (the loop goes on if its signs differ).
-            res = self.solver.polish(g, active, res)
-            lam, gap, new_active = self._update(res.u, res.mu)
-            its += res.iterations
         c, w = self.c, self.setup.w
         ncp = np.where(active, np.minimum(lam, c * gap), np.minimum(0.0, c * gap))
         lam_max = comm.allreduce(float(np.abs(lam).max(initial=0.0)), op=MPI.MAX)
@@ -150,17 +150,18 @@ class MultiplierIteration:
         )
         return Step(lam, gap, new_active, float(resid), record, text)
 
-    def _polish_first(
-        self, active: np.ndarray, new_active: np.ndarray, lam: np.ndarray, gap: np.ndarray
-    ) -> bool:
-        """Whether a loose solve's update waits for the polish (collective).
+    def _stationary(self, active: np.ndarray, loose: SaddleResult) -> bool:
+        """Whether an inexact solver goes on from its loose answer to the final tolerance.
 
-        When it keeps the set, and after a given first set when it only adds rows that
-        penetrate by less than LOOSE_PENETRATION of the largest traction (c g against
-        lambda): from a coarse prediction such a row's sign is within the loose solve's
-        error, and adding it made the exact set cycle; rows that truly enter penetrate
-        several times more (docs/scale.md, "An exact first set").
+        Only a solve to the final tolerance may call a set stationary (the loop goes on if
+        its signs differ). Asked (collectively) when the loose answer keeps the set, and
+        after a given first set when it only adds rows that penetrate by less than
+        LOOSE_PENETRATION of the largest traction (c g against lambda): from a coarse
+        prediction such a row's sign is within the loose solve's error, and adding it made
+        the exact set cycle; rows that truly enter penetrate several times more
+        (docs/scale.md, "An exact first set").
         """
+        lam, gap, new_active = self._update(loose.u, loose.mu)
         comm = self.setup.comm
         entering = new_active & ~active
         added = comm.allreduce(int(entering.sum()))

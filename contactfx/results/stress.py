@@ -12,7 +12,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from ..discretize.elasticity import sigma, sigma_zz
-from ..discretize.mesh_utils import owned_facets, vertex_coordinates, vertex_to_block
+from ..discretize.mesh_utils import cell_vertices, facet_columns, owned_facets
 from ..discretize.thermal import thermal_correction, thermal_zz
 from ..methods.solution import Solution
 from ..scenes import Model
@@ -53,16 +53,17 @@ def _nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np
     values = (
         expr.eval(msh, cells).reshape(len(cells), 4, 2, 2) if len(cells) else np.zeros((0, 4, 2, 2))
     )
-    c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)[cells]
-    xv = vertex_coordinates(msh)
-    v2b = vertex_to_block(el.V)
+    c2v, cx = cell_vertices(msh, cells)
+    cols = facet_columns(c2v, f2v)
+    cell_blocks = el.V.dofmap.list[cells]  # Q1: the cell's dofs in the order of its vertices
     imap = el.V.dofmap.index_map
+    at = np.arange(len(cells))
     nodes, xs, vals = [], [], []
     for k in range(2):
-        col = np.argmax(c2v == f2v[:, [k]], axis=1)
-        nodes.append(imap.local_to_global(v2b[f2v[:, k]].astype(np.int32)))
-        xs.append(xv[f2v[:, k]])
-        vals.append(values[np.arange(len(cells)), col])
+        col = cols[:, k]
+        nodes.append(imap.local_to_global(cell_blocks[at, col].astype(np.int32)))
+        xs.append(cx[at, col])
+        vals.append(values[at, col])
     comm = msh.comm
     gnode = np.concatenate(comm.allgather(np.concatenate(nodes)))
     gx = np.concatenate(comm.allgather(np.concatenate(xs)))

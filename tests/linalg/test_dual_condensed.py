@@ -142,9 +142,9 @@ def test_reused_multigrid_gives_the_fresh_answer(small_hertz) -> None:
     a = small_hertz.params["hertz_exact"]["a"]
     first, second = x < 1.2 * a, x < a
     assert 0 < (first & ~second).sum() <= 64  # within the reuse rule
-    last = solver.solve(setup.g, first)
-    reused = solver.polish(setup.g, second, last)
-    assert not reused.refactored
+    solver.solve(setup.g, first)
+    reused = solver.solve(setup.g, second, stationary=lambda res: True)
+    assert reused.final and not reused.refactored
     _, fresh_solver = _condensed_solver(small_hertz, reuse=False)
     fresh = fresh_solver.solve(setup.g, second)
     assert fresh.refactored
@@ -153,6 +153,41 @@ def test_reused_multigrid_gives_the_fresh_answer(small_hertz) -> None:
     assert np.abs(reused.mu - fresh.mu).max() <= 1e-6 * np.abs(fresh.mu).max()
     solver.destroy()
     fresh_solver.destroy()
+
+
+def test_a_stationary_set_goes_on_in_the_same_cg_run(small_hertz) -> None:
+    """Asked at the loose tolerance, the loop's answer stops CG or lets it go on unrestarted.
+
+    Going on gives the answer of a run restarted from the loose iterate (1e-7) in at most
+    its iterations; the loop is asked once, with the iterate the stopped run returns.
+    """
+    setup, stopped = _condensed_solver(small_hertz)
+    going, failing = (_condensed_solver(small_hertz)[1] for _ in range(2))
+    x = setup.layout.x[setup.layout.mine, 0]
+    zone = x < small_hertz.params["hertz_exact"]["a"]
+    asked: list[np.ndarray] = []
+
+    def no(res) -> bool:
+        asked.append(res.u)
+        return False
+
+    loose = stopped.solve(setup.g, zone, stationary=no)
+    assert not loose.final and len(asked) == 1
+    assert np.array_equal(asked[0], loose.u)
+    restarted = stopped.solve(setup.g, zone, stationary=lambda res: True)
+    on = going.solve(setup.g, zone, stationary=lambda res: True)
+    assert restarted.final and on.final
+    assert on.iterations <= loose.iterations + restarted.iterations
+    assert np.abs(on.u - restarted.u).max() <= 1e-7 * np.abs(restarted.u).max()
+    assert np.abs(on.mu - restarted.mu).max() <= 1e-6 * np.abs(restarted.mu).max()
+
+    def fails(res) -> bool:
+        raise InputError("the loop's own error")
+
+    with pytest.raises(InputError, match="the loop's own error"):  # not a PETSc error
+        failing.solve(setup.g, zone, stationary=fails)
+    for s in (stopped, going, failing):
+        s.destroy()
 
 
 def test_condensed_on_the_default_graded_hertz_mesh() -> None:
@@ -169,12 +204,12 @@ def test_condensed_on_the_default_graded_hertz_mesh() -> None:
     assert all(h["linear_iterations"] > 0 for h in sol.history)
 
 
-def test_loose_solves_then_polish_in_the_log(small_hertz) -> None:
-    """The loop stops its solves early and polishes only the stationary set."""
+def test_loose_solves_then_the_end_in_the_log(small_hertz) -> None:
+    """The loop stops its solves early and solves only the stationary set to the end."""
     sol = solve(small_hertz, "nts", solver="condensed", predictor="none")
     its = [h["linear_iterations"] for h in sol.history]
     assert len(its) >= 2
-    # The last step carries the polish (1e-4 -> 1e-9): more iterations than any loose one.
+    # The last step goes on from 1e-4 to 1e-9: more iterations than any loose one.
     assert its[-1] > max(its[:-1])
 
 

@@ -52,7 +52,7 @@ def test_structured_hertz_first_set_is_the_converged_one(method: str, basis: str
 def test_exact_start_on_gmsh_hertz_does_not_cycle(params: HertzParams) -> None:
     """gmsh Hertz, 136k / 23k DOFs, dual basis: from the exact set a loose solve added a row
     whose penetration is within its error and the next removed it again (a cycle error; the
-    23k one failed so from the former rule's set too); the polish decides it: one solve,
+    23k one failed so from the former rule's set too); the final tolerance decides it: one solve,
     MUMPS' converged set (docs/scale.md, "An exact first set")."""
     scene = hertz(params)
     sol = solve(scene, "mortar", basis="dual", solver="condensed")
