@@ -54,7 +54,7 @@ class _Checkpoint:
 
     at: float = 0.0
     ask: Callable[[PETSc.Vec, int], bool] | None = None  # (iterate, its) -> go on; None: asked
-    go_on: bool = False
+    stopped: bool = False  # the answer was no: the run ended at the loose tolerance
     error: BaseException | None = None
 
     def test(self, ksp: PETSc.KSP, its: int, rnorm: float) -> int:
@@ -64,11 +64,11 @@ class _Checkpoint:
             return 0
         self.ask = None
         try:
-            self.go_on = ask(ksp.getSolution(), its)
+            self.stopped = not ask(ksp.getSolution(), its)
         except BaseException as err:  # raised again after KSPSolve, on every rank alike
             self.error = err
             return int(PETSc.KSP.ConvergedReason.DIVERGED_BREAKDOWN)
-        return 0 if self.go_on else int(PETSc.KSP.ConvergedReason.CONVERGED_RTOL)
+        return int(PETSc.KSP.ConvergedReason.CONVERGED_RTOL) if self.stopped else 0
 
 
 class CondensedSolver:
@@ -157,7 +157,7 @@ class CondensedSolver:
         g: np.ndarray,
         active: np.ndarray,
         rtol: float,
-        stationary: LoopTest | None = None,
+        stationary: LoopTest = None,
     ) -> SaddleResult:
         t0 = time.perf_counter()
         nglob = self._K.getSize()[0]
@@ -183,22 +183,22 @@ class CondensedSolver:
         v.assemble()
         reuse = self._keeps_multigrid(piv)
         ksp, check = self._ksp, self._check
-        check.go_on, check.error = False, None
+        check.stopped, check.error = False, None
         try:
             with self._options.inserted():  # read lazily at setup and solve (GAMG levels)
                 A = self._operator(reuse, E, d, pv)
                 ksp.getPC().setReusePreconditioner(reuse)
                 ksp.setInitialGuessNonzero(True)
-                loose = self._relative_to_b(A, v, b, rtol)
-                if stationary is not None and loose > self._rtol:
+                target = self._relative_to_b(A, v, b, rtol)
+                if stationary is not None and target > self._rtol:
 
                     def ask(w: PETSc.Vec, its: int) -> bool:
                         u, mu = self._answer(E, w, t, r, pv, len(active))
                         return stationary(SaddleResult(u, mu, its, 0, not reuse, final=False))
 
-                    check.at, check.ask = loose * float(cast(Any, b.norm())), ask
-                    loose = self._rtol  # the run's own end; the checkpoint may stop it first
-                ksp.setTolerances(rtol=loose)
+                    check.at, check.ask = target * float(cast(Any, b.norm())), ask
+                    target = self._rtol  # the run's own end; the checkpoint may stop it first
+                ksp.setTolerances(rtol=target)
                 with global_options({} if reuse else self._setup_options):
                     ksp.setUp()
                 t1 = time.perf_counter()
@@ -215,7 +215,7 @@ class CondensedSolver:
                 f"condensed solve ({ksp.getType()}) did not converge: PETSc "
                 f"reason {reason} ({reason_name(reason)}) after {its} iterations"
             )
-        final = rtol <= self._rtol or check.go_on
+        final = target <= self._rtol and not check.stopped
         u, mu = self._answer(E, v, t, r, pv, len(active))
         t2 = time.perf_counter()
         for obj in (E, d, t, r, b, v):

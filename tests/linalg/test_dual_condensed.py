@@ -186,6 +186,8 @@ def test_a_stationary_set_goes_on_in_the_same_cg_run(small_hertz) -> None:
 
     with pytest.raises(InputError, match="the loop's own error"):  # not a PETSc error
         failing.solve(setup.g, zone, stationary=fails)
+    # From a start already at the final tolerance nothing is asked, and the answer is final.
+    assert going.solve(setup.g, zone, stationary=fails).final
     for s in (stopped, going, failing):
         s.destroy()
 
