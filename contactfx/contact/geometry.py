@@ -126,7 +126,7 @@ def _component_labels(n: int, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
     return np.unique(parent, return_inverse=True)[1].reshape(-1)
 
 
-def _incidence(n: int, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
+def incidence(n: int, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
     """(n, 2): the (at most two) segments at each node, -1 where there are fewer."""
     ends = np.concatenate([s0, s1])
     order = np.argsort(ends, kind="stable")
@@ -161,7 +161,7 @@ def chains(surface: Surface) -> Chains:
     key = np.minimum(s0, s1) * n + np.maximum(s0, s1)
     key_order = np.argsort(key, kind="stable")
     label = _component_labels(n, s0, s1)
-    inc = _incidence(n, s0, s1)
+    inc = incidence(n, s0, s1)
     seg_comp = label[s0]
     order, position = np.empty(m, np.int64), np.empty(m, np.int64)
     start, length = np.empty(m, np.int64), np.empty(m, np.int64)

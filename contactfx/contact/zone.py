@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import Surface
+from .geometry import Surface, incidence
 from .search import SegmentSearch
 
 # The two extrapolated zeros of a resolved smooth edge agree within this many elements of
@@ -58,15 +58,11 @@ def edge_distances(
     seg = np.asarray(segments, dtype=np.int64).reshape(-1, 2)
     length = np.linalg.norm(x[seg[:, 1]] - x[seg[:, 0]], axis=1)
     # The other segment through each end of each segment (a polyline: two per node at most).
-    first = np.full(len(x), -1)
-    other = np.full((len(seg), 2), -1)
-    for end in (0, 1):
-        for k, node in enumerate(seg[:, end]):
-            if first[node] < 0:
-                first[node] = k
-            else:
-                other[k, end] = first[node]
-                other[first[node], 0 if seg[first[node], 0] == node else 1] = k
+    inc = incidence(len(x), seg[:, 0], seg[:, 1])
+    k = np.arange(len(seg))
+    other = np.column_stack(
+        [np.where(inc[seg[:, e], 0] == k, inc[seg[:, e], 1], inc[seg[:, e], 0]) for e in (0, 1)]
+    )
     on = np.append(np.asarray(active, dtype=bool), False)  # index -1: no node
     q = np.append(np.asarray(p, dtype=float), 0.0) ** 2
     xx = np.vstack([x, np.zeros((1, 2))])

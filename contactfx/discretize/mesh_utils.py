@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dolfinx.mesh
 import numpy as np
 from dolfinx import fem
 
@@ -41,19 +40,22 @@ def owned_facets(scene: Scene, name: str) -> np.ndarray:
     return facets[facets < msh.topology.index_map(tdim - 1).size_local]
 
 
-def cell_vertices(msh: dolfinx.mesh.Mesh, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices (n, 4) of `cells` and their coordinates (n, 4, 2).
+def facet_ends(
+    V: fem.FunctionSpace, cells: np.ndarray, f2v: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Boundary facets' two ends, read from their cells only (Q1 quadrilaterals).
 
-    Only these cells are read: a surface's few thousand, not every vertex of the mesh (that
-    cost seconds per call at 10M DOFs: docs/scale.md, "One CG run per stationary set").
+    `cells` (n,): each facet's cell; `f2v` (n, 2): its vertices. Returns the cells' vertex
+    coordinates (n, 4, 2), each end's column in its cell (n, 2), the ends' coordinates
+    (n, 2, 2) and local dof blocks (n, 2). Only these cells are read, not every vertex of
+    the mesh (docs/scale.md, "One CG run per stationary set").
     """
+    msh = V.mesh
     tdim = msh.topology.dim
     msh.topology.create_connectivity(tdim, 0)
     c2v = msh.topology.connectivity(tdim, 0).array.reshape(-1, 4)[cells]
-    # Q1 geometry: the cell's geometry nodes are its vertices, in the same order.
-    return c2v, msh.geometry.x[msh.geometry.dofmaps[0][cells], :2]
-
-
-def facet_columns(c2v: np.ndarray, f2v: np.ndarray) -> np.ndarray:
-    """For each facet (its two vertices `f2v`) the columns of its vertices in its cell's `c2v`."""
-    return np.column_stack([np.argmax(c2v == f2v[:, [k]], axis=1) for k in range(2)])
+    # Q1: the cell's geometry nodes and its dofs are listed in the order of its vertices.
+    cx = msh.geometry.x[msh.geometry.dofmaps[0][cells], :2]
+    cols = np.column_stack([np.argmax(c2v == f2v[:, [k]], axis=1) for k in range(2)])
+    at = np.arange(len(cells))[:, None]
+    return cx, cols, cx[at, cols], V.dofmap.list[cells][at, cols]

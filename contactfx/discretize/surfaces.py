@@ -12,7 +12,7 @@ from ..contact.geometry import nodal_normals, segment_lengths
 from ..contact.search import project
 from ..errors import GeometryError, MeshError
 from ..scenes import Model, Scene
-from .mesh_utils import cell_vertices, facet_columns, owned_facets
+from .mesh_utils import facet_ends, owned_facets
 
 
 @dataclass(frozen=True)
@@ -40,18 +40,13 @@ def gather_surface(scene: Scene, V: fem.FunctionSpace, name: str) -> GatheredSur
 
     fv = f2v.array.reshape(-1, 2)[facets]
     cells = f2c.array[f2c.offsets[facets]]
-    c2v, cx = cell_vertices(msh, cells)
-    col = facet_columns(c2v, fv)
-    at = np.arange(len(facets))
+    cx, _, ends, blocks = facet_ends(V, cells, fv)
     cell_mid = cx.mean(axis=1)
-    x0, x1 = cx[at, col[:, 0]], cx[at, col[:, 1]]
+    x0, x1 = ends[:, 0], ends[:, 1]
     t = x1 - x0
     normal = np.column_stack([t[:, 1], -t[:, 0]]) / np.linalg.norm(t, axis=1)[:, None]
     flip = np.einsum("ij,ij->i", normal, 0.5 * (x0 + x1) - cell_mid) < 0
     normal[flip] *= -1
-    # For Q1 the dofs of a cell are listed in the order of its vertices.
-    cell_blocks = V.dofmap.list[cells]
-    blocks = np.column_stack([cell_blocks[at, col[:, 0]], cell_blocks[at, col[:, 1]]])
     gblocks = imap.local_to_global(blocks.ravel()).reshape(-1, 2)
     owner = np.concatenate([np.full(nloc, comm.rank, dtype=np.int64), owners_ghost])[blocks]
 

@@ -117,6 +117,7 @@ def coupling(
         e for part in comm.allgather([(r0 + r, c, v) for r, (c, v) in prows.items()]) for e in part
     ]
     e_rows = {int(p): (c, v) for p, c, v in every}
+    pivot_ids = np.fromiter(e_rows, dtype=np.int64, count=len(e_rows))
     ii: list[np.ndarray] = []
     jj: list[np.ndarray] = []
     vv: list[np.ndarray] = []
@@ -129,12 +130,13 @@ def coupling(
         ii += [rows, cols]
         jj += [cols, rows]
         vv += [etk, etk]
-        for q, kq in zip(kc, kv, strict=True):
-            e = e_rows.get(int(q))
-            if e is not None:  # K[p, q] couples two pivots: (E^T K E)[c, c_q]
-                ii.append(np.repeat(c, len(e[0])))
-                jj.append(np.tile(e[0], len(c)))
-                vv.append(np.outer(v, kq * e[1]).ravel())
+        # K[p, q] couples two pivots (a few of a row's columns): (E^T K E)[c, c_q].
+        hit = np.isin(kc, pivot_ids)
+        for q, kq in zip(kc[hit], kv[hit], strict=True):
+            cq, vq = e_rows[int(q)]
+            ii.append(np.repeat(c, len(cq)))
+            jj.append(np.tile(cq, len(c)))
+            vv.append(np.outer(v, kq * vq).ravel())
     if not ii:
         return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
     return np.concatenate(ii), np.concatenate(jj), np.concatenate(vv)

@@ -73,13 +73,22 @@ class SetHistory:
         return out
 
     def visit(self, active: np.ndarray, it: int, n_active: int, probing: bool) -> None:
-        """Record a set about to be solved; raise if it was solved before (a cycle)."""
+        """A set about to be solved; raise if a final answer was given on it before (a cycle)."""
         key = self.to_global(active).tobytes()
         repeat = probing and key == self.last  # the same set again, now with probes
         self.last = key
         if key in self.seen and not repeat:
             raise ActiveSetError(f"active set cycles at iteration {it} ({n_active} active nodes)")
-        self.seen.add(key)
+
+    def settle(self) -> None:
+        """The set visited last got a final answer: meeting it again is a cycle.
+
+        A loose answer (an inexact solver's, `Step.final` False) does not settle its set:
+        its signs may be wrong within its error, so the loop may come back to that set (a
+        loose solve released a row of an exact predicted set; the next step's final answer
+        took it back: docs/scale.md, "One CG run per stationary set").
+        """
+        self.seen.add(self.last)
 
     def global_indices(self, local_mask: np.ndarray) -> np.ndarray:
         """Global multiplier indices of a local row mask."""
@@ -153,6 +162,7 @@ class Step:
     residual: float  # relative complementarity residual (0 where not defined)
     record: dict[str, float] = field(default_factory=dict)  # extra history columns
     text: str = ""  # extra words for the log line
+    final: bool = True  # the solve reached the final tolerance (not a loop's loose answer)
 
 
 @dataclass(frozen=True)
@@ -219,6 +229,8 @@ def run_active_set(
         t0 = time.perf_counter()
         with timers("solve"):
             step = iteration.solve(active, it)
+        if step.final:
+            state.settle()
         t_solve = time.perf_counter() - t0
         resid = step.residual
         entered = comm.allreduce(int(np.sum(step.new_active & ~active)))

@@ -148,7 +148,7 @@ class MultiplierIteration:
         text = f"complementarity {resid:.2e}, {its} linear its, " + (
             f"{n_probes} probes, " if n_probes else ""
         )
-        return Step(lam, gap, new_active, float(resid), record, text)
+        return Step(lam, gap, new_active, float(resid), record, text, res.final)
 
     def _stationary(self, active: np.ndarray, loose: SaddleResult) -> bool:
         """Whether an inexact solver goes on from its loose answer to the final tolerance.

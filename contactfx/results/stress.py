@@ -12,7 +12,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from ..discretize.elasticity import sigma, sigma_zz
-from ..discretize.mesh_utils import cell_vertices, facet_columns, owned_facets
+from ..discretize.mesh_utils import facet_ends, owned_facets
 from ..discretize.thermal import thermal_correction, thermal_zz
 from ..methods.solution import Solution
 from ..scenes import Model
@@ -53,17 +53,14 @@ def _nodal_stress(sol: Solution, group: str) -> tuple[np.ndarray, np.ndarray, np
     values = (
         expr.eval(msh, cells).reshape(len(cells), 4, 2, 2) if len(cells) else np.zeros((0, 4, 2, 2))
     )
-    c2v, cx = cell_vertices(msh, cells)
-    cols = facet_columns(c2v, f2v)
-    cell_blocks = el.V.dofmap.list[cells]  # Q1: the cell's dofs in the order of its vertices
+    _, cols, ends, blocks = facet_ends(el.V, cells, f2v)
     imap = el.V.dofmap.index_map
     at = np.arange(len(cells))
     nodes, xs, vals = [], [], []
     for k in range(2):
-        col = cols[:, k]
-        nodes.append(imap.local_to_global(cell_blocks[at, col].astype(np.int32)))
-        xs.append(cx[at, col])
-        vals.append(values[at, col])
+        nodes.append(imap.local_to_global(blocks[:, k].astype(np.int32)))
+        xs.append(ends[:, k])
+        vals.append(values[at, cols[:, k]])
     comm = msh.comm
     gnode = np.concatenate(comm.allgather(np.concatenate(nodes)))
     gx = np.concatenate(comm.allgather(np.concatenate(xs)))

@@ -51,9 +51,10 @@ def _first_step_iterations(sol) -> int:
 def test_low_rank_gives_the_full_rank_answer(scene, full, tolerance, caplog) -> None:
     """BLR at the preset's threshold and at a deliberately loose one: the full-rank answer.
 
-    At 1e-8 the compressed factors need GMRES iterations that exact ones do not (the
-    full-rank step takes one back-substitution; GMRES from zero on exact factors two). At
-    1e-2 GMRES does not converge on them: the solver refactors at full rank, and says so.
+    At 1e-8 no single back-substitution with the compressed factors is accepted (the
+    full-rank step takes one): GMRES runs (its count depends on the compression, so only
+    "more than one" is asserted). At 1e-2 GMRES does not converge on
+    them: the solver refactors at full rank, and says so.
     """
     spec = replace(SOLVERS["mumps-blr"], low_rank=LowRank(0, tolerance))
     with caplog.at_level("INFO", logger="contactfx"):
@@ -63,7 +64,7 @@ def test_low_rank_gives_the_full_rank_answer(scene, full, tolerance, caplog) -> 
     fell_back = "GMRES on the factorization failed" in caplog.text
     assert fell_back is (tolerance == 1e-2)
     if not fell_back:
-        assert _first_step_iterations(sol) > 2
+        assert _first_step_iterations(sol) > 1
 
 
 def test_low_rank_by_petsc_options_is_refined_too(scene, full) -> None:
@@ -71,7 +72,7 @@ def test_low_rank_by_petsc_options_is_refined_too(scene, full) -> None:
     spec = SOLVERS["mumps"].with_petsc(["mat_mumps_icntl_35=2", "mat_mumps_cntl_7=1e-6"])
     sol = solve(scene, "mortar", solver=spec)
     _same_answer(sol, full)
-    assert _first_step_iterations(sol) > 2
+    assert _first_step_iterations(sol) > 1  # GMRES, not one back-substitution
 
 
 def test_a_throwaway_solver_on_compressed_factors_runs_gmres(scene) -> None:
@@ -104,7 +105,7 @@ def test_a_throwaway_solver_on_compressed_factors_runs_gmres(scene) -> None:
     # orders of magnitude above it (docs/scale.md, "Block low-rank factorization").
     assert residual["blr"] <= 10.0 * residual["full"]
     assert residual["single"] >= 1e4 * residual["blr"]
-    assert results["blr"].iterations > 2
+    assert results["blr"].iterations > 1
     dmu = np.abs(results["blr"].mu - results["full"].mu).max()
     assert dmu <= 1e-8 * np.abs(results["full"].mu).max()
     setup.destroy()
