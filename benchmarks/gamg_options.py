@@ -139,6 +139,26 @@ ROUND2: dict[str, dict[str, object]] = {
     "icc3-thr0.02c": {"pc_gamg_threshold": "0.05,0.02,0.02,0.02,0.02,0.02,0.02,0.02,0.02"},
 }
 SETS.update({name: {**ICC3, **extra} for name, extra in ROUND2.items()})
+# Issue 33's third round: the smoother's Krylov method and steps on the 0.7.0 preset
+# (ICC(0), threshold 0.05, two aggressive levels by minimum-degree MIS, 4 Chebyshev steps).
+PRESET: dict[str, object] = {
+    **ICC3,
+    "pc_gamg_aggressive_coarsening": 2,
+    "pc_gamg_mis_k_minimum_degree_ordering": True,
+    "mg_levels_ksp_max_it": 4,
+}
+ROUND3: dict[str, dict[str, object]] = {
+    "p-rich1": {"mg_levels_ksp_type": "richardson", "mg_levels_ksp_max_it": 1},
+    "p-rich2": {"mg_levels_ksp_type": "richardson", "mg_levels_ksp_max_it": 2},
+    "p-rich3": {"mg_levels_ksp_type": "richardson", "mg_levels_ksp_max_it": 3},
+    "p-w": {"pc_mg_cycle_type": "w"},
+    "p-w-it2": {"pc_mg_cycle_type": "w", "mg_levels_ksp_max_it": 2},
+    "p-w-it3": {"pc_mg_cycle_type": "w", "mg_levels_ksp_max_it": 3},
+    "p-it2": {"mg_levels_ksp_max_it": 2},
+    "p-it3": {"mg_levels_ksp_max_it": 3},
+    "p-cheb6": {"mg_levels_ksp_max_it": 6},
+}
+SETS.update({name: {**PRESET, **extra} for name, extra in ROUND3.items()})
 
 
 def spec_for(name: str) -> SolverSpec:

@@ -3,11 +3,12 @@
 The factorized system with its gap right-hand sides shifted by s on the released rows R has
 the same u as the new one as soon as mu_R = 0, and mu_R = mu_R(0) + M s with M the
 multiplier responses of R to unit shifts (kept from the probe step, else one multi-RHS
-solve). Starting from every row, mu_R(0) is large (far rows pulled shut) and the shift that
-cancels it can leave a relative residual of ~1e-7 (600k DOFs; 4e-8 for the factorized set's
-own solve): up to two steps of iterative refinement, each the same capacitance solve (two
-back-substitutions) on the residual, bring it to RELEASED_RTOL or the factorized set's own
-level; if not, the caller refactors.
+solve). The answer is accepted where its relative residual is within ROUNDOFF times that of
+the factorized set's own back-substitution (or below RELEASED_RTOL): as accurate as a fresh
+factorization of the new set, solved once. Starting from every row, mu_R(0) is large (far
+rows pulled shut) and the shift that cancels it can leave more: up to two steps of iterative
+refinement, each the same capacitance solve (two back-substitutions) on the residual; if
+that is not enough, the caller refactors.
 """
 
 from __future__ import annotations
@@ -24,9 +25,12 @@ from .responses import local_slice
 
 log = logging.getLogger("contactfx")
 
-# A capacitance solve is refined while its relative residual exceeds this or, if larger, that
-# of the factorization's own back-substitution (MUMPS' accuracy on these saddle points).
+# A capacitance solve is refined while its relative residual exceeds this or, if larger,
+# ROUNDOFF times that of the factorization's own back-substitution (MUMPS' accuracy on these
+# saddle points). Within it the answer is as far from the exact one as a fresh factorization's
+# single back-substitution of the same set: docs/scale.md, "The release step's refinement".
 RELEASED_RTOL = 1e-8
+ROUNDOFF = 2.0
 # Refinement steps before giving up (each costs two back-substitutions).
 REFINEMENTS = 2
 # With approximate (block low-rank) factors each step gains about their accuracy.
@@ -108,7 +112,7 @@ def released_solve(
     b.array[rows_l] = np.where(factored, -g, 0.0)
     applies = 1
     steps = REFINEMENTS if target is None else APPROX_REFINEMENTS
-    target = max(RELEASED_RTOL, floor) if target is None else target
+    target = max(RELEASED_RTOL, ROUNDOFF * floor) if target is None else target
     try:
         if first is not None:
             x.array[:] = first

@@ -22,7 +22,7 @@ from petsc4py import PETSc
 
 from ..errors import SolverError
 from .blocks import SaddleBlocks
-from .capacitance import released_solve
+from .capacitance import ROUNDOFF, released_solve
 from .mumps import MumpsEstimate, analyze_pc, compressed, petsc_library
 from .petsc_options import PrefixedOptions, petsc_error_message, reason_name
 from .policy import Decision, Factored, FactorizationPolicy
@@ -43,7 +43,6 @@ _APPLY_RTOL = 1e-7
 # back-substitution's does, at round-off), on a fresh or a lagged factorization
 # (docs/scale.md, "Block low-rank factorization").
 APPROX_RTOL = 1e-13
-_ROUNDOFF = 2.0  # a capacitance solve on them: to this multiple of its true residual
 # GMRES around the factorization: one iteration with a fresh one, a few with a lagged one
 # (the change is low-rank); right preconditioning tests the true residual, modified
 # Gram-Schmidt keeps the basis orthogonal down to round-off.
@@ -288,7 +287,7 @@ class SaddleSolver:
             self.factored.solution_for(g),
             self.factored.own_residual,
             # Approximate factors: to their fresh GMRES solve's round-off, not their own.
-            _ROUNDOFF * self.factored.own_residual if self.approximate else None,
+            ROUNDOFF * self.factored.own_residual if self.approximate else None,
         )
         if done is None:
             return None

@@ -107,6 +107,37 @@ def test_released_rows_use_capacitance(hertz_system) -> None:
         assert np.all(res.mu[~(x < 1.2)] == 0.0)
 
 
+def test_an_inexact_capacitance_answer_is_refined(hertz_system, monkeypatch) -> None:
+    """A capacitance matrix off by 1e-4 leaves a residual far above the factorization's own:
+    the refinement runs (two back-substitutions per step) and ends at the fresh solve.
+
+    Without the error the first answer is accepted after one back-substitution (its residual
+    within ROUNDOFF x the factorization's own)."""
+    from contactfx.linalg import capacitance
+
+    el, B, g, x = hertz_system
+    iterations = []
+    for skew in (1.0, 1.0 + 1e-4):
+
+        class Skewed(capacitance.DenseLU):
+            factor = skew
+
+            def __init__(self, a: np.ndarray) -> None:
+                super().__init__(a * self.factor)
+
+        monkeypatch.setattr(capacitance, "DenseLU", Skewed)
+        with _saddle(el, B, FactorizationPolicy()) as solver:
+            solver.solve(g, x < 2.0)
+            res = solver.solve(g, x < 1.2)
+            assert res.released > 0 and solver.factored.count == 1
+            floor = solver.factored.own_residual
+            assert res.residual is not None
+            assert res.residual <= max(capacitance.RELEASED_RTOL, capacitance.ROUNDOFF * floor)
+            _close(res, _fresh(el, B, g, x < 1.2))
+            iterations.append(res.iterations)
+    assert iterations[0] == 1 and iterations[1] in (3, 5), iterations
+
+
 def test_near_nullspace_is_the_kernel_of_free_bodies() -> None:
     """The three joint rigid modes: orthonormal, K v = 0 without Dirichlet rows, and the
     span of the translations and the rotation written from the dof coordinates."""
