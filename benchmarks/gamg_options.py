@@ -62,6 +62,7 @@ ICC = {"mg_levels_pc_type": "bjacobi", "mg_levels_sub_pc_type": "icc"}
 SETS: dict[str, dict[str, object]] = {
     "base": {},
     "chosen": {},
+    "gamg": {},
     "thr0": {"pc_gamg_threshold": 0.0},
     "thr0.02": {"pc_gamg_threshold": 0.02},
     "thr0.05": {"pc_gamg_threshold": 0.05},
@@ -162,11 +163,15 @@ SETS.update({name: {**PRESET, **extra} for name, extra in ROUND3.items()})
 
 
 def spec_for(name: str) -> SolverSpec:
-    """The condensed preset as it is (`chosen`), or its former options with SETS[name]."""
+    """The condensed preset as it is (`chosen`), `condensed-gamg` (`gamg`), or GAMG with the
+    former options and SETS[name]."""
     preset = SOLVERS["condensed"]
     if name == "chosen":
-        return preset
-    return replace(preset, petsc={**BASE, **SETS[name]}, name=f"condensed-{name}")
+        return preset  # on the structured mesh: its geometric multigrid
+    if name == "gamg":
+        return SOLVERS["condensed-gamg"]
+    # GAMG with these options on every mesh (no geometric levels).
+    return replace(preset, petsc={**BASE, **SETS[name]}, name=f"condensed-{name}", geometric=None)
 
 
 def split_global(spec: SolverSpec) -> tuple[SolverSpec, dict[str, object]]:

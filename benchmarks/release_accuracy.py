@@ -3,7 +3,7 @@ refinement").
 
 `[mpirun -n R] python benchmarks/release_accuracy.py REFINE [MESH]`: the Hertz scene (mortar,
 `mumps`, default grading) solved three times in one process with `--reference-timing`:
-the loop as it is; the loop with every release step refined as before 0.8.2 (to the
+the loop as it is; the loop with every release step refined as before 0.9.0 (to the
 factorization's own residual, ROUNDOFF = 1); and once more with the reference solve by
 GMRES to 1e-15 around the fresh LDL^T (the accurate answer of the final set). Prints the
 largest difference of u and mu from the accurate answer, relative to its largest entry, for

@@ -15,6 +15,7 @@ from typing import Self
 
 from .contact import Kernel
 from .errors import InputError
+from .option_sets import GAMG, GEOMETRIC_MG, MUMPS_LDLT, MUMPS_LU
 
 
 def _unknown(enum: type[StrEnum], value: object, what: str) -> InputError:
@@ -192,6 +193,9 @@ class SolverSpec:
     schur: SchurPre | None = None
     free_products: bool = False  # GAMG's setup frees its products' data (methods/solvers.py)
     low_rank: LowRank | None = None  # a direct solver's BLR factorization (methods/solvers.py)
+    # A condensed solver's options where the scene's mesh brings its own coarser grids
+    # (Scene.grid: a geometric multigrid); None: `petsc` (GAMG) on every mesh.
+    geometric: Mapping[str, object] | None = None
 
     def __post_init__(self) -> None:
         self._check()
@@ -248,6 +252,7 @@ class SolverSpec:
         for a fieldsplit pc_fieldsplit_schur_precondition sets `schur`.
         """
         petsc = dict(self.petsc)
+        geometric = None if self.geometric is None else dict(self.geometric)
         rtol, schur = self.rtol, self.schur
         for item in items:
             key, sep, value = item.partition("=")
@@ -267,36 +272,27 @@ class SolverSpec:
                 except ValueError:
                     raise _unknown(SchurPre, value, SCHUR_KEY) from None
             petsc[key] = value
+            if geometric is not None and not key.startswith(("pc_type", "pc_gamg")):
+                geometric[key] = value  # e.g. the smoother's steps: both multigrids
         if self.kind is SolverKind.FIELDSPLIT:
             petsc.pop(SCHUR_KEY, None)
-        return replace(self, petsc=petsc, rtol=rtol, schur=schur)
+        return replace(self, petsc=petsc, rtol=rtol, schur=schur, geometric=geometric)
 
-
-_MUMPS_LU: dict[str, object] = {
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-    # The ordering (ICNTL(7)) is chosen by size in methods/solvers.py. CNTL(1) = 0.1 (default
-    # 0.01): AMD's LDL^T is as accurate as LU then (docs/scale.md, "The ordering rule").
-    "mat_mumps_cntl_1": 0.1,
-}
-# The saddle point is symmetric (indefinite): LDL^T (docs/scale.md, "Symmetric default").
-_MUMPS_LDLT: dict[str, object] = {**_MUMPS_LU, "pc_type": "cholesky"}
 
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
     {
-        "auto": SolverSpec(SolverKind.AUTO, _MUMPS_LDLT, name="auto"),  # docs/scale.md
-        "mumps": SolverSpec(SolverKind.DIRECT, _MUMPS_LDLT, name="mumps"),
-        "mumps-lu": SolverSpec(SolverKind.DIRECT, _MUMPS_LU, name="mumps-lu"),
+        "auto": SolverSpec(SolverKind.AUTO, MUMPS_LDLT, name="auto"),  # docs/scale.md
+        "mumps": SolverSpec(SolverKind.DIRECT, MUMPS_LDLT, name="mumps"),
+        "mumps-lu": SolverSpec(SolverKind.DIRECT, MUMPS_LU, name="mumps-lu"),
         # Opt-in: MUMPS' block low-rank LDL^T, every solve refined by GMRES to full-rank
         # accuracy (docs/scale.md, "Block low-rank factorization").
         "mumps-blr": SolverSpec(
-            SolverKind.DIRECT, _MUMPS_LDLT, name="mumps-blr", low_rank=LowRank()
+            SolverKind.DIRECT, MUMPS_LDLT, name="mumps-blr", low_rank=LowRank()
         ),
         # Opt-in (docs/scale.md, "The Schur route, measured"): MUMPS' Schur complement of
         # every multiplier row, one factorization, each set a dense solve. Serial only: on
         # several ranks the `mumps` path runs instead.
-        "mumps-schur": SolverSpec(SolverKind.DIRECT_SCHUR, _MUMPS_LDLT, name="mumps-schur"),
+        "mumps-schur": SolverSpec(SolverKind.DIRECT_SCHUR, MUMPS_LDLT, name="mumps-schur"),
         # Schur fieldsplit, A00 = K + gamma B^T B factorized by MUMPS, S by Jacobi-GMRES.
         "fieldsplit": SolverSpec(
             SolverKind.FIELDSPLIT,
@@ -344,28 +340,26 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
             schur=SchurPre.USER,
         ),
         # Multipliers eliminated (D diagonal: NTS or dual mortar), CG on the SPD displacement
-        # system, GAMG (two levels of aggressive coarsening) with the bodies' rigid modes; the
-        # loop's solves only need signs (loose_rtol, docs/condensed.md).
+        # system, GAMG (two levels of aggressive coarsening) with the bodies' rigid modes, or
+        # a geometric multigrid where the mesh is a structured grid; the loop's solves only
+        # need signs (loose_rtol, docs/condensed.md).
         "condensed": SolverSpec(
             SolverKind.CONDENSED,
-            {
-                "ksp_type": "cg",
-                "ksp_norm_type": "unpreconditioned",
-                "ksp_max_it": 5000,
-                "pc_type": "gamg",
-                # docs/scale.md, "GAMG on stretched cells", "Setup cost and growth": ICC(0)
-                # smooths along stretched cells; 2 aggressive levels cheapen the coarse products.
-                "pc_gamg_threshold": 0.05,
-                "pc_gamg_aggressive_coarsening": 2,
-                "pc_gamg_mis_k_minimum_degree_ordering": True,
-                "mg_levels_pc_type": "bjacobi",
-                "mg_levels_sub_pc_type": "icc",
-                "mg_levels_ksp_max_it": 4,
-            },
+            GAMG,
             rtol=1e-9,
             loose_rtol=1e-4,
             name="condensed",
             free_products=True,  # never reused: docs/scale.md, "Memory of the condensed path"
+            geometric=GEOMETRIC_MG,
+        ),
+        # The same with GAMG on every mesh (the structured grid's levels unused).
+        "condensed-gamg": SolverSpec(
+            SolverKind.CONDENSED,
+            GAMG,
+            rtol=1e-9,
+            loose_rtol=1e-4,
+            name="condensed-gamg",
+            free_products=True,
         ),
         # The same condensed system factorized: MUMPS Cholesky (SPD, SYM=1). Later sets run CG
         # preconditioned by the kept factorization (a low-rank change: a few iterations)

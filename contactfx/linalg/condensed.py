@@ -1,9 +1,11 @@
-"""The condensed solver: the active multipliers eliminated, CG + GAMG on the displacements.
+"""The condensed solver: the active multipliers eliminated, CG + multigrid on the displacements.
 
 The elimination itself is `linalg/elimination.py`. The first set builds T^T K T and GAMG on
 it, with the rigid modes of all bodies (zero on the pivots) as near-nullspace. Later sets
 differ from it by a few pivots, a low-rank change: CG keeps that multigrid and applies the
 new operator matrix-free, from the last displacement, until the pivots have moved too far.
+Given the prolongations of the mesh's own coarser grids (a structured grid), PCMG on them
+with Galerkin coarse operators replaces GAMG; its setup is cheap, so every set rebuilds it.
 The loop's solves stop at a loose tolerance (only signs decide the set): there the loop's
 `stationary` test reads the loose answer inside the CG run (a convergence test), and on a
 stationary set the same run goes on to the final tolerance, so the answer does not depend on
@@ -80,6 +82,7 @@ class CondensedSolver:
     preconditioner is a factorization, kept while that is cheaper than a new one.
     `free_products`: the preconditioner's setup frees its matrix products' intermediate data
     (PETSc's unprefixed mat_product_clear: GAMG's products carry no prefix).
+    `interpolations`: a PCMG's prolongations, finest first (owned); None: GAMG's own.
     """
 
     def __init__(
@@ -96,6 +99,7 @@ class CondensedSolver:
         reuse: bool = True,
         policy: FactorizationPolicy | None = None,
         free_products: bool = False,
+        interpolations: list[PETSc.Mat] | None = None,
     ) -> None:
         self._K, self._f = K, f
         self._comm = K.getComm()
@@ -121,6 +125,7 @@ class CondensedSolver:
             {"mat_product_clear": True} if free_products else {}
         )
         self._check = _Checkpoint()  # the loop's question during a solve
+        self._interp = interpolations or []  # a geometric multigrid's, finest first
         self._tested = False  # its convergence test is in the KSP (petsc4py adds one)
 
     exact = False  # the loop's solves stop at loose_rtol, a stationary set's go on
@@ -129,7 +134,7 @@ class CondensedSolver:
 
     def destroy(self) -> None:
         """Free the PETSc objects."""
-        for obj in (self._ksp, self._u, self._diag, self._A):
+        for obj in (self._ksp, self._u, self._diag, self._A, *self._interp):
             if obj is not None:
                 obj.destroy()
 
@@ -249,8 +254,8 @@ class CondensedSolver:
         in more than max(REBUILD_FRACTION of the set, REBUILD_CHANGES) places.
         """
         prev = self._built_for
-        if not self.reuse or prev is None:
-            return False
+        if not self.reuse or prev is None or self._interp:
+            return False  # a geometric multigrid's setup costs a few CG iterations: rebuilt
         changed = self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
         if self.policy is not None:
             return self.policy.decide(changed, False, release=False) is Decision.LAGGED
@@ -272,6 +277,8 @@ class CondensedSolver:
         A = condensed_matrix(self._K, pv.e_rows, self._r0, piv, self._diag)
         if self._modes:
             A.setNearNullSpace(self._near_nullspace(piv))
+        if self._interp:  # before the operators: a rebuild resets the PC
+            _geometric_levels(ksp.getPC(), self._interp, piv)
         ksp.setOperators(A)
         ksp.setFromOptions()
         if not self._tested:  # before PETSc's default test, once (after the type is set)
@@ -316,3 +323,28 @@ class CondensedSolver:
         for w in modes:
             w.destroy()
         return nsp
+
+
+def _geometric_levels(pc: PETSc.PC, interp: list[PETSc.Mat], piv: np.ndarray) -> None:
+    """PCMG on the given prolongations (finest first), the pivots' rows of the finest zero.
+
+    The pivots are decoupled rows of T^T K T + P: the coarse grids must not correct them.
+    """
+    fine = interp[0].copy()
+    keep = fine.createVecLeft()
+    keep.set(1.0)
+    keep.setValues(cast(Any, piv.astype(PETSc.IntType)), cast(Any, np.zeros(len(piv))))
+    keep.assemble()
+    fine.diagonalScale(L=keep)
+    keep.destroy()
+    n = len(interp) + 1
+    if pc.getType() == PETSc.PC.Type.MG:
+        # A rebuild: the Galerkin products start afresh (their data was freed: free_products).
+        pc.reset()
+    else:
+        pc.setType(PETSc.PC.Type.MG)
+    if pc.getMGLevels() != n:
+        pc.setMGLevels(n)
+    for level, P in enumerate([fine, *interp[1:]]):
+        pc.setMGInterpolation(n - 1 - level, P)  # PETSc's level 0 is the coarsest
+    fine.destroy()

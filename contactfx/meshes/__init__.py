@@ -7,7 +7,19 @@ ValueError for bad parameters.
 """
 
 from .blocks import build_blocks
+from .grid_levels import Level, grid_levels
 from .hertz import QUAD4, build_hertz
-from .hertz_structured import GridPart, hertz_grid, hertz_grid_part
+from .hertz_structured import GridLines, GridPart, grid_lines, hertz_grid, hertz_grid_part
 
-__all__ = ["QUAD4", "GridPart", "build_blocks", "build_hertz", "hertz_grid", "hertz_grid_part"]
+__all__ = [
+    "QUAD4",
+    "GridLines",
+    "GridPart",
+    "Level",
+    "build_blocks",
+    "build_hertz",
+    "grid_levels",
+    "grid_lines",
+    "hertz_grid",
+    "hertz_grid_part",
+]

@@ -177,18 +177,8 @@ def _disc(ln: _Lines) -> tuple[np.ndarray, np.ndarray]:
 
     pa = patch(ln.a_curves, ln.a_corners, u)
     pb = patch(ln.b_curves, ln.b_corners, w)
-    nu, nv, nw = len(u) - 1, len(v) - 1, len(w) - 1
-    ida = np.arange((nu + 1) * (nv + 1)).reshape(nu + 1, nv + 1)
-    n = ida.size
-    idb = np.empty((nw + 1, nv + 1), dtype=np.int64)
-    idb[0] = ida[nu]
-    idb[1:] = n + np.arange(nw * (nv + 1)).reshape(nw, nv + 1)
-    n += nw * (nv + 1)
-    ids = np.empty((nu + 1, nw + 1), dtype=np.int64)
-    ids[:, 0] = ida[:, 0]
-    ids[nu, :] = idb[:, 0]
-    ids[:nu, 1:] = n + np.arange(nu * nw).reshape(nu, nw)
-    n += nu * nw
+    ida, idb, ids, n = disc_ids(len(u) - 1, len(v) - 1, len(w) - 1)
+    nu, nw = len(u) - 1, len(w) - 1
     disc_x = np.empty((n, 2))
     disc_x[ida] = pa
     disc_x[idb] = pb
@@ -200,6 +190,48 @@ def _disc(ln: _Lines) -> tuple[np.ndarray, np.ndarray]:
     disc_x[ids[:, nw], 1] = yc
     disc_x[idb[nw], 1] = yc
     return disc_x, np.vstack([_quads(ida), _quads(idb), _quads(ids)])
+
+
+def disc_ids(nu: int, nv: int, nw: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Node numbers of the disc's patches a (u, v), b (w, v), the square (u, w); their count.
+
+    b shares a's edge u = 1, the square shares a's and b's edges v = 0.
+    """
+    ida = np.arange((nu + 1) * (nv + 1)).reshape(nu + 1, nv + 1)
+    n = ida.size
+    idb = np.empty((nw + 1, nv + 1), dtype=np.int64)
+    idb[0] = ida[nu]
+    idb[1:] = n + np.arange(nw * (nv + 1)).reshape(nw, nv + 1)
+    n += nw * (nv + 1)
+    ids = np.empty((nu + 1, nw + 1), dtype=np.int64)
+    ids[:, 0] = ida[:, 0]
+    ids[nu, :] = idb[:, 0]
+    ids[:nu, 1:] = n + np.arange(nu * nw).reshape(nu, nw)
+    return ida, idb, ids, n + nu * nw
+
+
+def grid_lines(
+    R: float,
+    width: float,
+    height: float,
+    h_contact: float,
+    r_refine: float,
+    h_far: float,
+    slope: float,
+) -> GridLines:
+    """The 1D point distributions of `hertz_grid`'s mesh (what its coarser grids are cut from)."""
+    ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
+    return GridLines(ln.xs, ln.ys, ln.u, ln.v, ln.w)
+
+
+class GridLines(NamedTuple):
+    """The grid lines of `hertz_grid`: block columns xs and rows ys, the disc's u, v, w."""
+
+    xs: np.ndarray
+    ys: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    w: np.ndarray
 
 
 class GridPart(NamedTuple):

@@ -6,10 +6,12 @@ The methods turn a SolverSpec into a solver here; contactfx/linalg itself knows 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from functools import partial
 
 import numpy as np
 from petsc4py import PETSc
 
+from ..discretize.grid_mg import grid_interpolations
 from ..discretize.setup import ContactSetup
 from ..discretize.supports import rigid_body_modes
 from ..linalg.nullspace import near_nullspace
@@ -107,26 +109,32 @@ def make_solver(
     modes: Callable[[], list[PETSc.Vec]],
     node_dofs: np.ndarray,
     reuse: bool = True,
+    grid: Callable[[], list[PETSc.Mat]] | None = None,
 ) -> LinearSolver:
     """The solver `spec` asks for, on K, B (this rank's rows) and f.
 
     `modes()`: the rigid-body modes (called only by the solvers that use GAMG on the
     displacements); `node_dofs` (m, 2): the dofs of each multiplier row's active node (the
-    condensed solver's pivots); `reuse` False: a throwaway solver for one set. An `auto`
-    spec must be resolved first (methods/autosolve.py); here it is its direct path.
+    condensed solver's pivots); `reuse` False: a throwaway solver for one set; `grid()`: the
+    prolongations of the mesh's own coarser grids, if it has them (a condensed spec with
+    `geometric` options then runs a geometric multigrid). An `auto` spec must be resolved
+    first (methods/autosolve.py); here it is its direct path.
     """
     spec = direct_path(spec)
     if spec.kind.condensed:
         from ..linalg.condensed import CondensedSolver  # not on the direct path: docs/scale.md
 
         factorized = spec.kind is SolverKind.CONDENSED_DIRECT
+        levels = grid() if grid is not None and spec.geometric is not None else None
         return CondensedSolver(
             K,
             B,
             f,
-            with_ordering(spec.petsc, K.getSize()[0]),
+            spec.geometric
+            if levels and spec.geometric
+            else with_ordering(spec.petsc, K.getSize()[0]),
             node_dofs,
-            [] if factorized else modes(),
+            [] if factorized or levels else modes(),
             rtol=spec.rtol,
             loose_rtol=spec.loose_rtol,
             reuse=reuse,
@@ -134,6 +142,7 @@ def make_solver(
             # the cost rule of the saddle-point solver decides when to refactor.
             policy=FactorizationPolicy(reuse) if factorized else None,
             free_products=spec.free_products and not reuses_interpolation(spec.petsc),
+            interpolations=levels,
         )
     direct = spec.kind.factorizes_saddle
     if spec.kind is SolverKind.DIRECT_SCHUR and schur_available(K.getComm()):
@@ -175,4 +184,5 @@ def setup_solver(
         modes=lambda: rigid_body_modes(el.V, scene),
         node_dofs=setup.node_dofs(),
         reuse=reuse,
+        grid=None if scene.grid is None else partial(grid_interpolations, el.V, el.bcs, scene.grid),
     )

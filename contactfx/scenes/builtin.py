@@ -11,7 +11,7 @@ from dolfinx.io.gmsh import MeshData
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..meshes import build_blocks, build_hertz
+from ..meshes import build_blocks, build_hertz, grid_lines
 from .checks import check_scene
 from .mesh_cache import cached_to_dolfinx
 from .model import (
@@ -306,7 +306,12 @@ def hertz(
     extra: dict[str, Any] = {"hertz_exact": exact}
     # The load on the flat face: P over its width 2 R (a cylinder), or its disc pi R^2 (a sphere).
     load = h.P / (math.pi * h.R**2) if h.model is Model.AXISYMMETRIC else h.P / (2 * h.R)
-    return _two_body_scene(data, h, load, active, "hertz", ref, extra, size_field)
+    scene = _two_body_scene(data, h, load, active, "hertz", ref, extra, size_field)
+    if h.mesh != "structured":
+        return scene
+    far = h.R / 6.0 if h_far is None else h_far  # build_hertz_structured's default
+    lines = grid_lines(h.R, h.width, h.height, h.refine, h.r_refine, far, h.slope)
+    return replace(scene, grid=lines)
 
 
 def build_scene(

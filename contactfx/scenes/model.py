@@ -18,6 +18,7 @@ from dolfinx.io.gmsh import PhysicalGroup
 from mpi4py import MPI
 
 from ..errors import InputError, MeshError
+from ..meshes import GridLines
 from .fits import LameReference, check_interference, check_thermal
 from .obstacle import Obstacle
 
@@ -275,6 +276,8 @@ class Scene:
     obstacles: tuple[Obstacle, ...] = ()
     model: Model = Model.PLANE_STRAIN
     units: Units = field(default_factory=Units)
+    # The lines of a structured mesh (its coarser grids: a geometric multigrid's levels).
+    grid: GridLines | None = field(default=None, compare=False, repr=False)
 
     @property
     def comm(self) -> MPI.Comm:

@@ -57,11 +57,13 @@ def small_hertz():
     return hertz(HertzParams(refine=0.08, h_far=0.8, mesh="structured"), comm=MPI.COMM_SELF)
 
 
+@pytest.mark.parametrize("solver", ["condensed", "condensed-gamg"])
 @pytest.mark.parametrize(("method", "basis"), [("nts", "standard"), ("mortar", "dual")])
-def test_condensed_equals_mumps(small_hertz, method: str, basis: str) -> None:
-    """Eliminating the multipliers gives MUMPS' saddle-point answer: same set, 1e-6."""
+def test_condensed_equals_mumps(small_hertz, method: str, basis: str, solver: str) -> None:
+    """Eliminating the multipliers gives MUMPS' saddle-point answer: same set, 1e-6, with
+    the structured grid's geometric multigrid (`condensed`) and with GAMG."""
     ref = solve(small_hertz, method, basis=basis, solver="mumps")
-    sol = solve(small_hertz, method, basis=basis, solver="condensed")
+    sol = solve(small_hertz, method, basis=basis, solver=solver)
     assert np.array_equal(sol.active, ref.active)
     assert np.abs(sol.pressure - ref.pressure).max() <= 1e-6 * np.abs(ref.pressure).max()
     du = np.abs(sol.u.x.array - ref.u.x.array).max()
@@ -69,15 +71,16 @@ def test_condensed_equals_mumps(small_hertz, method: str, basis: str) -> None:
     assert all(h["linear_iterations"] > 0 for h in sol.history)  # CG really ran
 
 
-def _condensed_solver(scene, reuse: bool = True):
-    """The setup of the NTS Hertz problem and a condensed solver on it."""
+def _condensed_solver(scene, reuse: bool = True, solver: str = "condensed-gamg"):
+    """The setup of the NTS Hertz problem and a condensed solver on it (GAMG: the tests of
+    its kept multigrid; `condensed` on this structured mesh: the geometric multigrid)."""
     from contactfx.discretize.setup import prepare_contact
     from contactfx.methods.active_set import ActiveSetOptions
     from contactfx.options import Method
     from contactfx.timers import Timers
 
     setup = prepare_contact(scene, Method.NTS.kernel, ActiveSetOptions().penetration_tol, Timers())
-    return setup, solver_for(setup, "condensed", scene, reuse=reuse)
+    return setup, solver_for(setup, solver, scene, reuse=reuse)
 
 
 def test_condensed_matrix_equals_ptap(small_hertz) -> None:
@@ -206,13 +209,15 @@ def test_condensed_on_the_default_graded_hertz_mesh() -> None:
     assert all(h["linear_iterations"] > 0 for h in sol.history)
 
 
-def test_loose_solves_then_the_end_in_the_log(small_hertz) -> None:
+@pytest.mark.parametrize("solver", ["condensed", "condensed-gamg"])
+def test_loose_solves_then_the_end_in_the_log(small_hertz, solver: str) -> None:
     """The loop stops its solves early and solves only the stationary set to the end."""
-    sol = solve(small_hertz, "nts", solver="condensed", predictor="none")
+    sol = solve(small_hertz, "nts", solver=solver, predictor="none")
     its = [h["linear_iterations"] for h in sol.history]
-    assert len(its) >= 2
-    # The last step goes on from 1e-4 to 1e-9: more iterations than any loose one.
-    assert its[-1] > max(its[:-1])
+    assert len(its) >= 3
+    # The last step goes on from 1e-4 to 1e-9: more iterations than any loose one from the
+    # previous set's displacements (the first starts from zero).
+    assert its[-1] > max(its[1:-1])
 
 
 @pytest.mark.parametrize(("method", "basis"), [("mortar", "standard"), ("sts", "standard")])
@@ -275,8 +280,39 @@ def test_release_solve_stops_at_the_first_solves_accuracy(small_hertz, monkeypat
     assert np.abs(mu["now"] - mu["former"]).max() <= 1e-2 * scale
 
 
+def test_geometric_multigrid_on_the_structured_grid(small_hertz) -> None:
+    """On the structured mesh `condensed` runs PCMG on the grid's own coarser grids: a fresh
+    solve of the Hertz zone to 1e-9 in at most 12 CG iterations (GAMG on the same system:
+    more than 15; docs/scale.md, "Geometric multigrid on the structured grid"), every level
+    a grid of the mesh, the pivots' rows of the finest prolongation zero, MUMPS' answer."""
+    x = None
+    its = {}
+    answers = {}
+    for name in ("condensed", "condensed-gamg"):
+        setup, solver = _condensed_solver(small_hertz, reuse=False, solver=name)
+        x = setup.layout.x[setup.layout.mine, 0]
+        zone = x < small_hertz.params["hertz_exact"]["a"]
+        res = solver.solve(setup.g, zone)
+        assert res.reason > 0 and res.final
+        its[name] = res.iterations
+        answers[name] = res
+        pc = solver._ksp.getPC()
+        assert (pc.getType() == "mg") == (name == "condensed")
+        if name == "condensed":
+            n = pc.getMGLevels()
+            assert n >= 3
+            sizes = [pc.getMGInterpolation(k).getSize() for k in range(1, n)]
+            assert sizes[-1][0] == setup.elasticity.K.getSize()[0]
+            assert all(a[1] == b[0] for a, b in zip(sizes[1:], sizes[:-1], strict=False))
+        solver.destroy()
+    assert its["condensed"] <= 12 < 15 < its["condensed-gamg"], its
+    a, b = answers["condensed"], answers["condensed-gamg"]
+    assert np.abs(a.u - b.u).max() <= 1e-6 * np.abs(b.u).max()
+    assert np.abs(a.mu - b.mu).max() <= 1e-5 * np.abs(b.mu).max()
+
+
 def test_condensed_preset_on_stretched_cells(small_hertz) -> None:
-    """The `condensed` preset on cells of aspect up to 10 (issue 33): a fresh solve of the
+    """The `condensed-gamg` preset on cells of aspect up to 10 (issue 33): a fresh solve of the
     Hertz zone from zero to the final 1e-9 in at most 30 CG iterations, the issue's bound
     (the counts of this and earlier presets: docs/scale.md, "GAMG on stretched cells"; a
     point smoother needs several times more here), on a hierarchy whose fine level is in

@@ -19,6 +19,7 @@ from contactfx import run_scene
 from contactfx.api import as_request
 from contactfx.discretize.mesh_utils import scene_dofs
 from contactfx.errors import InputError
+from contactfx.methods import solver_choice
 from contactfx.methods.solver_choice import (
     SAFETY,
     Choice,
@@ -54,12 +55,14 @@ def test_choose_safety_factor() -> None:
     assert choose(1000.0, 1000.0, True, safety=1.01) is Choice.CONDENSED
 
 
-def test_node_budget_one_rank() -> None:
+def test_node_budget_one_rank(monkeypatch) -> None:
     comm = MPI.COMM_SELF
     assert node_budget(comm, 300.0, 500.0) == (300.0, 500.0)
     assert node_budget(comm, None, 500.0) == (None, None)
     avail = mem_available_mb()
     assert avail is None or avail > 0.0
+    # MemAvailable moves between two reads while other processes run: read it once.
+    monkeypatch.setattr(solver_choice, "mem_available_mb", lambda: avail)
     assert node_budget(comm, 300.0, None) == ((300.0, avail) if avail else (None, None))
 
 

@@ -1,0 +1,104 @@
+"""A structured mesh's coarser grids as PETSc prolongations on the displacement space.
+
+`meshes.grid_levels` gives the prolongations between the grid's levels in the grid's node
+numbering; here the finest one is mapped to DOLFINx's owned dofs (the mesh's input node
+numbers are the grid's), every level takes the two displacement components, and the coarser
+levels are split over the ranks in contiguous blocks of nodes. Rows of Dirichlet dofs are
+zero: the coarse grids do not correct what the boundary fixes.
+"""
+
+from __future__ import annotations
+
+from typing import Any, cast
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from ..meshes import GridLines, Level, grid_levels
+
+# The coarsest grid's nodes: it is factorized (MUMPS), a few thousand unknowns.
+COARSEST_NODES = 1500
+
+
+def grid_interpolations(
+    V: fem.FunctionSpace, bcs: list[fem.DirichletBC], lines: GridLines
+) -> list[PETSc.Mat]:
+    """Prolongations of the vector P1 space V on `lines`' grid, finest first (PETSc AIJ).
+
+    V's mesh must be the grid's (`hertz_grid` / `hertz_grid_part`, input node numbers kept).
+    """
+    comm = V.mesh.comm
+    levels = grid_levels(lines, COARSEST_NODES)
+    imap = V.dofmap.index_map
+    n_owned, first = imap.size_local, imap.local_range[0]
+    msh = V.mesh
+    # The grid node of each owned dof block (P1: a block per mesh node).
+    node_block = np.empty(msh.geometry.x.shape[0], dtype=np.int64)
+    node_block[msh.geometry.dofmaps[0].ravel()] = V.dofmap.list.ravel()
+    grid_of_block = np.empty(imap.size_local + imap.num_ghosts, dtype=np.int64)
+    grid_of_block[node_block] = np.asarray(msh.geometry.input_global_indices)
+    if levels and comm.allreduce(n_owned) != levels[0].n_fine:
+        raise ValueError("the mesh is not the grid of these lines")
+    fixed: np.ndarray | None = np.zeros(2 * n_owned, dtype=bool)
+    for bc in bcs:
+        dofs, _ = bc.dof_indices()
+        fixed[dofs[dofs < 2 * n_owned]] = True  # type: ignore[index]
+    mats = []
+    rows_of = grid_of_block[:n_owned]  # fine rows: the owned blocks' grid nodes
+    row_dofs = (first, n_owned)
+    for k, level in enumerate(levels):
+        lo, hi = _split(level.n_coarse, comm.rank, comm.size)
+        mats.append(
+            _prolongation(comm, level, rows_of, row_dofs, (lo, hi - lo), fixed if k == 0 else None)
+        )
+        rows_of = np.arange(lo, hi)
+        row_dofs = (lo, hi - lo)
+        fixed = None
+    return mats
+
+
+def _split(n: int, rank: int, size: int) -> tuple[int, int]:
+    # Contiguous blocks of nodes, the first n % size one larger.
+    q, r = divmod(n, size)
+    lo = rank * q + min(rank, r)
+    return lo, lo + q + (rank < r)
+
+
+def _prolongation(
+    comm: MPI.Comm,
+    level: Level,
+    rows_of: np.ndarray,
+    row_nodes: tuple[int, int],
+    col_nodes: tuple[int, int],
+    fixed: np.ndarray | None,
+) -> PETSc.Mat:
+    """The owned rows (fine nodes `rows_of`, in that order) of a level, both components."""
+    order = np.argsort(level.rows, kind="stable")
+    rows, cols, vals = level.rows[order], level.cols[order], level.vals[order]
+    starts = np.searchsorted(rows, np.arange(level.n_fine + 1))
+    count = starts[rows_of + 1] - starts[rows_of]
+    local_ptr = np.concatenate([[0], np.cumsum(count)])
+    take = np.repeat(starts[rows_of] - local_ptr[:-1], count) + np.arange(local_ptr[-1])
+    c, v = cols[take], vals[take]
+    # Node rows -> dof rows 2i, 2i + 1 with the same weights on columns 2j, 2j + 1.
+    indptr = np.zeros(2 * len(rows_of) + 1, dtype=np.int64)
+    indptr[1:] = np.cumsum(np.repeat(count, 2))
+    ci = np.empty(2 * len(c), dtype=np.int64)
+    vi = np.empty(2 * len(c))
+    for comp in (0, 1):
+        # Row 2i + comp holds entries local_ptr[i] .. local_ptr[i + 1] of comp's columns.
+        pos = indptr[2 * np.arange(len(rows_of)) + comp]
+        dest = np.repeat(pos - local_ptr[:-1], count) + np.arange(len(c))
+        ci[dest] = 2 * c + comp
+        vi[dest] = v
+    if fixed is not None:
+        vi[np.repeat(fixed, np.diff(indptr))] = 0.0
+    n_rows, n_cols = 2 * row_nodes[1], 2 * col_nodes[1]
+    csr: Any = (indptr.astype(PETSc.IntType), ci.astype(PETSc.IntType), vi)
+    P = PETSc.Mat().createAIJ(
+        size=((n_rows, PETSc.DECIDE), (n_cols, PETSc.DECIDE)), csr=csr, comm=cast(Any, comm)
+    )
+    P.assemble()
+    return P
