@@ -32,7 +32,7 @@ def grid_interpolations(
     comm = V.mesh.comm
     levels = grid_levels(lines, COARSEST_NODES)
     imap = V.dofmap.index_map
-    n_owned, first = imap.size_local, imap.local_range[0]
+    n_owned = imap.size_local
     msh = V.mesh
     # The grid node of each owned dof block (P1: a block per mesh node).
     node_block = np.empty(msh.geometry.x.shape[0], dtype=np.int64)
@@ -41,21 +41,16 @@ def grid_interpolations(
     grid_of_block[node_block] = np.asarray(msh.geometry.input_global_indices)
     if levels and comm.allreduce(n_owned) != levels[0].n_fine:
         raise ValueError("the mesh is not the grid of these lines")
-    fixed: np.ndarray | None = np.zeros(2 * n_owned, dtype=bool)
+    fixed = np.zeros(2 * n_owned, dtype=bool)
     for bc in bcs:
-        dofs, _ = bc.dof_indices()
-        fixed[dofs[dofs < 2 * n_owned]] = True  # type: ignore[index]
+        dofs = bc.dof_indices()[0]
+        fixed[dofs[dofs < 2 * n_owned]] = True
     mats = []
     rows_of = grid_of_block[:n_owned]  # fine rows: the owned blocks' grid nodes
-    row_dofs = (first, n_owned)
     for k, level in enumerate(levels):
         lo, hi = _split(level.n_coarse, comm.rank, comm.size)
-        mats.append(
-            _prolongation(comm, level, rows_of, row_dofs, (lo, hi - lo), fixed if k == 0 else None)
-        )
+        mats.append(_prolongation(comm, level, rows_of, hi - lo, fixed if k == 0 else None))
         rows_of = np.arange(lo, hi)
-        row_dofs = (lo, hi - lo)
-        fixed = None
     return mats
 
 
@@ -70,11 +65,13 @@ def _prolongation(
     comm: MPI.Comm,
     level: Level,
     rows_of: np.ndarray,
-    row_nodes: tuple[int, int],
-    col_nodes: tuple[int, int],
+    n_cols: int,
     fixed: np.ndarray | None,
 ) -> PETSc.Mat:
-    """The owned rows (fine nodes `rows_of`, in that order) of a level, both components."""
+    """The owned rows of a level (fine nodes `rows_of`, in that order), both components.
+
+    `n_cols`: the owned coarse nodes; the rows of `fixed` dofs are zero.
+    """
     order = np.argsort(level.rows, kind="stable")
     rows, cols, vals = level.rows[order], level.cols[order], level.vals[order]
     starts = np.searchsorted(rows, np.arange(level.n_fine + 1))
@@ -95,10 +92,8 @@ def _prolongation(
         vi[dest] = v
     if fixed is not None:
         vi[np.repeat(fixed, np.diff(indptr))] = 0.0
-    n_rows, n_cols = 2 * row_nodes[1], 2 * col_nodes[1]
     csr: Any = (indptr.astype(PETSc.IntType), ci.astype(PETSc.IntType), vi)
-    P = PETSc.Mat().createAIJ(
-        size=((n_rows, PETSc.DECIDE), (n_cols, PETSc.DECIDE)), csr=csr, comm=cast(Any, comm)
-    )
+    sizes = ((2 * len(rows_of), PETSc.DECIDE), (2 * n_cols, PETSc.DECIDE))
+    P = PETSc.Mat().createAIJ(size=sizes, csr=csr, comm=cast(Any, comm))
     P.assemble()
     return P
