@@ -39,7 +39,7 @@ from contactfx.contact import Kernel
 from contactfx.discretize.setup import prepare_contact
 from contactfx.discretize.supports import rigid_body_modes
 from contactfx.linalg import condensed
-from contactfx.linalg.elimination import LocalRows, condensed_matrix, elimination_matrix
+from contactfx.linalg.elimination import LocalRows, condensed_matrix
 from contactfx.linalg.nullspace import orthonormalize
 from contactfx.linalg.petsc_options import PrefixedOptions, global_options
 from contactfx.linalg.pivots import pivots
@@ -185,14 +185,13 @@ def bonded_solve(setup: Any, scene: Any, active: np.ndarray, spec: SolverSpec) -
     """The same K with the active pivots fixed (no contact coupling), CG + GAMG from zero."""
     K, f = setup.elasticity.K, setup.elasticity.f
     comm = K.getComm()
-    r0, r1 = K.getOwnershipRange()
+    r0 = K.getOwnershipRange()[0]
     n = K.getSize()[0]
     pv = pivots(LocalRows.of(setup.B, setup.node_dofs()), active, comm.tompi4py(), r0, n)
     piv = pv.dofs
     ip: Any = piv.astype(PETSc.IntType)
-    E = elimination_matrix({}, r0, r1, n, comm, False)  # no coupling: Dirichlet pivots
     diag = K.getDiagonal()
-    A = condensed_matrix(K, E, piv, diag)
+    A = condensed_matrix(K, {}, r0, piv, diag)  # no coupling rows: Dirichlet pivots
     modes = rigid_body_modes(setup.elasticity.V, scene)
     for m in modes:
         m.setValues(ip, cast(Any, np.zeros(len(piv))))
@@ -216,7 +215,7 @@ def bonded_solve(setup: Any, scene: Any, active: np.ndarray, spec: SolverSpec) -
         ksp.solve(b, x)
     seconds = time.perf_counter() - t0
     its = ksp.getIterationNumber()
-    for obj in (ksp, A, E, diag, b, x, *modes):
+    for obj in (ksp, A, diag, b, x, *modes):
         obj.destroy()
     return its, seconds
 
