@@ -279,6 +279,20 @@ class SolverSpec:
         return replace(self, petsc=petsc, rtol=rtol, schur=schur, geometric=geometric)
 
 
+# Multipliers eliminated (D diagonal: NTS or dual mortar), CG on the SPD displacement system,
+# GAMG (two levels of aggressive coarsening) with the bodies' rigid modes, or a geometric
+# multigrid where the mesh is a structured grid; the loop's solves only need signs
+# (loose_rtol, docs/condensed.md).
+CONDENSED = SolverSpec(
+    SolverKind.CONDENSED,
+    GAMG,
+    rtol=1e-9,
+    loose_rtol=1e-4,
+    name="condensed",
+    free_products=True,  # never reused: docs/scale.md, "Memory of the condensed path"
+    geometric=GEOMETRIC_MG,
+)
+
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
     {
         "auto": SolverSpec(SolverKind.AUTO, MUMPS_LDLT, name="auto"),  # docs/scale.md
@@ -339,28 +353,9 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
             name="fieldsplit-gamg",
             schur=SchurPre.USER,
         ),
-        # Multipliers eliminated (D diagonal: NTS or dual mortar), CG on the SPD displacement
-        # system, GAMG (two levels of aggressive coarsening) with the bodies' rigid modes, or
-        # a geometric multigrid where the mesh is a structured grid; the loop's solves only
-        # need signs (loose_rtol, docs/condensed.md).
-        "condensed": SolverSpec(
-            SolverKind.CONDENSED,
-            GAMG,
-            rtol=1e-9,
-            loose_rtol=1e-4,
-            name="condensed",
-            free_products=True,  # never reused: docs/scale.md, "Memory of the condensed path"
-            geometric=GEOMETRIC_MG,
-        ),
+        "condensed": CONDENSED,
         # The same with GAMG on every mesh (the structured grid's levels unused).
-        "condensed-gamg": SolverSpec(
-            SolverKind.CONDENSED,
-            GAMG,
-            rtol=1e-9,
-            loose_rtol=1e-4,
-            name="condensed-gamg",
-            free_products=True,
-        ),
+        "condensed-gamg": replace(CONDENSED, name="condensed-gamg", geometric=None),
         # The same condensed system factorized: MUMPS Cholesky (SPD, SYM=1). Later sets run CG
         # preconditioned by the kept factorization (a low-rank change: a few iterations)
         # until the pivots have moved too far (linalg/condensed.py).

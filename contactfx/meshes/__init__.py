@@ -9,7 +9,7 @@ ValueError for bad parameters.
 from .blocks import build_blocks
 from .grid_levels import Level, grid_levels
 from .hertz import QUAD4, build_hertz
-from .hertz_structured import GridLines, GridPart, grid_lines, hertz_grid, hertz_grid_part
+from .hertz_structured import GridLines, GridPart, grid_geometry, hertz_grid, hertz_grid_part
 
 __all__ = [
     "QUAD4",
@@ -18,8 +18,8 @@ __all__ = [
     "Level",
     "build_blocks",
     "build_hertz",
+    "grid_geometry",
     "grid_levels",
-    "grid_lines",
     "hertz_grid",
     "hertz_grid_part",
 ]

@@ -72,8 +72,12 @@ class _Lines(NamedTuple):
     a_corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
     b_corners: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
+    def lines(self) -> GridLines:
+        """The grid lines alone (what the coarser grids are cut from: meshes/grid_levels.py)."""
+        return GridLines(self.xs, self.ys, self.u, self.v, self.w)
 
-def _lines(
+
+def grid_geometry(
     R: float,
     width: float,
     height: float,
@@ -82,6 +86,7 @@ def _lines(
     h_far: float,
     slope: float,
 ) -> _Lines:
+    """The 1D point distributions and corner points `hertz_grid`'s mesh is built from."""
     # Block [0, width] x [0, height]: fine at x = 0 along the top.
     xs = graded_points(width, h_contact, r_refine, slope, h_far)
     ys = height - graded_points(height, h_contact, 0.0, slope, h_far)[::-1]
@@ -150,7 +155,7 @@ def hertz_grid(
     slope: float,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """Node coordinates, quad cells and the number of block cells (which come first)."""
-    ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
+    ln = grid_geometry(R, width, height, h_contact, r_refine, h_far, slope)
     bx, by = np.meshgrid(ln.xs, ln.ys, indexing="ij")
     block_ids = np.arange(bx.size).reshape(bx.shape)
     block_x = np.column_stack([bx.ravel(), by.ravel()])
@@ -210,20 +215,6 @@ def disc_ids(nu: int, nv: int, nw: int) -> tuple[np.ndarray, np.ndarray, np.ndar
     return ida, idb, ids, n + nu * nw
 
 
-def grid_lines(
-    R: float,
-    width: float,
-    height: float,
-    h_contact: float,
-    r_refine: float,
-    h_far: float,
-    slope: float,
-) -> GridLines:
-    """The 1D point distributions of `hertz_grid`'s mesh (what its coarser grids are cut from)."""
-    ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
-    return GridLines(ln.xs, ln.ys, ln.u, ln.v, ln.w)
-
-
 class GridLines(NamedTuple):
     """The grid lines of `hertz_grid`: block columns xs and rows ys, the disc's u, v, w."""
 
@@ -280,7 +271,7 @@ def hertz_grid_part(
     only, the disc's nodes whole (to cut the disc by x). With `nparts == 1`, `hertz_grid`'s
     arrays.
     """
-    ln = _lines(R, width, height, h_contact, r_refine, h_far, slope)
+    ln = grid_geometry(R, width, height, h_contact, r_refine, h_far, slope)
     nx, ny = len(ln.xs) - 1, len(ln.ys) - 1
     n_bx = (nx + 1) * (ny + 1)  # block nodes; the disc's follow
     # Block cells k = (column i, row j), column by column: the strips by x (then y).

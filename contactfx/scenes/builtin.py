@@ -11,7 +11,7 @@ from dolfinx.io.gmsh import MeshData
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..meshes import build_blocks, build_hertz, grid_lines
+from ..meshes import build_blocks, build_hertz, grid_geometry
 from .checks import check_scene
 from .mesh_cache import cached_to_dolfinx
 from .model import (
@@ -310,7 +310,7 @@ def hertz(
     if h.mesh != "structured":
         return scene
     far = h.R / 6.0 if h_far is None else h_far  # build_hertz_structured's default
-    lines = grid_lines(h.R, h.width, h.height, h.refine, h.r_refine, far, h.slope)
+    lines = grid_geometry(h.R, h.width, h.height, h.refine, h.r_refine, far, h.slope).lines()
     return replace(scene, grid=lines)
 
 

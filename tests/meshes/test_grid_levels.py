@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from contactfx.meshes import grid_levels, grid_lines, hertz_grid
+from contactfx.meshes import grid_geometry, grid_levels, hertz_grid
 from contactfx.meshes.grid_levels import grid_patches, kept_lines
 
 ARGS = (60.0, 60.0, 60.0, 0.1, 2.0, 1.0, 0.1)  # R, width, height, h, r_refine, h_far, slope
@@ -25,7 +25,7 @@ def _matrix(level) -> sp.csr_matrix:
 
 @pytest.fixture(scope="module")
 def grid():
-    lines = grid_lines(*ARGS)
+    lines = grid_geometry(*ARGS).lines()
     x, cells, n_block = hertz_grid(*ARGS)
     return lines, x, cells, n_block
 
