@@ -36,8 +36,7 @@ from run import EDGE_RATIO, refine_for
 
 from contactfx.contact import Kernel
 from contactfx.discretize.setup import prepare_contact
-from contactfx.discretize.supports import rigid_body_modes
-from contactfx.methods.solvers import make_solver
+from contactfx.methods.solvers import setup_solver
 from contactfx.options import SOLVERS, Basis
 from contactfx.scenes import HertzParams, Scene, hertz
 from contactfx.timers import Timers
@@ -164,18 +163,8 @@ def run(target: float) -> dict[str, Any]:
     }
     zone = setup.layout.x[setup.layout.mine, 0] < scene.params["hertz_exact"]["a"]
     for name in ("condensed", "condensed-gamg"):
-        solver = make_solver(
-            SOLVERS[name],
-            el.K,
-            setup.B,
-            el.f,
-            e_max=setup.e_max,
-            h=setup.h,
-            modes=lambda: rigid_body_modes(el.V, scene),
-            node_dofs=setup.node_dofs(),
-            reuse=False,
-            grid=(lambda: [m.copy() for m in mats]) if name == "condensed" else None,
-        )
+        levels = (lambda: [m.copy() for m in mats]) if name == "condensed" else None
+        solver = setup_solver(setup, SOLVERS[name], scene, reuse=False, grid=levels)
         t = time.perf_counter()
         res = solver.solve(setup.g, zone)
         out[name] = {"its": res.iterations, "seconds": round(time.perf_counter() - t, 2)}

@@ -170,10 +170,20 @@ def make_solver(
 
 
 def setup_solver(
-    setup: ContactSetup, spec: SolverSpec, scene: Scene, *, reuse: bool
+    setup: ContactSetup,
+    spec: SolverSpec,
+    scene: Scene,
+    *,
+    reuse: bool,
+    grid: Callable[[], list[PETSc.Mat]] | None = None,
 ) -> LinearSolver:
-    """The solver of a contact setup's saddle points (reuse: it keeps its setup across sets)."""
+    """The solver of a contact setup's saddle points (reuse: it keeps its setup across sets).
+
+    `grid`: other multigrid prolongations than the scene's own grid's (a benchmark's).
+    """
     el = setup.elasticity
+    if grid is None and scene.grid is not None:
+        grid = partial(grid_interpolations, el.V, el.bcs, scene.grid)
     return make_solver(
         spec,
         el.K,
@@ -184,5 +194,5 @@ def setup_solver(
         modes=lambda: rigid_body_modes(el.V, scene),
         node_dofs=setup.node_dofs(),
         reuse=reuse,
-        grid=None if scene.grid is None else partial(grid_interpolations, el.V, el.bcs, scene.grid),
+        grid=grid,
     )
