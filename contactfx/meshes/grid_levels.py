@@ -6,8 +6,9 @@ gives a coarser grid of the same patches whose nodes are nodes of the finer one;
 node's value is interpolated bilinearly in the patch's line parameters from the corners of
 the coarser cell it lies in. Shared patch edges use the same lines on both sides, so a node
 on them gets the same weights from either patch. These are the prolongations of a geometric
-multigrid: cell shape does not matter to it, unlike GAMG's aggregation on stretched cells
-(docs/scale.md, "Geometric multigrid on the structured grid").
+multigrid: on the accurate family's cells (aspect up to 10) its iterations stay flat where
+GAMG's aggregation grows; on far more stretched cells both degrade (coarsening every line in
+both directions): docs/scale.md, "Geometric multigrid on the structured grid".
 """
 
 from __future__ import annotations
@@ -68,14 +69,13 @@ def coarsen(patches: list[Patch], n_fine: int) -> tuple[Level, list[Patch]]:
         cids = number[c]
         out.append((cids, s[si], t[ti]))
         (ki, ws), (kj, wt) = _cell_weights(s, si), _cell_weights(t, ti)
-        fid = ids
-        new = ~done[fid]  # a node on an edge shared with an earlier patch has its row
-        done[fid] = True
+        new = ~done[ids]  # a node on an edge shared with an earlier patch has its row
+        done[ids] = True
         for a in (0, 1):
             for b in (0, 1):
                 w = np.outer(ws if a else 1.0 - ws, wt if b else 1.0 - wt)
                 m = new & (w > 0.0)
-                rows.append(fid[m])
+                rows.append(ids[m])
                 cols.append(cids[np.ix_(ki + a, kj + b)][m])
                 vals.append(w[m])
     level = Level(

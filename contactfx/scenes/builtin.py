@@ -11,7 +11,7 @@ from dolfinx.io.gmsh import MeshData
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..meshes import build_blocks, build_hertz, grid_geometry
+from ..meshes import build_blocks, build_hertz
 from .checks import check_scene
 from .mesh_cache import cached_to_dolfinx
 from .model import (
@@ -281,9 +281,10 @@ def hertz(
         params = replace(params, r_refine=round(1.4 * exact["a"], 6))
     h = params
     h_far = h.h_far or None
+    lines = None
     if h.mesh == "structured":
         # Built directly in DOLFINx: gmsh's quad mesher is too slow for millions of DOFs.
-        data = build_hertz_structured(
+        data, lines = build_hertz_structured(
             comm, h.R, h.width, h.height, h.refine, h.r_refine, h_far, h.slope
         )
     else:
@@ -307,11 +308,7 @@ def hertz(
     # The load on the flat face: P over its width 2 R (a cylinder), or its disc pi R^2 (a sphere).
     load = h.P / (math.pi * h.R**2) if h.model is Model.AXISYMMETRIC else h.P / (2 * h.R)
     scene = _two_body_scene(data, h, load, active, "hertz", ref, extra, size_field)
-    if h.mesh != "structured":
-        return scene
-    far = h.R / 6.0 if h_far is None else h_far  # build_hertz_structured's default
-    lines = grid_geometry(h.R, h.width, h.height, h.refine, h.r_refine, far, h.slope).lines()
-    return replace(scene, grid=lines)
+    return scene if lines is None else replace(scene, grid=lines)
 
 
 def build_scene(

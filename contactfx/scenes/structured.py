@@ -10,7 +10,7 @@ from dolfinx.io.gmsh import MeshData, PhysicalGroup
 from mpi4py import MPI
 
 from ..errors import InputError
-from ..meshes import hertz_grid_part
+from ..meshes import GridLines, grid_geometry, hertz_grid_part
 from .partition import stay_on_rank
 
 # Physical groups, named like the gmsh scene's (the numbers themselves are free).
@@ -35,11 +35,11 @@ def build_hertz_structured(
     h_far: float | None = None,
     slope: float = 0.1,
     contact_extent: float | None = None,
-) -> MeshData:
+) -> tuple[MeshData, GridLines]:
     """The Hertz half model (quarter disc on a block) as a distributed structured quad mesh.
 
     Returned as gmsh's MeshData (no ridge or peak tags), so that both meshers feed the same
-    scene construction.
+    scene construction, with the grid's lines (its coarser grids: `Scene.grid`).
     """
     h_far = R / 6.0 if h_far is None else h_far
     extent = min(width, R / 4.0) if contact_extent is None else contact_extent
@@ -56,7 +56,8 @@ def build_hertz_structured(
     tdim = msh.topology.dim
     cell_tags = dmesh.meshtags(msh, tdim, np.arange(len(body), dtype=np.int32), body)
     facet_tags = tag_hertz_facets(msh, body, R, height, extent)
-    return MeshData(msh, cell_tags, facet_tags, None, None, dict(TAGS))
+    lines = grid_geometry(R, width, height, h_contact, r_refine, h_far, slope).lines()
+    return MeshData(msh, cell_tags, facet_tags, None, None, dict(TAGS)), lines
 
 
 def cell_bodies(msh: dmesh.Mesh, parts: list[tuple[int, int]]) -> np.ndarray:

@@ -108,16 +108,17 @@ def test_released_rows_use_capacitance(hertz_system) -> None:
 
 
 def test_an_inexact_capacitance_answer_is_refined(hertz_system, monkeypatch) -> None:
-    """A capacitance matrix off by 1e-4 leaves a residual far above the factorization's own:
+    """A capacitance matrix off by 1e-5 leaves a residual far above the factorization's own:
     the refinement runs (two back-substitutions per step) and ends at the fresh solve.
 
-    Without the error the first answer is accepted after one back-substitution (its residual
-    within ROUNDOFF x the factorization's own)."""
+    Without the error the first answer is accepted after one back-substitution (here below
+    RELEASED_RTOL; the ROUNDOFF rule itself acts at round-off, measured in
+    benchmarks/release_accuracy.py, not asserted here)."""
     from contactfx.linalg import capacitance
 
     el, B, g, x = hertz_system
     iterations = []
-    for skew in (1.0, 1.0 + 1e-4):
+    for skew in (1.0, 1.0 + 1e-5):
 
         class Skewed(capacitance.DenseLU):
             factor = skew

@@ -29,7 +29,7 @@ HERE = Path(__file__).resolve().parent
 def build(comm: MPI.Comm) -> MeshData:
     """The scene's structured mesh at ARGS on `comm`."""
     R, width, height, h_contact, r_refine, h_far, slope = ARGS
-    return build_hertz_structured(comm, R, width, height, h_contact, r_refine, h_far, slope)
+    return build_hertz_structured(comm, R, width, height, h_contact, r_refine, h_far, slope)[0]
 
 
 def mesh_arrays(md: MeshData, comm: MPI.Comm) -> dict[str, np.ndarray]:
