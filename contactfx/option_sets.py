@@ -17,7 +17,8 @@ GAMG: dict[str, object] = {
     "mg_levels_sub_pc_type": "icc",
     "mg_levels_ksp_max_it": 4,
 }
-# The same CG on a structured grid's own coarser grids (discretize/grid_mg.py): Galerkin
+# The same CG on coarser grids (a structured grid's own, discretize/grid_mg.py, or the scene
+# remeshed, discretize/remesh_mg.py): Galerkin
 # coarse operators, the same ICC(0)-preconditioned Chebyshev smoother, the coarsest grid
 # factorized (docs/scale.md, "Geometric multigrid on the structured grid").
 GEOMETRIC_MG: dict[str, object] = {

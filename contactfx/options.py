@@ -193,8 +193,9 @@ class SolverSpec:
     schur: SchurPre | None = None
     free_products: bool = False  # GAMG's setup frees its products' data (methods/solvers.py)
     low_rank: LowRank | None = None  # a direct solver's BLR factorization (methods/solvers.py)
-    # A condensed solver's options where the scene's mesh brings its own coarser grids
-    # (Scene.grid: a geometric multigrid); None: `petsc` (GAMG) on every mesh.
+    # A condensed solver's options where the scene has coarser grids: the structured grid's
+    # own (Scene.grid) or its remeshes (a recipe): a geometric multigrid; None: `petsc`
+    # (GAMG) on every mesh, also where the scene has neither.
     geometric: Mapping[str, object] | None = None
 
     def __post_init__(self) -> None:

@@ -48,52 +48,61 @@ def grid_interpolations(
     mats = []
     rows_of = grid_of_block[:n_owned]  # fine rows: the owned blocks' grid nodes
     for k, level in enumerate(levels):
-        lo, hi = _split(level.n_coarse, comm.rank, comm.size)
-        mats.append(_prolongation(comm, level, rows_of, hi - lo, fixed if k == 0 else None))
+        lo, hi = split_nodes(level.n_coarse, comm.rank, comm.size)
+        count, cols, vals = _level_rows(level, rows_of)
+        mats.append(node_prolongation(comm, count, cols, vals, hi - lo, fixed if k == 0 else None))
         rows_of = np.arange(lo, hi)
     return mats
 
 
-def _split(n: int, rank: int, size: int) -> tuple[int, int]:
-    # Contiguous blocks of nodes, the first n % size one larger.
+def split_nodes(n: int, rank: int, size: int) -> tuple[int, int]:
+    """This rank's contiguous block of n coarse nodes (the first n % size blocks one larger)."""
     q, r = divmod(n, size)
     lo = rank * q + min(rank, r)
     return lo, lo + q + (rank < r)
 
 
-def _prolongation(
-    comm: MPI.Comm,
-    level: Level,
-    rows_of: np.ndarray,
-    n_cols: int,
-    fixed: np.ndarray | None,
-) -> PETSc.Mat:
-    """The owned rows of a level (fine nodes `rows_of`, in that order), both components.
-
-    `n_cols`: the owned coarse nodes; the rows of `fixed` dofs are zero.
-    """
+def _level_rows(level: Level, rows_of: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rows of fine nodes `rows_of` (in that order) as counts, columns and weights."""
     order = np.argsort(level.rows, kind="stable")
     rows, cols, vals = level.rows[order], level.cols[order], level.vals[order]
     starts = np.searchsorted(rows, np.arange(level.n_fine + 1))
     count = starts[rows_of + 1] - starts[rows_of]
     local_ptr = np.concatenate([[0], np.cumsum(count)])
     take = np.repeat(starts[rows_of] - local_ptr[:-1], count) + np.arange(local_ptr[-1])
-    c, v = cols[take], vals[take]
+    return count, cols[take], vals[take]
+
+
+def node_prolongation(
+    comm: MPI.Comm,
+    count: np.ndarray,
+    c: np.ndarray,
+    v: np.ndarray,
+    n_cols: int,
+    fixed: np.ndarray | None,
+) -> PETSc.Mat:
+    """The owned rows of a level, both components, from its node rows in CSR form.
+
+    Node row i has `count[i]` entries of `c` (global coarse nodes) and `v`; `n_cols`: the
+    owned coarse nodes; the rows of `fixed` dofs are zero.
+    """
+    local_ptr = np.concatenate([[0], np.cumsum(count)])
+    n_rows = len(count)
     # Node rows -> dof rows 2i, 2i + 1 with the same weights on columns 2j, 2j + 1.
-    indptr = np.zeros(2 * len(rows_of) + 1, dtype=np.int64)
+    indptr = np.zeros(2 * n_rows + 1, dtype=np.int64)
     indptr[1:] = np.cumsum(np.repeat(count, 2))
     ci = np.empty(2 * len(c), dtype=np.int64)
     vi = np.empty(2 * len(c))
     for comp in (0, 1):
         # Row 2i + comp holds entries local_ptr[i] .. local_ptr[i + 1] of comp's columns.
-        pos = indptr[2 * np.arange(len(rows_of)) + comp]
+        pos = indptr[2 * np.arange(n_rows) + comp]
         dest = np.repeat(pos - local_ptr[:-1], count) + np.arange(len(c))
         ci[dest] = 2 * c + comp
         vi[dest] = v
     if fixed is not None:
         vi[np.repeat(fixed, np.diff(indptr))] = 0.0
     csr: Any = (indptr.astype(PETSc.IntType), ci.astype(PETSc.IntType), vi)
-    sizes = ((2 * len(rows_of), PETSc.DECIDE), (2 * n_cols, PETSc.DECIDE))
+    sizes = ((2 * n_rows, PETSc.DECIDE), (2 * n_cols, PETSc.DECIDE))
     P = PETSc.Mat().createAIJ(size=sizes, csr=csr, comm=cast(Any, comm))
     P.assemble()
     return P

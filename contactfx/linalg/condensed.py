@@ -4,8 +4,9 @@ The elimination itself is `linalg/elimination.py`. The first set builds T^T K T 
 it, with the rigid modes of all bodies (zero on the pivots) as near-nullspace. Later sets
 differ from it by a few pivots, a low-rank change: CG keeps that multigrid and applies the
 new operator matrix-free, from the last displacement, until the pivots have moved too far.
-Given the prolongations of the mesh's own coarser grids (a structured grid), PCMG on them
-with Galerkin coarse operators replaces GAMG; its setup is cheap, so every set rebuilds it.
+Given the prolongations of coarser grids (a structured grid's own, or a remeshed scene's),
+PCMG on them with Galerkin coarse operators replaces GAMG; its setup is cheap, so every set
+rebuilds it.
 The loop's solves stop at a loose tolerance (only signs decide the set): there the loop's
 `stationary` test reads the loose answer inside the CG run (a convergence test), and on a
 stationary set the same run goes on to the final tolerance, so the answer does not depend on

@@ -12,6 +12,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..discretize.grid_mg import grid_interpolations
+from ..discretize.remesh_mg import remesh_interpolations
 from ..discretize.setup import ContactSetup
 from ..discretize.supports import rigid_body_modes
 from ..linalg.nullspace import near_nullspace
@@ -116,7 +117,7 @@ def make_solver(
     `modes()`: the rigid-body modes (called only by the solvers that use GAMG on the
     displacements); `node_dofs` (m, 2): the dofs of each multiplier row's active node (the
     condensed solver's pivots); `reuse` False: a throwaway solver for one set; `grid()`: the
-    prolongations of the mesh's own coarser grids, if it has them (a condensed spec with
+    prolongations of the scene's coarser grids, if it has them (a condensed spec with
     `geometric` options then runs a geometric multigrid). An `auto` spec must be resolved
     first (methods/autosolve.py); here it is its direct path.
     """
@@ -179,11 +180,14 @@ def setup_solver(
 ) -> LinearSolver:
     """The solver of a contact setup's saddle points (reuse: it keeps its setup across sets).
 
-    `grid`: other multigrid prolongations than the scene's own grid's (a benchmark's).
+    `grid`: other multigrid prolongations than the scene's (a benchmark's). The scene's: its
+    structured grid's coarser grids, else (a recipe) its remeshes x8, x16, ... (non-nested).
     """
     el = setup.elasticity
     if grid is None and scene.grid is not None:
         grid = partial(grid_interpolations, el.V, el.bcs, scene.grid)
+    elif grid is None and scene.can_remesh:
+        grid = partial(remesh_interpolations, el.V, el.bcs, scene)
     return make_solver(
         spec,
         el.K,

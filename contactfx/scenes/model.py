@@ -278,6 +278,11 @@ class Scene:
     units: Units = field(default_factory=Units)
     # The lines of a structured mesh (its coarser grids: a geometric multigrid's levels).
     grid: GridLines | None = field(default=None, compare=False, repr=False)
+    # Remeshes already made on the scene's communicator, by factor: the coarse predictor and
+    # a multigrid's levels ask for the same ones. Not an init field: `replace` starts empty.
+    _remeshes: dict[float, Scene] = field(
+        default_factory=dict, init=False, compare=False, repr=False
+    )
 
     @property
     def comm(self) -> MPI.Comm:
@@ -306,9 +311,16 @@ class Scene:
         """Whether the scene knows how its mesh was made (a built-in scene or a .geo)."""
         return self.recipe is not None
 
-    def remeshed(self, factor: float) -> Scene:
-        """The same scene with every mesh size times `factor` (InputError if it cannot be)."""
-        return self.require_recipe().resized(factor).build(self.comm)
+    def remeshed(self, factor: float, comm: MPI.Comm | None = None) -> Scene:
+        """The same scene with every mesh size times `factor` (InputError if it cannot be).
+
+        On `comm` if given, else on the scene's (collective; kept for the next call).
+        """
+        if comm is not None:
+            return self.require_recipe().resized(factor).build(comm)
+        if factor not in self._remeshes:
+            self._remeshes[factor] = self.require_recipe().resized(factor).build(self.comm)
+        return self._remeshes[factor]
 
     def remeshed_to(self, field: SizeField) -> Scene:
         """The same scene's geometry meshed by gmsh with the sizes of `field` (collective)."""

@@ -295,6 +295,19 @@ def auto_condensed() -> tuple[Solution, Arrays]:
 CASES["hertz-auto-condensed"] = Case(auto_condensed, {"act": Exact(), "p": Rel(1e-6)})
 
 
+def condensed_gmsh() -> tuple[Solution, Arrays]:
+    """The condensed solver on a gmsh mesh, dual mortar: every rank remeshes the scene x8
+    for the multigrid's level (the same serial meshes, split over the ranks)."""
+    sol = solve(hertz(HertzParams(refine=0.1, h_far=1.0, refine_edge=0.025)), "mortar",
+                basis="dual", solver="condensed")  # fmt: skip
+    its = np.array([h["linear_iterations"] for h in sol.history])
+    assert its.max() <= 8, its  # GAMG: 10 and more on this mesh (test_dual_condensed.py)
+    return sol, {"act": sol.active[by_position(sol)], "p": sol.pressure[by_position(sol)]}
+
+
+CASES["hertz-condensed-gmsh"] = Case(condensed_gmsh, {"act": Exact(), "p": Rel(1e-6)})
+
+
 def probe_by_selected_inverse(solver: str) -> Callable[[], Any]:
     """Mortar on Hertz: the rows probed in step 1 (selected inverse) and the pressures."""
 
