@@ -18,9 +18,9 @@ GAMG: dict[str, object] = {
     "mg_levels_ksp_max_it": 4,
 }
 # The same CG on coarser grids (a structured grid's own, discretize/grid_mg.py, or the scene
-# remeshed, discretize/remesh_mg.py): Galerkin
-# coarse operators, the same ICC(0)-preconditioned Chebyshev smoother, the coarsest grid
-# factorized (docs/scale.md, "Geometric multigrid on the structured grid").
+# remeshed, discretize/remesh_mg.py): Galerkin coarse operators, the same ICC(0)-preconditioned
+# Chebyshev smoother, the coarsest grid factorized (docs/scale.md, "Geometric multigrid on
+# the structured grid" and "A geometric multigrid on gmsh meshes").
 GEOMETRIC_MG: dict[str, object] = {
     "ksp_type": "cg",
     "ksp_norm_type": "unpreconditioned",

@@ -41,10 +41,7 @@ def grid_interpolations(
     grid_of_block[node_block] = np.asarray(msh.geometry.input_global_indices)
     if levels and comm.allreduce(n_owned) != levels[0].n_fine:
         raise ValueError("the mesh is not the grid of these lines")
-    fixed = np.zeros(2 * n_owned, dtype=bool)
-    for bc in bcs:
-        dofs = bc.dof_indices()[0]
-        fixed[dofs[dofs < 2 * n_owned]] = True
+    fixed = _owned_fixed(bcs, n_owned)
     mats = []
     rows_of = grid_of_block[:n_owned]  # fine rows: the owned blocks' grid nodes
     for k, level in enumerate(levels):
@@ -53,6 +50,15 @@ def grid_interpolations(
         mats.append(node_prolongation(comm, count, cols, vals, hi - lo, fixed if k == 0 else None))
         rows_of = np.arange(lo, hi)
     return mats
+
+
+def _owned_fixed(bcs: list[fem.DirichletBC], n_owned: int) -> np.ndarray:
+    """(2 n_owned,) whether each owned dof of a 2-component P1 space is fixed by `bcs`."""
+    fixed = np.zeros(2 * n_owned, dtype=bool)
+    for bc in bcs:
+        dofs = bc.dof_indices()[0]
+        fixed[dofs[dofs < 2 * n_owned]] = True
+    return fixed
 
 
 def split_nodes(n: int, rank: int, size: int) -> tuple[int, int]:
@@ -79,7 +85,7 @@ def node_prolongation(
     c: np.ndarray,
     v: np.ndarray,
     n_cols: int,
-    fixed: np.ndarray | None,
+    fixed: np.ndarray | None = None,
 ) -> PETSc.Mat:
     """The owned rows of a level, both components, from its node rows in CSR form.
 

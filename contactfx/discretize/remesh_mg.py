@@ -2,10 +2,13 @@
 
 A gmsh mesh has no nested coarser grid, but its recipe remeshes the same geometry with every
 size x8, x16, ... (FIRST_FACTOR, then doubling). The prolongation from a coarse mesh to a
-finer one evaluates the coarse cell's linear basis at each finer node (`meshes.cell_weights`):
+finer one evaluates the coarse cell's bilinear basis at each finer node (`meshes.cell_weights`):
 the cell of the same body that contains it (DOLFINx's bounding-box tree, then an edge-sign
 test), else the nearest cell of that body (finer nodes on a curved boundary, outside the
-coarser polygon: extrapolated). Measured against GAMG on the gmsh Hertz family in
+coarser polygon: extrapolated). Unlike the structured grid's, the Dirichlet rows keep their
+weights: zeroed, they left the columns of coarse nodes near a support empty (a singular
+Galerkin coarse operator on the default Hertz mesh); coarse nodes no finer node interpolates
+from are dropped for the same reason. Measured against GAMG on the gmsh Hertz family in
 docs/scale.md ("A geometric multigrid on gmsh meshes").
 
 Every rank meshes every coarser level whole (on its own communicator: the ranks' meshes are
@@ -17,6 +20,7 @@ from __future__ import annotations
 
 import logging
 import time
+from typing import NamedTuple
 
 import numpy as np
 from dolfinx import fem, geometry
@@ -25,9 +29,10 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..errors import InputError, MeshError
-from ..meshes.cell_weights import contains, p1_weights
+from ..meshes.cell_weights import contains, q1_weights
 from ..scenes import Scene
 from .grid_mg import COARSEST_NODES, node_prolongation, split_nodes
+from .supports import body_blocks
 
 log = logging.getLogger(__name__)
 
@@ -36,31 +41,37 @@ log = logging.getLogger(__name__)
 # factorization without coarsening.
 MAX_KEPT = 0.6
 MAX_LEVELS = 8
-# The first coarser mesh is x8 (then x16, x32, ...): on the gmsh Hertz family x2, x4 and x8
-# gave the same 5 CG iterations from 100k to 2M DOFs, x16 6-7; x8 costs gmsh 1/64 of the
-# fine mesh and the cycle least (docs/scale.md, "A geometric multigrid on gmsh meshes").
+# The first coarser mesh is x8 (then x16, x32, ...): the coarsest first step whose CG
+# iterations match x2's, so gmsh and the cycle cost least (measured by first factor:
+# docs/scale.md, "A geometric multigrid on gmsh meshes").
 FIRST_FACTOR = 8.0
 
 
-def remesh_interpolations(
-    V: fem.FunctionSpace, bcs: list[fem.DirichletBC], scene: Scene
-) -> list[PETSc.Mat]:
+class CoarseLevel(NamedTuple):
+    """A coarser level: the prolongation onto the finer one, its nodes' coordinates and bodies."""
+
+    P: PETSc.Mat
+    x: np.ndarray  # (n, 2): every node of the level (all ranks), in its column order
+    body: np.ndarray  # (n,): each node's body index
+
+
+def remesh_interpolations(V: fem.FunctionSpace, scene: Scene) -> list[PETSc.Mat]:
     """Prolongations of the vector P1 space V from remeshes of `scene`, finest first.
 
     Empty if the scene's first remesh fails or does not coarsen (the caller keeps GAMG).
     """
+    return [level.P for level in remesh_levels(V, scene)]
+
+
+def remesh_levels(V: fem.FunctionSpace, scene: Scene) -> list[CoarseLevel]:
+    """The coarser levels of V from remeshes of `scene`, finest first (remesh_interpolations)."""
     comm = V.mesh.comm
     t0 = time.perf_counter()
     n_owned = V.dofmap.index_map.size_local
     x = V.tabulate_dof_coordinates()[:n_owned, :2]
     body = _block_bodies(V, scene)[:n_owned]
-    fixed = np.zeros(2 * n_owned, dtype=bool)
-    for bc in bcs:
-        dofs = bc.dof_indices()[0]
-        fixed[dofs[dofs < 2 * n_owned]] = True
     n_nodes = comm.allreduce(n_owned)
-    mats: list[PETSc.Mat] = []
-    sizes = []
+    levels: list[CoarseLevel] = []
     for k in range(MAX_LEVELS):
         if n_nodes <= COARSEST_NODES:
             break
@@ -71,29 +82,52 @@ def remesh_interpolations(
         if len(cx) > MAX_KEPT * n_nodes:
             break
         count, cols, vals = _rows(x, body, coarse)
-        lo, hi = split_nodes(len(cx), comm.rank, comm.size)
-        mats.append(node_prolongation(comm, count, cols, vals, hi - lo, fixed if k == 0 else None))
-        sizes.append(len(cx))
-        node_body = _node_bodies(coarse)
-        x, body, n_nodes = cx[lo:hi], node_body[lo:hi], len(cx)
+        used = _used_nodes(comm, len(cx), count, cols)
+        count, cols, vals = _only_used(used, count, cols, vals)
+        n_used = int(used.sum())
+        lo, hi = split_nodes(n_used, comm.rank, comm.size)
+        P = node_prolongation(comm, count, cols, vals, hi - lo)
+        levels.append(CoarseLevel(P, cx[used], _node_bodies(coarse)[used]))
+        x, body, n_nodes = levels[-1].x[lo:hi], levels[-1].body[lo:hi], n_used
     log.info(
         "multigrid: %d coarser meshes of %s nodes (remeshed x%g to x%g), %.2f s",
-        len(mats),
-        " / ".join(f"{n:,}" for n in sizes),
+        len(levels),
+        " / ".join(f"{len(level.x):,}" for level in levels),
         FIRST_FACTOR,
-        FIRST_FACTOR * 2 ** max(len(mats) - 1, 0),
+        FIRST_FACTOR * 2 ** max(len(levels) - 1, 0),
         time.perf_counter() - t0,
     )
-    return mats
+    return levels
+
+
+def _used_nodes(comm: MPI.Comm, n: int, count: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """(n,) the coarse nodes some finer row (on any rank) interpolates from.
+
+    A non-nested coarse node can have no finer node in its cells: its column would be empty
+    and the Galerkin coarse operator singular, so it is dropped.
+    """
+    used = np.zeros(n, dtype=bool)
+    used[cols] = True
+    comm.Allreduce(MPI.IN_PLACE, used, op=MPI.LOR)
+    return used
+
+
+def _only_used(
+    used: np.ndarray, count: np.ndarray, cols: np.ndarray, vals: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rows (CSR) without the entries of unused nodes, columns renumbered among the used."""
+    keep = used[cols]
+    row = np.repeat(np.arange(len(count)), count)
+    count = np.bincount(row[keep], minlength=len(count))
+    return count, (np.cumsum(used) - 1)[cols[keep]], vals[keep]
 
 
 def _block_bodies(V: fem.FunctionSpace, scene: Scene) -> np.ndarray:
-    """The body index of every dof block (P1: a block per mesh node)."""
-    msh = V.mesh
-    node_block = np.empty(msh.geometry.x.shape[0], dtype=np.int64)
-    node_block[msh.geometry.dofmaps[0].ravel()] = V.dofmap.list.ravel()
-    out = np.full(len(node_block), -1, dtype=np.int64)
-    out[node_block] = _node_bodies(scene)
+    """The body index of every local dof block (the first body's where bodies share one)."""
+    im = V.dofmap.index_map
+    out = np.full(im.size_local + im.num_ghosts, -1, dtype=np.int64)
+    for i, b in reversed(list(enumerate(scene.bodies))):
+        out[body_blocks(V, scene.body_cells(b))] = i
     return out
 
 
@@ -109,7 +143,7 @@ def _node_bodies(scene: Scene) -> np.ndarray:
 def _coarser(scene: Scene, factor: float, comm: MPI.Comm) -> Scene | None:
     """The scene remeshed x`factor` on this rank alone; None where gmsh cannot mesh it."""
     try:
-        coarse = scene.remeshed(factor, comm=None if comm.size == 1 else MPI.COMM_SELF)
+        coarse = scene.remeshed(factor, comm=MPI.COMM_SELF)
     except (InputError, MeshError) as exc:
         log.info("multigrid: no mesh x%g (%s)", factor, exc)
         return None
@@ -130,11 +164,13 @@ def _rows(x: np.ndarray, body: np.ndarray, coarse: Scene) -> tuple[np.ndarray, .
     for b in np.unique(body):
         mine = np.flatnonzero(body == b)
         cell[mine] = _locate(msh, coarse.body_cells(coarse.bodies[b]), x[mine])
-    w, ok = p1_weights(x, cx[cells[cell]])
+    corners = cx[cells[cell]]
+    w, ok = q1_weights(x, corners)
     # Far out of its cell's reference square (a concave corner): the cell's nearest vertex.
-    for i in np.flatnonzero(~ok):
-        w[i] = 0.0
-        w[i, np.argmin(((cx[cells[cell[i]]] - x[i]) ** 2).sum(axis=1))] = 1.0
+    far = np.flatnonzero(~ok)
+    nearest = np.argmin(((corners[far] - x[far, None, :]) ** 2).sum(axis=2), axis=1)
+    w[far] = 0.0
+    w[far, nearest] = 1.0
     w[np.abs(w) < 1e-13] = 0.0
     keep = w != 0.0
     return keep.sum(axis=1), cells[cell][keep], w[keep]

@@ -187,7 +187,7 @@ def setup_solver(
     if grid is None and scene.grid is not None:
         grid = partial(grid_interpolations, el.V, el.bcs, scene.grid)
     elif grid is None and scene.can_remesh:
-        grid = partial(remesh_interpolations, el.V, el.bcs, scene)
+        grid = partial(remesh_interpolations, el.V, scene)
     return make_solver(
         spec,
         el.K,

@@ -278,11 +278,6 @@ class Scene:
     units: Units = field(default_factory=Units)
     # The lines of a structured mesh (its coarser grids: a geometric multigrid's levels).
     grid: GridLines | None = field(default=None, compare=False, repr=False)
-    # Remeshes already made on the scene's communicator, by factor: the coarse predictor and
-    # a multigrid's levels ask for the same ones. Not an init field: `replace` starts empty.
-    _remeshes: dict[float, Scene] = field(
-        default_factory=dict, init=False, compare=False, repr=False
-    )
 
     @property
     def comm(self) -> MPI.Comm:
@@ -314,13 +309,10 @@ class Scene:
     def remeshed(self, factor: float, comm: MPI.Comm | None = None) -> Scene:
         """The same scene with every mesh size times `factor` (InputError if it cannot be).
 
-        On `comm` if given, else on the scene's (collective; kept for the next call).
+        On `comm` if given (a multigrid's levels: each rank alone), else on the scene's
+        (collective).
         """
-        if comm is not None:
-            return self.require_recipe().resized(factor).build(comm)
-        if factor not in self._remeshes:
-            self._remeshes[factor] = self.require_recipe().resized(factor).build(self.comm)
-        return self._remeshes[factor]
+        return self.require_recipe().resized(factor).build(self.comm if comm is None else comm)
 
     def remeshed_to(self, field: SizeField) -> Scene:
         """The same scene's geometry meshed by gmsh with the sizes of `field` (collective)."""

@@ -25,7 +25,7 @@ from contactfx.timers import Timers
 @pytest.fixture(scope="module")
 def levels():
     """A small gmsh Hertz mesh and its levels with the first remesh x2 (so that there are
-    several: the default x8 leaves one at this size)."""
+    several: the default first factor leaves one at this size)."""
     mp = pytest.MonkeyPatch()
     mp.setattr(remesh_mg, "FIRST_FACTOR", 2.0)
     scene = hertz(
@@ -33,11 +33,11 @@ def levels():
     )
     setup = prepare_contact(scene, Method.MORTAR.kernel, 1e-8, Timers(), Basis.DUAL)
     el = setup.elasticity
-    mats = remesh_mg.remesh_interpolations(el.V, el.bcs, scene)
+    out = remesh_mg.remesh_levels(el.V, scene)
     mp.undo()
-    yield scene, el, [_scipy(m) for m in mats]
-    for m in mats:
-        m.destroy()
+    yield scene, el, out
+    for level in out:
+        level.P.destroy()
 
 
 def _scipy(m) -> sp.csr_matrix:
@@ -64,58 +64,72 @@ def _interleaved(x: np.ndarray, body: np.ndarray) -> np.ndarray:
     return np.stack([f, 2.0 * f], axis=1).ravel()
 
 
-def test_levels_coarsen(levels) -> None:
-    """Two or more levels, each the scene remeshed x2 more coarsely, with fewer than 0.6 of
-    the nodes of the level before."""
-    scene, el, mats = levels
-    assert len(mats) >= 2
-    n_fine = el.V.dofmap.index_map.size_local * 2
-    sizes = [n_fine] + [m.shape[1] for m in mats]
-    assert [m.shape[0] for m in mats] == sizes[:-1]
+def test_levels_are_the_remeshes(levels) -> None:
+    """Two or more levels; level k's nodes are nodes of the scene remeshed 2^(k+1) times
+    coarser, each with that mesh's body, fewer than 0.6 of the level before; none is an
+    empty column (a singular coarse operator)."""
+    scene, el, out = levels
+    assert len(out) >= 2
+    sizes = [el.V.dofmap.index_map.size_local] + [len(level.x) for level in out]
     assert all(b < 0.6 * a for a, b in itertools.pairwise(sizes))
-    for k, m in enumerate(mats):
-        assert m.shape[1] == 2 * scene.remeshed(2.0 ** (k + 1)).mesh.geometry.x.shape[0]
+    for k, level in enumerate(out):
+        P = _scipy(level.P)
+        assert P.shape == (2 * sizes[k], 2 * sizes[k + 1])
+        assert (np.abs(P).sum(axis=0) > 0).all()
+        mesh = scene.remeshed(2.0 ** (k + 1))
+        # Keyed by position and body: the two bodies each have a node where they touch.
+        cx, cb = np.round(mesh.mesh.geometry.x[:, :2], 12), _bodies(mesh)
+        index = {(*p, b): i for i, (p, b) in enumerate(zip(cx, cb, strict=True))}
+        keys = zip(np.round(level.x, 12), level.body, strict=True)
+        where = [index[(*p, b)] for p, b in keys]  # KeyError: not a node of that body there
+        assert len(set(where)) == len(where)
 
 
 def test_prolongations_reproduce_each_bodys_affine_function(levels) -> None:
-    """P f_coarse = f_fine for a different affine function per body, at every row but the
-    Dirichlet ones (zero rows) on the finest level; the other rows sum to one."""
-    scene, el, mats = levels
+    """P f_coarse = f_fine for a different affine function per body, at every row (Dirichlet
+    rows too: they keep their weights); rows sum to one."""
+    scene, el, out = levels
     n = el.V.dofmap.index_map.size_local
-    x_fine = el.V.tabulate_dof_coordinates()[:n, :2]
+    fine_x = el.V.tabulate_dof_coordinates()[:n, :2]
     node_block = np.empty(scene.mesh.geometry.x.shape[0], dtype=np.int64)
     node_block[scene.mesh.geometry.dofmaps[0].ravel()] = el.V.dofmap.list.ravel()
-    body_fine = np.empty(n, dtype=np.int64)
-    body_fine[node_block] = _bodies(scene)
-    fixed = np.zeros(2 * n, dtype=bool)
-    for bc in el.bcs:
-        fixed[bc.dof_indices()[0]] = True
-    assert fixed.any()
-    fine_x, fine_body = x_fine, body_fine
-    for k, P in enumerate(mats):
-        coarse = scene.remeshed(2.0 ** (k + 1))
-        cx, cbody = coarse.mesh.geometry.x[:, :2], _bodies(coarse)
-        got = P @ _interleaved(cx, cbody)
+    fine_body = np.empty(n, dtype=np.int64)
+    fine_body[node_block] = _bodies(scene)
+    for level in out:
+        P = _scipy(level.P)
         want = _interleaved(fine_x, fine_body)
-        free = ~fixed if k == 0 else np.ones(len(want), dtype=bool)
-        assert np.abs(got - want)[free].max() < 1e-9 * np.abs(want).max()
-        sums = np.asarray(P.sum(axis=1)).ravel()  # a row's weights: on its component's columns
-        assert np.abs(sums[free] - 1.0).max() < 1e-12
-        if k == 0:
-            assert np.abs(P[fixed]).sum() == 0.0
-        fine_x, fine_body = cx, cbody
+        got = P @ _interleaved(level.x, level.body)
+        assert np.abs(got - want).max() < 1e-9 * np.abs(want).max()
+        assert np.abs(np.asarray(P.sum(axis=1)).ravel() - 1.0).max() < 1e-12
+        fine_x, fine_body = level.x, level.body
 
 
-def test_the_default_levels_start_at_x8(levels) -> None:
-    """By default the first coarser mesh is the scene remeshed x8 (FIRST_FACTOR), then x16...
-    down to the coarsest size; here, 8k nodes, x8 is already under it: one level."""
+def test_the_default_levels_start_at_the_first_factor(levels) -> None:
+    """By default the first coarser mesh is the scene remeshed FIRST_FACTOR times coarser,
+    then twice that... down to the coarsest size; on this 8k-node mesh the first is already
+    under it: one level."""
     scene, el, _ = levels
-    mats = remesh_mg.remesh_interpolations(el.V, el.bcs, scene)
+    out = remesh_mg.remesh_levels(el.V, scene)
     try:
-        assert remesh_mg.FIRST_FACTOR == 8.0
-        coarse = scene.remeshed(8.0).mesh.geometry.x.shape[0]
+        coarse = scene.remeshed(remesh_mg.FIRST_FACTOR).mesh.geometry.x.shape[0]
         assert coarse <= remesh_mg.COARSEST_NODES < el.V.dofmap.index_map.size_local
-        assert [m.getSize()[1] for m in mats] == [2 * coarse]
+        assert len(out) == 1 and len(out[0].x) <= coarse
     finally:
-        for m in mats:
-            m.destroy()
+        for level in out:
+            level.P.destroy()
+
+
+def test_no_empty_coarse_column_on_the_default_mesh() -> None:
+    """The default Hertz mesh (nodes held by the edge sizes: its remeshes keep most of them)
+    has coarse nodes no finer node interpolates from; they are dropped, so every column of
+    every level carries weight (else PCMG's Galerkin operator is singular and CG breaks
+    down: DIVERGED_INDEFINITE_PC)."""
+    scene = hertz(HertzParams(), comm=MPI.COMM_SELF)
+    setup = prepare_contact(scene, Method.NTS.kernel, 1e-8, Timers())
+    out = remesh_mg.remesh_levels(setup.elasticity.V, scene)
+    assert out
+    for level in out:
+        P = _scipy(level.P)
+        assert (np.abs(P).sum(axis=0) > 0).all()
+        assert len(level.x) < scene.remeshed(remesh_mg.FIRST_FACTOR).mesh.geometry.x.shape[0]
+        level.P.destroy()

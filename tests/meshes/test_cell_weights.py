@@ -1,8 +1,8 @@
-"""meshes.cell_weights: basis weights of points in triangles and quadrilaterals.
+"""meshes.cell_weights: bilinear basis weights of points in quadrilaterals.
 
-References: points made from known reference coordinates by the cell's own forward map
-(barycentric or bilinear), affine functions (which both bases reproduce, inside the cell and
-extrapolated), and containment decided by the reference coordinates of that forward map.
+References: points made from known reference coordinates by the cell's own bilinear map,
+affine functions (which the Q1 basis reproduces, inside the cell and extrapolated), and
+containment decided by the reference coordinates of that forward map.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from contactfx.meshes.cell_weights import contains, p1_weights
+from contactfx.meshes.cell_weights import contains, q1_weights
 
 RNG = np.random.default_rng(7)
 
@@ -23,10 +23,6 @@ def _quads(n: int) -> np.ndarray:
     angle = RNG.uniform(0, 2 * np.pi, n)
     rot = np.stack([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
     return np.einsum("ijn,nkj->nki", rot, corners) + RNG.uniform(-5, 5, size=(n, 1, 2))
-
-
-def _triangles(n: int) -> np.ndarray:
-    return RNG.uniform(-1.0, 1.0, size=(n, 3, 2)) * np.array([3.0, 0.5])
 
 
 def _bilinear(corners: np.ndarray, ref: np.ndarray) -> np.ndarray:
@@ -42,22 +38,21 @@ def test_quad_weights_invert_the_bilinear_map(outside: float) -> None:
     those coordinates' bilinear basis back to 1e-10."""
     corners = _quads(500)
     ref = RNG.uniform(-outside, 1.0 + outside, size=(500, 2))
-    w, ok = p1_weights(_bilinear(corners, ref), corners)
+    w, ok = q1_weights(_bilinear(corners, ref), corners)
     s, t = ref[:, 0], ref[:, 1]
     expected = np.stack([(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t], axis=1)
     assert ok.all()
     assert np.abs(w - expected).max() < 1e-10
 
 
-@pytest.mark.parametrize("make", [_quads, _triangles])
-def test_weights_reproduce_affine_functions(make) -> None:
+def test_weights_reproduce_affine_functions() -> None:
     """sum_i w_i f(x_i) = f(x) for affine f, in the cell and extrapolated near it; weights
     sum to one."""
-    corners = make(400)
-    lam = RNG.uniform(-0.2, 1.2, size=(400, corners.shape[1]))
+    corners = _quads(400)
+    lam = RNG.uniform(-0.2, 1.2, size=(400, 4))
     lam /= lam.sum(axis=1, keepdims=True)
     points = np.einsum("nk,nkd->nd", lam, corners)  # near the cell, some outside
-    w, ok = p1_weights(points, corners)
+    w, ok = q1_weights(points, corners)
     a, b, c = 0.3, -1.7, 2.5
     f = a + b * corners[..., 0] + c * corners[..., 1]
     assert np.abs(w.sum(axis=1)[ok] - 1.0).max() < 1e-10
@@ -66,29 +61,19 @@ def test_weights_reproduce_affine_functions(make) -> None:
     assert np.abs(err[ok]).max() < 1e-9
 
 
-@pytest.mark.parametrize("make", [_quads, _triangles])
-def test_contains_agrees_with_the_reference_coordinates(make) -> None:
+def test_contains_agrees_with_the_reference_coordinates() -> None:
     """The edge-sign test says inside exactly where the points' reference coordinates (from
-    the forward map) lie in the reference cell, away from its boundary by 1e-6."""
-    corners = make(2000)
-    nv = corners.shape[1]
-    if nv == 4:
-        ref = RNG.uniform(-0.5, 1.5, size=(2000, 2))
-        points = _bilinear(corners, ref)
-        inside = (ref > 1e-6).all(axis=1) & (ref < 1 - 1e-6).all(axis=1)
-        outside = (ref < -1e-6).any(axis=1) | (ref > 1 + 1e-6).any(axis=1)
-    else:
-        lam = RNG.uniform(-0.5, 1.0, size=(2000, 3))
-        lam[:, 2] = 1.0 - lam[:, 0] - lam[:, 1]
-        points = np.einsum("nk,nkd->nd", lam, corners)
-        inside = (lam > 1e-6).all(axis=1)
-        outside = (lam < -1e-6).any(axis=1)
+    the forward map) lie in the reference square, away from its boundary by 1e-6."""
+    corners = _quads(2000)
+    ref = RNG.uniform(-0.5, 1.5, size=(2000, 2))
+    points = _bilinear(corners, ref)
+    inside = (ref > 1e-6).all(axis=1) & (ref < 1 - 1e-6).all(axis=1)
+    outside = (ref < -1e-6).any(axis=1) | (ref > 1 + 1e-6).any(axis=1)
     got = contains(points, corners)
     assert got[inside].all() and not got[outside].any()
     assert inside.sum() > 100 and outside.sum() > 100
     # Either orientation: the same answer with the vertex order mirrored.
-    flipped = corners[:, [1, 0, 3, 2]] if nv == 4 else corners[:, [1, 0, 2]]
-    assert np.array_equal(contains(points, flipped), got)
+    assert np.array_equal(contains(points, corners[:, [1, 0, 3, 2]]), got)
 
 
 def test_far_outside_is_flagged() -> None:
@@ -97,5 +82,5 @@ def test_far_outside_is_flagged() -> None:
     centre = corners.mean(axis=1)
     size = np.linalg.norm(corners[:, 3] - corners[:, 0], axis=1)[:, None]
     far = centre + 6.0 * size * np.array([1.0, 0.0])
-    _, ok = p1_weights(far, corners)
+    _, ok = q1_weights(far, corners)
     assert not ok.any()
