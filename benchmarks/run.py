@@ -210,17 +210,26 @@ def save(meta: dict[str, Any], runs: list[dict[str, Any]]) -> list[dict[str, Any
 def update(cases: list[str]) -> None:
     """Run `cases` and merge them into results.json (the README notes when rows changed).
 
-    A case is MESH:FAMILY:METHODS:SOLVER:SIZE:RANKS:REPEATS, SIZE the target DOFs for the
-    10H family and the refine value for the default one.
+    A case is MESH:FAMILY:METHODS:SOLVER:SIZE:RANKS:REPEATS[:BASIS], SIZE the target DOFs
+    for the 10H family and the refine value for the default one, BASIS mortar's multiplier
+    basis (standard; `condensed` needs dual).
     """
     data = json.loads((HERE / "results.json").read_text())
     new = []
     for case in cases:
-        mesh, fam, methods, solver, size, ranks, repeats = case.split(":")
+        mesh, fam, methods, solver, size, ranks, repeats, *basis = case.split(":")
         h0 = refine_for(float(size), mesh) if fam == "10H" else float(size)
         h_far = None if fam == "10H" else 0.0
         for _ in range(int(repeats)):
-            recs = run_process(mesh, tuple(methods.split(",")), solver, h0, int(ranks), h_far=h_far)
+            recs = run_process(
+                mesh,
+                tuple(methods.split(",")),
+                solver,
+                h0,
+                int(ranks),
+                h_far=h_far,
+                basis=basis[0] if basis else "standard",
+            )
             new += recs
             for rec in recs:
                 print(
@@ -272,7 +281,7 @@ def main() -> None:
         "--case",
         action="append",
         default=[],
-        metavar="MESH:FAMILY:METHODS:SOLVER:SIZE:RANKS:REPEATS",
+        metavar="MESH:FAMILY:METHODS:SOLVER:SIZE:RANKS:REPEATS[:BASIS]",
         help="run only these cases (e.g. gmsh:10H:nts,sts,mortar:mumps:1e6:1:3) and merge "
         "them into results.json, replacing earlier runs of the same case",
     )

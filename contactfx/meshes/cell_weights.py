@@ -15,6 +15,9 @@ import numpy as np
 # Newton on the bilinear map: quadratic convergence from the centre for convex cells; a
 # point this far outside its cell (reference units) is not extrapolated from it.
 NEWTON_STEPS = 8
+# Newton converges quadratically: after a step this small (reference units) the error is
+# of its square, below round-off.
+_SETTLED = 1e-9
 FAR_OUTSIDE = 1.0
 
 # The ring of a quadrilateral's corners in DOLFINx's (tensor) order.
@@ -50,24 +53,42 @@ def contains(points: np.ndarray, corners: np.ndarray, tol: float = 1e-10) -> np.
 
 
 def _reference(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
-    """Reference coordinates of each point in its cell (NaN where Newton missed it)."""
+    """Reference coordinates of each point in its cell (NaN where Newton missed it).
+
+    Newton on the points not yet converged only: most need 3-4 of the NEWTON_STEPS.
+    """
     x0, x1, x2, x3 = (corners[:, k] for k in range(4))
-
-    def forward(ref: np.ndarray) -> np.ndarray:
-        s, t = ref[:, :1], ref[:, 1:]
-        return x0 * (1 - s) * (1 - t) + x1 * s * (1 - t) + x2 * (1 - s) * t + x3 * s * t
-
     ref = np.full((len(points), 2), 0.5)
+    todo = np.arange(len(points))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for _ in range(NEWTON_STEPS):
-            s, t = ref[:, :1], ref[:, 1:]
-            ds = (x1 - x0) * (1 - t) + (x3 - x2) * t  # dx/ds
-            dt = (x2 - x0) * (1 - s) + (x3 - x1) * s  # dx/dt
-            r = points - forward(ref)
+            a0, a1, a2, a3 = x0[todo], x1[todo], x2[todo], x3[todo]
+            s, t = ref[todo, :1], ref[todo, 1:]
+            ds = (a1 - a0) * (1 - t) + (a3 - a2) * t  # dx/ds
+            dt = (a2 - a0) * (1 - s) + (a3 - a1) * s  # dx/dt
+            r = points[todo] - _forward(a0, a1, a2, a3, s, t)
             det = ds[:, 0] * dt[:, 1] - ds[:, 1] * dt[:, 0]
-            ref[:, 0] += (r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det
-            ref[:, 1] += (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det
+            step = np.stack(
+                [
+                    (r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det,
+                    (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det,
+                ],
+                axis=1,
+            )
+            ref[todo] += step
+            # Converged to round-off (reference units), or lost (NaN: the test below).
+            todo = todo[~(np.abs(step).max(axis=1) <= _SETTLED)]
+            if not len(todo):
+                break
         scale = np.linalg.norm(x3 - x0, axis=1) + np.linalg.norm(x2 - x1, axis=1)
-        miss = ~(np.linalg.norm(points - forward(ref), axis=1) <= 1e-9 * scale)
+        at = _forward(x0, x1, x2, x3, ref[:, :1], ref[:, 1:])
+        miss = ~(np.linalg.norm(points - at, axis=1) <= 1e-9 * scale)
     ref[miss] = np.nan
     return ref
+
+
+def _forward(
+    x0: np.ndarray, x1: np.ndarray, x2: np.ndarray, x3: np.ndarray, s: np.ndarray, t: np.ndarray
+) -> np.ndarray:
+    """The bilinear map of reference coordinates (s, t), each (n, 1), to (n, 2) points."""
+    return x0 * (1 - s) * (1 - t) + x1 * s * (1 - t) + x2 * (1 - s) * t + x3 * s * t
