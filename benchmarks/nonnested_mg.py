@@ -73,8 +73,8 @@ def run(target: float, mumps: bool = False) -> dict[str, Any]:
 
 if __name__ == "__main__":
     if "--mumps" in sys.argv and MPI.COMM_WORLD.size > 1:
-        # Under mpirun -n 2 the fixed-set MUMPS solve at 400k did not return (both ranks
-        # busy for 11 minutes); not investigated: the comparison is serial.
+        # Under mpirun its fixed-set MUMPS solve hung, not investigated (docs/scale.md, "A
+        # geometric multigrid on gmsh meshes"): the comparison is serial.
         sys.exit("nonnested_mg.py: --mumps is serial only (run it without mpirun)")
     for arg in sys.argv[1:]:
         if arg == "--mumps":

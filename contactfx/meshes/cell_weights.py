@@ -55,7 +55,8 @@ def contains(points: np.ndarray, corners: np.ndarray, tol: float = 1e-10) -> np.
 def _reference(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """Reference coordinates of each point in its cell (NaN where Newton missed it).
 
-    Newton on the points not yet converged only: most need 3-4 of the NEWTON_STEPS.
+    Newton on the points not yet converged only: most settle well before NEWTON_STEPS
+    (counts: docs/scale.md, "The gmsh levels' point weights").
     """
     x0, x1, x2, x3 = (corners[:, k] for k in range(4))
     ref = np.full((len(points), 2), 0.5)
