@@ -47,12 +47,27 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # MathJax 3 from the installed package, copied into _static/mathjax: the site renders its
+    # math with no network (sphinx.ext.mathjax alone loads MathJax from a CDN).
+    "sphinx-mathjax-offline",
     "sphinxarg.ext",
 ]
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
 html_theme = "pydata_sphinx_theme"
 html_title = f"contactfx {release}"
-html_theme_options = {"navigation_with_keys": False, "show_toc_level": 2}
+html_theme_options = {
+    "navigation_with_keys": False,
+    "show_toc_level": 2,
+    # The top bar holds the four sections of index.md's toctree (user guide, demos,
+    # benchmarks, reference); each section's pages fill the left "Section Navigation".
+    "header_links_before_dropdown": 4,
+    "show_nav_level": 1,
+    "navigation_depth": 2,
+}
+# The front page is a landing page: no section sidebar on it.
+html_sidebars = {"index": []}
+html_static_path = ["_static"]
+html_css_files = ["contactfx.css"]
 
 myst_enable_extensions = ["dollarmath", "amsmath"]
 myst_heading_anchors = 3
