@@ -109,7 +109,12 @@ class ContactPair:
 
     @property
     def prescribed_overlap(self) -> float:
-        """D of `interference = D` (0 for true or false: the gap is the drawn one)."""
+        """The overlap prescribed along the normal (length units), or 0.
+
+        ``interference = D`` (a number D > 0: bodies drawn touching) prescribes D;
+        ``interference = true`` (bodies drawn overlapping) or ``false`` prescribes nothing:
+        the gap is the drawn one, and this is 0.
+        """
         d = self.interference
         return 0.0 if isinstance(d, bool) else d
 
