@@ -76,14 +76,22 @@ for name, params in BLOCK_SCENES.items():
                 "multipliers": data["multipliers"],
                 "dofs": data["dofs"],
                 "contact_force": data["contact_force"],
-                "force_error": abs(data["contact_force"] / (params.p * params.l2 / 2) - 1),
+                "force_error": abs(
+                    data["contact_force"] / (params.p * params.l2 / 2) - 1
+                ),
                 "time": data["times"]["total"],
-                **{f"mismatch_{k}": v for k, v in mismatch(data["interface"], corner).items()},
+                **{
+                    f"mismatch_{k}": v
+                    for k, v in mismatch(data["interface"], corner).items()
+                },
             }
             if name == "S4":
                 dev = body_stress_deviation(sol, -params.p)
                 row.update(
-                    {f"patch_{k}": v for k, v in patch_errors(data["interface"], params.p).items()}
+                    {
+                        f"patch_{k}": v
+                        for k, v in patch_errors(data["interface"], params.p).items()
+                    }
                 )
                 row.update({f"patch_field_{k}": v for k, v in dev.items()})
             row["interface"] = data["interface"]
@@ -111,7 +119,11 @@ if comm.rank == 0:
     for name, params in BLOCK_SCENES.items():
         actives = (2,) if name == "S1" else (2, 1)
         fig, axes = plt.subplots(
-            1, len(actives), figsize=(6.5 * len(actives), 4.2), squeeze=False, layout="constrained"
+            1,
+            len(actives),
+            figsize=(6.5 * len(actives), 4.2),
+            squeeze=False,
+            layout="constrained",
         )
         for ax, active in zip(axes[0], actives, strict=True):
             for k, row in enumerate(
@@ -120,7 +132,9 @@ if comm.rank == 0:
                 itf = row["interface"]
                 x = np.asarray(itf["x"])
                 for key, style in (("sigma_yy_1", "-"), ("sigma_yy_2", "--")):
-                    y = np.array([np.nan if v is None else v for v in itf[key]], dtype=float)
+                    y = np.array(
+                        [np.nan if v is None else v for v in itf[key]], dtype=float
+                    )
                     if name == "S4":
                         # The exact state is uniform: plot the relative error on a log axis.
                         y = np.maximum(np.abs(y / params.p + 1), 1e-16)
@@ -176,7 +190,9 @@ if comm.rank == 0:
     table = "\n".join(lines)
     (OUT / "table.md").write_text(table + "\n")
     (OUT / "summary.json").write_text(
-        json.dumps([{k: v for k, v in r.items() if k != "interface"} for r in rows], indent=1)
+        json.dumps(
+            [{k: v for k, v in r.items() if k != "interface"} for r in rows], indent=1
+        )
     )
     print(table)
 # -
@@ -192,7 +208,10 @@ for r in rows:
     assert r["force_error"] < 1e-10, r
 for r in rows:
     if r["scene"] == "S4" and r["method"] == "mortar":
-        assert max(r["patch_field_body1"], r["patch_field_body2"], r["patch_pressure"]) < 1e-8, r
+        assert (
+            max(r["patch_field_body1"], r["patch_field_body2"], r["patch_pressure"])
+            < 1e-8
+        ), r
 s1 = [r for r in rows if r["scene"] == "S1"]
 ref = np.array(s1[0]["interface"]["sigma_yy_2"], dtype=float)
 xs = np.asarray(s1[0]["interface"]["x"])

@@ -30,7 +30,13 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
-from contactfx import HertzReference, Obstacle, load_scene_file, run_scene, scene_from_gmsh
+from contactfx import (
+    HertzReference,
+    Obstacle,
+    load_scene_file,
+    run_scene,
+    scene_from_gmsh,
+)
 from contactfx.results.references import exact_pressure, hertz_summary
 from contactfx.scenes import Dirichlet
 
@@ -40,7 +46,13 @@ import matplotlib.pyplot as plt
 comm = MPI.COMM_WORLD
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "obstacles"
 SCENES = Path(__file__).resolve().parent / "scenes"
-METHODS = [("nts", {}), ("sts", {}), ("mortar", {}), ("mortar", {"basis": "dual"}), ("penalty", {})]
+METHODS = [
+    ("nts", {}),
+    ("sts", {}),
+    ("mortar", {}),
+    ("mortar", {"basis": "dual"}),
+    ("penalty", {}),
+]
 
 
 def say(*args: object) -> None:
@@ -103,7 +115,14 @@ same = scene_from_gmsh(
     bodies={"block": {"E": 7000.0, "nu": 0.3}},
     dirichlet=[Dirichlet("symmetry", ux=0.0), Dirichlet("base", uy=0.0)],
     obstacles=[
-        Obstacle("indenter", "circle", "top", center=(0, 20), radius=20, displacement=(0, -0.05))
+        Obstacle(
+            "indenter",
+            "circle",
+            "top",
+            center=(0, 20),
+            radius=20,
+            displacement=(0, -0.05),
+        )
     ],
     comm=comm,
 )
@@ -137,7 +156,9 @@ def sadowsky(c: dict, b: float = 1.0) -> tuple[float, float, float]:
     interior = float(np.max(np.abs(p[inner] - exact)) / (P / (np.pi * b)))
     theta = np.linspace(0.0, 0.5 * np.pi, 200001)
     ph = np.interp(b * np.sin(theta), x, p)
-    l1 = float(np.trapezoid(np.abs(ph * b * np.cos(theta) - P / np.pi), theta) / (0.5 * P))
+    l1 = float(
+        np.trapezoid(np.abs(ph * b * np.cos(theta) - P / np.pi), theta) / (0.5 * P)
+    )
     return P, interior, l1
 
 

@@ -33,7 +33,12 @@ import numpy as np
 from mpi4py import MPI
 
 from contactfx.methods.multipliers import solve_contact
-from contactfx.methods.penalty import DEFAULT_FACTOR, ConditionOptions, penetration, solve_penalty
+from contactfx.methods.penalty import (
+    DEFAULT_FACTOR,
+    ConditionOptions,
+    penetration,
+    solve_penalty,
+)
 from contactfx.options import Method
 from contactfx.request import SolveRequest
 from contactfx.results.references import hertz_summary
@@ -88,7 +93,9 @@ for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
     for factor in FACTORS:
         eps = factor * eu
         request = SolveRequest.parse("penalty", penalty=eps)
-        sol = solve_penalty(scene, request, condition=ConditionOptions(max_it=CG_MAX_IT))
+        sol = solve_penalty(
+            scene, request, condition=ConditionOptions(max_it=CG_MAX_IT)
+        )
         du = comm.allreduce(float(np.abs(sol.u.x.array - u_ref).max()), op=MPI.MAX)
         cond = sol.penalty.condition
         row = {
@@ -116,7 +123,11 @@ for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
             f"{name:5s} eps = {factor:7.0e} E/h = {eps:9.3e} MPa/cm: penetration "
             f"{row['penetration']:.2e} cm, pressure error vs mortar "
             f"{row['pressure_error_vs_mortar']:.2e}, u error {row['u_error_vs_mortar']:.2e}"
-            + (f", L2 vs Hertz {row['l2_error_vs_exact']:.4f}" if kind == "hertz" else "")
+            + (
+                f", L2 vs Hertz {row['l2_error_vs_exact']:.4f}"
+                if kind == "hertz"
+                else ""
+            )
             + f", cond {row['condition']:.2e}, CG its {row['cg_iterations']}"
         )
 say(f"{len(rows)} penalty solves in {time.perf_counter() - t0:.1f} s")
@@ -134,7 +145,13 @@ if comm.rank == 0:
     for ax, name in zip(axes, ("S3", "Hertz"), strict=True):
         rs = [r for r in rows if r["scene"] == name]
         f = np.array([r["factor"] for r in rs])
-        ax.loglog(f, [r["penetration"] for r in rs], "o-", color="C0", label="penetration (cm)")
+        ax.loglog(
+            f,
+            [r["penetration"] for r in rs],
+            "o-",
+            color="C0",
+            label="penetration (cm)",
+        )
         ax.loglog(
             f,
             [r["pressure_error_vs_mortar"] for r in rs],
@@ -158,7 +175,11 @@ if comm.rank == 0:
                 label="L2 error of p vs exact Hertz",
             )
             ax.axhline(
-                rs[0]["l2_error_mortar"], color="C3", ls=":", lw=1, label="mortar L2 error vs exact"
+                rs[0]["l2_error_mortar"],
+                color="C3",
+                ls=":",
+                lw=1,
+                label="mortar L2 error vs exact",
             )
         ax.axvline(DEFAULT_FACTOR, color="k", ls=":", lw=1)
         ax.set_xlabel("eps / (E_max / h)")
@@ -188,7 +209,9 @@ if comm.rank == 0:
     ]
     for r in rows:
         l2 = f"{r['l2_error_vs_exact']:.4f}" if "l2_error_vs_exact" in r else ""
-        its = f"{r['cg_iterations']}" + ("" if r["cg_converged"] else " (not converged)")
+        its = f"{r['cg_iterations']}" + (
+            "" if r["cg_converged"] else " (not converged)"
+        )
         lines.append(
             f"| {r['scene']} | {r['factor']:.0e} | {r['eps']:.2e} | "
             f"{r['penetration']:.2e} | {r['pressure_error_vs_mortar']:.2e} | "
@@ -223,7 +246,9 @@ if not QUICK:
     # The other side: past ~1e6 E/h round-off in the factorization takes over again.
     errs = [r["pressure_error_vs_mortar"] for r in s3.values()]
     assert s3[1e10]["pressure_error_vs_mortar"] > 100 * min(errs)
-assert abs(hz[1e3]["l2_error_vs_exact"] / hz[1e3]["l2_error_mortar"] - 1) < 0.01, hz[1e3]
+assert abs(hz[1e3]["l2_error_vs_exact"] / hz[1e3]["l2_error_mortar"] - 1) < 0.01, hz[
+    1e3
+]
 for r in rows:
     assert np.isfinite(r["p_max"]) and r["penetration"] >= 0
 say("all checks passed")

@@ -62,7 +62,9 @@ def say(*args: object) -> None:
 
 def interface_arrays(data: dict) -> dict[str, np.ndarray]:
     return {
-        k: np.array([np.nan if v is None else v for v in data["interface"][k]], dtype=float)
+        k: np.array(
+            [np.nan if v is None else v for v in data["interface"][k]], dtype=float
+        )
         for k in ("x", "pressure", "sigma_yy_1", "sigma_yy_2")
     }
 
@@ -82,7 +84,9 @@ for name, params in BLOCK_SCENES.items():
     runs[name] = {"mortar": mortar}
     for label, opts in SETTINGS.items():
         try:
-            sol, data = run_case("blocks", params, Method.SCHWARZ, comm=comm, schwarz=opts)
+            sol, data = run_case(
+                "blocks", params, Method.SCHWARZ, comm=comm, schwarz=opts
+            )
             data = data.to_json()
             entry = {"data": data, "history": data["active_set"], "converged": True}
             if label.startswith("Aitken"):
@@ -127,7 +131,9 @@ if comm.rank == 0:
         ax.set_ylim(1e-14, 10)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
-    fig.suptitle("Dirichlet-Neumann iteration: relative change of B2's interface displacement")
+    fig.suptitle(
+        "Dirichlet-Neumann iteration: relative change of B2's interface displacement"
+    )
     fig.savefig(OUT / "residual.png", dpi=110)
     plt.close(fig)
 # -
@@ -167,7 +173,9 @@ for k in levels:
 if comm.rank == 0:
     fig, ax = plt.subplots(figsize=(6.5, 4.5), layout="constrained")
     dofs = [r["dofs"] for r in sweep]
-    ax.loglog(dofs, [r["mortar_solve"] for r in sweep], "s-", label="mortar LM: saddle solve")
+    ax.loglog(
+        dofs, [r["mortar_solve"] for r in sweep], "s-", label="mortar LM: saddle solve"
+    )
     ax.loglog(
         dofs,
         [r["schwarz_solve"] for r in sweep],
@@ -213,7 +221,10 @@ for name, params in BLOCK_SCENES.items():
     ait = r["Aitken, omega_0 = 0.5"]["data"]
     a, m = interface_arrays(ait), interface_arrays(r["mortar"])
     diff = (
-        max(float(np.nanmax(np.abs(a[k] - m[k]))) for k in ("pressure", "sigma_yy_1", "sigma_yy_2"))
+        max(
+            float(np.nanmax(np.abs(a[k] - m[k])))
+            for k in ("pressure", "sigma_yy_1", "sigma_yy_2")
+        )
         / params.p
     )
     rows.append(

@@ -64,7 +64,9 @@ def graded(h_edge: float) -> HertzParams:
 
 EDGES = [0.04, 0.02] if QUICK else [0.04, 0.02, 0.01]
 exact = hertz_exact(replace(HertzParams(), model=Model.AXISYMMETRIC))
-say(f"3D Hertz: a = {exact['a']:.4f} cm, p0 = {exact['p0']:.3f} MPa, E* = {exact['E_star']:.1f}")
+say(
+    f"3D Hertz: a = {exact['a']:.4f} cm, p0 = {exact['p0']:.3f} MPa, E* = {exact['E_star']:.1f}"
+)
 rows, profiles = [], {}
 for h in EDGES:
     for method in METHODS:
@@ -91,9 +93,13 @@ for h in EDGES:
 # half-width and the peak pressure approach the 3D values.
 
 # +
-say(f"{'h_e':>6} {'method':>7} {'cells':>6} {'force':>12} {'a err':>8} {'p0 err':>8} {'L2':>7}")
+say(
+    f"{'h_e':>6} {'method':>7} {'cells':>6} {'force':>12} {'a err':>8} {'p0 err':>8} {'L2':>7}"
+)
 for h, method, cells, force, ea, ep, l2 in rows:
-    say(f"{h:6.3f} {method:>7} {cells:6d} {force:12.8f} {ea:+8.2%} {ep:+8.2%} {l2:7.2%}")
+    say(
+        f"{h:6.3f} {method:>7} {cells:6d} {force:12.8f} {ea:+8.2%} {ep:+8.2%} {l2:7.2%}"
+    )
 
 if comm.rank == 0:
     OUT.mkdir(parents=True, exist_ok=True)

@@ -86,7 +86,9 @@ for num, den in RATIOS:
     for e_ratio in E_RATIOS:
         for side in SIDES:
             sizes = (
-                {"size2": h_act, "size1": h_pas} if side == 2 else {"size1": h_act, "size2": h_pas}
+                {"size2": h_act, "size1": h_pas}
+                if side == 2
+                else {"size1": h_act, "size2": h_pas}
             )
             params = replace(S4, E1=e_ratio * S4.E2, **sizes)
             scene = build_scene("blocks", params, active=side, comm=comm)
@@ -126,7 +128,9 @@ def grid(method: str, measure) -> np.ndarray:
     out = np.full((len(row_keys), len(cols)), np.nan)
     for r in rows:
         if r["method"] == method:
-            out[row_keys.index((r["E1/E2"], r["active"])), cols.index(r["ratio"])] = measure(r)
+            out[row_keys.index((r["E1/E2"], r["active"])), cols.index(r["ratio"])] = (
+                measure(r)
+            )
     return np.maximum(out, FLOOR)
 
 
@@ -169,7 +173,9 @@ if comm.rank == 0:
         "max |sigma_yy/p + 1| over both bodies",
         OUT / "patch_stress.png",
     )
-    heatmaps(lambda r: r["pressure"], "max |pressure/p - 1|", OUT / "patch_pressure.png")
+    heatmaps(
+        lambda r: r["pressure"], "max |pressure/p - 1|", OUT / "patch_pressure.png"
+    )
     lines = [
         "| method | active | E1/E2 | ratio | body 1 | body 2 | pressure |",
         "|---|---|---|---|---|---|---|",
@@ -240,12 +246,16 @@ for name in OSC_SCENES:
                 }
                 for body in (1, 2):
                     xs, s = surface_stress(sol, f"contact{body}")
-                    row[f"sigma_yy_{body}"] = zigzag(xs, s, 0.7 * xc, 0.95 * xc) / base.p
+                    row[f"sigma_yy_{body}"] = (
+                        zigzag(xs, s, 0.7 * xc, 0.95 * xc) / base.p
+                    )
                 row["mismatch_corner"] = mismatch(interface(sol), xc)["corner"] / base.p
                 osc.append(row)
             say(
                 f"{name} B{side} active, h2 = {params.size2:.3f}: "
-                + ", ".join(f"{r['method']} {r['pressure']:.1e}" for r in osc[-len(METHODS) :])
+                + ", ".join(
+                    f"{r['method']} {r['pressure']:.1e}" for r in osc[-len(METHODS) :]
+                )
             )
 say(f"oscillation study: {len(osc)} solves in {time.perf_counter() - t0:.1f} s")
 
@@ -271,7 +281,9 @@ if comm.rank == 0:
                     rs = [
                         r
                         for r in osc
-                        if r["scene"] == name and r["method"] == m.value and r["active"] == side
+                        if r["scene"] == name
+                        and r["method"] == m.value
+                        and r["active"] == side
                     ]
                     # The penalty curve lies on the mortar one: thinner, with crosses, on top.
                     thin = m == Method.PENALTY
@@ -293,13 +305,17 @@ if comm.rank == 0:
             ax.set_title(f"{name}: {title}", fontsize=9)
             ax.grid(alpha=0.3, which="both")
     axes[0, 0].legend(fontsize=7)
-    fig.suptitle("Node-to-node oscillation near the corner (0.7 x_c .. 0.95 x_c) under refinement")
+    fig.suptitle(
+        "Node-to-node oscillation near the corner (0.7 x_c .. 0.95 x_c) under refinement"
+    )
     fig.savefig(OUT / "corner_oscillation.png", dpi=110)
     plt.close(fig)
     (OUT / "oscillation.json").write_text(json.dumps(osc, indent=1))
     lines = [
         "| scene | active | method | "
-        + " | ".join(f"h2={r:.3g}" for r in sorted({o["h2"] for o in osc}, reverse=True))
+        + " | ".join(
+            f"h2={r:.3g}" for r in sorted({o["h2"] for o in osc}, reverse=True)
+        )
         + " |"
     ]
     lines.append("|" + "---|" * (3 + len(LEVELS)))
@@ -310,7 +326,9 @@ if comm.rank == 0:
                     (
                         r
                         for r in osc
-                        if r["scene"] == name and r["active"] == side and r["method"] == m.value
+                        if r["scene"] == name
+                        and r["active"] == side
+                        and r["method"] == m.value
                     ),
                     key=lambda r: -r["h2"],
                 )
@@ -341,11 +359,17 @@ if comm.rank == 0:
 for r in rows:
     if r["method"] in ("mortar", "penalty"):
         assert max(r["body1"], r["body2"], r["pressure"]) < 1e-8, r
-nts_worst = max(max(r["body1"], r["body2"], r["pressure"]) for r in rows if r["method"] == "nts")
+nts_worst = max(
+    max(r["body1"], r["body2"], r["pressure"]) for r in rows if r["method"] == "nts"
+)
 assert nts_worst > 1e-3, nts_worst
 for name in OSC_SCENES:
     rs = sorted(
-        (r for r in osc if r["scene"] == name and r["method"] == "mortar" and r["active"] == 2),
+        (
+            r
+            for r in osc
+            if r["scene"] == name and r["method"] == "mortar" and r["active"] == 2
+        ),
         key=lambda r: -r["h2"],
     )
     assert rs[-1]["pressure"] < rs[0]["pressure"], rs

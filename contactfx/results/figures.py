@@ -6,6 +6,7 @@ The deformed-field picture is like the paper's Fig. 3; the charts read the run's
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +15,7 @@ import numpy as np
 from ..methods.solution import Solution
 from .obstacles import outline
 from .records import RunSummary
+from .references import exact_pressure
 from .stress import sigma_field
 
 # A field whose spread is below this fraction of its scale is uniform to round-off: it is
@@ -290,5 +292,47 @@ def plot_pair(run: RunSummary, k: int, path: Path) -> Path:
     bx.legend(fontsize=8)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_hertz_profiles(runs: Sequence[tuple[str, RunSummary]], path: Path) -> Path:
+    """Chart the contact pressure of labelled runs against Hertz, and each one's difference.
+
+    Every run needs the paper's interface block (built-in scenes) and a Hertz reference; the
+    exact profile is the first run's. A label containing "uniform" is drawn dashed.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    first = runs[0][1]
+    assert first.hertz, "the runs have no Hertz reference"
+    a, p0 = first.hertz[0].a_exact, first.hertz[0].p0_exact
+    fig, (top, bottom) = plt.subplots(
+        2, 1, figsize=(8, 7), sharex=True, height_ratios=[2, 1], layout="constrained"
+    )
+    xs = np.linspace(0.0, 1.5 * a, 600)
+    top.plot(xs, exact_pressure(xs, a, p0), "k-", lw=2.5, alpha=0.4, label="exact (Hertz)")
+    for label, run in runs:
+        assert run.interface is not None, f"{label}: the run has no interface block"
+        x = np.asarray(run.interface["x"], dtype=float)
+        p = np.asarray(run.interface["pressure"], dtype=float)
+        style = "--" if "uniform" in label else "-"
+        top.plot(x, p, style, marker=".", ms=3, lw=1, label=label)
+        bottom.plot(x, p - exact_pressure(x, a, p0), style, marker=".", ms=3, lw=1)
+    for ax in (top, bottom):
+        ax.axvline(a, color="gray", lw=0.8, ls=":")
+        ax.grid(alpha=0.3)
+    top.set_ylabel(f"contact pressure ({first.units.stress})")
+    bottom.set_ylabel("p - p_exact")
+    bottom.set_xlabel(f"x ({first.units.length})")
+    bottom.set_xlim(0.0, 1.5 * a)
+    bottom.set_ylim(-0.2 * p0, 0.2 * p0)
+    top.legend(fontsize=8)
+    top.set_title(f"Contact pressure against Hertz (a = {a:.4g} {first.units.length})")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
