@@ -128,8 +128,9 @@ else:
     best = [r for r in mortar if r.elements <= 5000 and r.factor <= 1.0][-1]
     assert best.errors["a"] < 0.0025 and best.errors["p0"] < 0.005
     assert best.errors["l2"] < 0.008
-    # The rate on the levels with h_e <= 0.04 cm (the coarser have a handful of contact
-    # nodes): measured 0.96, asserted with the margin of the edge's placement in a cell.
+    # The rate on the levels with h_e <= 0.04 cm (the coarser have a handful of
+    # contact nodes): measured 0.96, asserted with the margin of the edge's
+    # placement in a cell.
     fine = [r for r in mortar if r.factor <= 8.0]
     rate = fit_rate([r.factor for r in fine], [r.errors["l2"] for r in fine])
     assert rate is not None and rate >= 0.9, rate
