@@ -98,7 +98,8 @@ for name, params in BLOCK_SCENES.items():
             rows.append(row)
             say(
                 f"{name} {method.value:7s} active={active}: force error "
-                f"{row['force_error']:.1e}, mismatch centre {row['mismatch_center']:.3g} MPa, "
+                f"{row['force_error']:.1e}, mismatch centre "
+                f"{row['mismatch_center']:.3g} MPa, "
                 f"corner {row['mismatch_corner']:.3g} MPa ({row['time']:.2f} s)"
             )
             if method == Method.MORTAR and active == 2 and (name == "S4" or not QUICK):

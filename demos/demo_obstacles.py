@@ -98,8 +98,10 @@ for method, options in METHODS:
     h = hertz_summary(sol, HertzReference(0, 20.0, P, symmetric=True)).to_json()
     hertz[label(method, options)] = (h, c)
     say(
-        f"{label(method, options):12s} P = {P:.4f}: a {100 * (h['a'] / h['a_exact'] - 1):+.2f} %, "
-        f"p0 {100 * (h['p0'] / h['p0_exact'] - 1):+.2f} %, L2 {100 * h['l2_error']:.2f} %, "
+        f"{label(method, options):12s} P = {P:.4f}: a "
+        f"{100 * (h['a'] / h['a_exact'] - 1):+.2f} %, "
+        f"p0 {100 * (h['p0'] / h['p0_exact'] - 1):+.2f} %, L2 "
+        f"{100 * h['l2_error']:.2f} %, "
         f"{c['active_nodes']} active nodes, balance {c['balance']:.1e}, "
         f"{time.perf_counter() - t0:.2f} s"
     )
@@ -146,7 +148,7 @@ say(f"Python API: force {again['contacts'][0]['force']}")
 
 # +
 def sadowsky(c: dict, b: float = 1.0) -> tuple[float, float, float]:
-    """P, the max error at |x| <= b/2 (relative to p(0)) and the L1 error over the face."""
+    """P, the max error at |x| <= b/2 (relative to p(0)), the L1 error over the face."""
     P = 2.0 * abs(c["force"][1])
     x, p = np.asarray(c["interface"]["x"]), np.asarray(c["interface"]["pressure"])
     order = np.argsort(x)
@@ -171,7 +173,8 @@ for method, options in METHODS:
     P, interior, l1 = sadowsky(c)
     flat[label(method, options)] = (P, interior, l1, c)
     say(
-        f"{label(method, options):12s} P = {P:.4f}: max error |x| <= b/2 {100 * interior:.2f} %, "
+        f"{label(method, options):12s} P = {P:.4f}: max error |x| <= b/2 "
+        f"{100 * interior:.2f} %, "
         f"L1 over the face {100 * l1:.2f} %, {c['active_nodes']} active nodes"
     )
 # -

@@ -138,8 +138,10 @@ for method in METHODS:
     results[method] = data
     for h, c in zip(data["hertz_pairs"], data["contacts"], strict=True):
         say(
-            f"{method:8s} pair {h['pair']}: a {100 * (h['a'] / h['a_exact'] - 1):+6.2f} %, "
-            f"p0 {100 * (h['p0'] / h['p0_exact'] - 1):+6.2f} %, L2 {100 * h['l2_error']:5.2f} %, "
+            f"{method:8s} pair {h['pair']}: a "
+            f"{100 * (h['a'] / h['a_exact'] - 1):+6.2f} %, "
+            f"p0 {100 * (h['p0'] / h['p0_exact'] - 1):+6.2f} %, L2 "
+            f"{100 * h['l2_error']:5.2f} %, "
             f"force {c['force'][1]:+.8g}, balance {c['balance']:.1e}"
         )
     say(

@@ -122,7 +122,8 @@ for name, kind, params in (("S3", "blocks", S3), ("Hertz", "hertz", HERTZ)):
         say(
             f"{name:5s} eps = {factor:7.0e} E/h = {eps:9.3e} MPa/cm: penetration "
             f"{row['penetration']:.2e} cm, pressure error vs mortar "
-            f"{row['pressure_error_vs_mortar']:.2e}, u error {row['u_error_vs_mortar']:.2e}"
+            f"{row['pressure_error_vs_mortar']:.2e}, u error "
+            f"{row['u_error_vs_mortar']:.2e}"
             + (
                 f", L2 vs Hertz {row['l2_error_vs_exact']:.4f}"
                 if kind == "hertz"

@@ -166,8 +166,10 @@ for k in levels:
         }
     )
     say(
-        f"S2 / {k}: {schwarz['dofs']} dofs, {schwarz['iterations']} iterations, Schwarz "
-        f"{sweep[-1]['schwarz_solve']:.3f} s vs mortar {sweep[-1]['mortar_solve']:.3f} s"
+        f"S2 / {k}: {schwarz['dofs']} dofs, {schwarz['iterations']} iterations, "
+        "Schwarz "
+        f"{sweep[-1]['schwarz_solve']:.3f} s vs mortar "
+        f"{sweep[-1]['mortar_solve']:.3f} s"
     )
 
 if comm.rank == 0:

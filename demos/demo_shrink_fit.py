@@ -82,7 +82,8 @@ say("| method | mean pressure | Lame | error | active | initial overlap |")
 say("|---|---|---|---|---|---|")
 for r in rows:
     say(
-        f"| {r['method']} | {r['p_mean']:.5g} | {r['p_exact']:.5g} | {100 * r['error']:.3f} % "
+        f"| {r['method']} | {r['p_mean']:.5g} | {r['p_exact']:.5g} | "
+        f"{100 * r['error']:.3f} % "
         f"| {r['active']} | {r['initial_overlap']:.3e} |"
     )
 # -

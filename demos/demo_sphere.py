@@ -65,7 +65,8 @@ def graded(h_edge: float) -> HertzParams:
 EDGES = [0.04, 0.02] if QUICK else [0.04, 0.02, 0.01]
 exact = hertz_exact(replace(HertzParams(), model=Model.AXISYMMETRIC))
 say(
-    f"3D Hertz: a = {exact['a']:.4f} cm, p0 = {exact['p0']:.3f} MPa, E* = {exact['E_star']:.1f}"
+    f"3D Hertz: a = {exact['a']:.4f} cm, p0 = {exact['p0']:.3f} MPa, E* = "
+    f"{exact['E_star']:.1f}"
 )
 rows, profiles = [], {}
 for h in EDGES:
@@ -94,7 +95,8 @@ for h in EDGES:
 
 # +
 say(
-    f"{'h_e':>6} {'method':>7} {'cells':>6} {'force':>12} {'a err':>8} {'p0 err':>8} {'L2':>7}"
+    f"{'h_e':>6} {'method':>7} {'cells':>6} {'force':>12} {'a err':>8} {'p0 err':>8} "
+    f"{'L2':>7}"
 )
 for h, method, cells, force, ea, ep, l2 in rows:
     say(

@@ -193,7 +193,8 @@ if comm.rank == 0:
             key=lambda r: max(r["body1"], r["body2"], r["pressure"]),
         )
         say(
-            f"{m.value:8s} worst case: ratio {worst['ratio']}, E1/E2 {worst['E1/E2']:g}, "
+            f"{m.value:8s} worst case: ratio {worst['ratio']}, E1/E2 "
+            f"{worst['E1/E2']:g}, "
             f"B{worst['active']} active: body1 {worst['body1']:.1e}, body2 "
             f"{worst['body2']:.1e}, pressure {worst['pressure']:.1e}"
         )
@@ -214,7 +215,7 @@ if comm.rank == 0:
 
 # +
 def zigzag(x: np.ndarray, v: np.ndarray, lo: float, hi: float) -> float:
-    """Max deviation of v_i from the chord through its neighbours, for x_i in [lo, hi]."""
+    """Max deviation of v_i from the chord through its neighbours, x_i in [lo, hi]."""
     t = (x[1:-1] - x[:-2]) / (x[2:] - x[:-2])
     dev = np.abs(v[1:-1] - ((1 - t) * v[:-2] + t * v[2:]))
     inside = (x[1:-1] >= lo) & (x[1:-1] <= hi)
@@ -306,7 +307,8 @@ if comm.rank == 0:
             ax.grid(alpha=0.3, which="both")
     axes[0, 0].legend(fontsize=7)
     fig.suptitle(
-        "Node-to-node oscillation near the corner (0.7 x_c .. 0.95 x_c) under refinement"
+        "Node-to-node oscillation near the corner (0.7 x_c .. 0.95 x_c) under "
+        "refinement"
     )
     fig.savefig(OUT / "corner_oscillation.png", dpi=110)
     plt.close(fig)
@@ -335,7 +337,8 @@ if comm.rank == 0:
                 lines.append(
                     f"| {name} | {side} | {m.value} | "
                     + " | ".join(
-                        f"{r['pressure']:.1e} / {r['sigma_yy_1']:.1e} / {r['sigma_yy_2']:.1e}"
+                        f"{r['pressure']:.1e} / {r['sigma_yy_1']:.1e} / "
+                        f"{r['sigma_yy_2']:.1e}"
                         for r in rs
                     )
                     + " |"
