@@ -34,6 +34,50 @@ def overlap_tolerance(weights: np.ndarray) -> float:
     return 1e-12 * max(float(np.max(weights, initial=0.0)), 1e-300)
 
 
+# Where an overlap interval ends within this fraction of its active segment from a node, it
+# reaches that node (round-off of the clipping).
+REACH = 1e-9
+TWO_CELLS = True
+
+
+def end_rows(segments: np.ndarray, n_nodes: int, some: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """The row of each active node after the end modification at the passive surface's ends.
+
+    `some` (m,): active segment e faces the passive surface somewhere; `reach` (m, 2): that
+    part reaches node k of e. A node o whose only facing segment e reaches the other node i
+    of e but not o (e straddles the end of the passive surface, o lies beyond it) gets no row
+    of its own: its basis function on e is merged into i's, so i's multiplier is constant on
+    the facing part of e (N_i + N_o = 1, psi_i + psi_o = 1 for the dual basis). Without it the
+    two functions, restricted to a short facing part, are nearly dependent: their two
+    multipliers fit the corner's load by a steep slope, o's grows large and i's turns tensile
+    (docs/edges.md). This is the boundary modification of the dual-mortar literature
+    (Wohlmuth; Popp et al.; Cichosz and Bischoff): the node whose support is only partly
+    covered leaves the multiplier space. A segment facing the passive surface only strictly
+    inside (both of its nodes beyond a passive surface shorter than one segment) keeps its
+    two rows. Returns `rows` (n_nodes,): rows[j] = j, or i for a merged o.
+    """
+    rows = np.arange(n_nodes)
+    facing = np.bincount(segments[some].ravel(), minlength=n_nodes)
+    full = reach[:, 0] & reach[:, 1]
+    degree = np.bincount(segments.ravel(), minlength=n_nodes)
+    n_full = np.bincount(segments[full].ravel(), minlength=n_nodes)
+    for k in (0, 1):
+        o, i = segments[:, k], segments[:, 1 - k]
+        merge = some & reach[:, 1 - k] & ~reach[:, k] & (facing[o] == 1)
+        rows[o[merge]] = i[merge]
+    if TWO_CELLS:
+        # The last reached node: its outward segment faces only partly or not at all.
+        last = np.zeros(n_nodes, dtype=bool)
+        last[rows[rows != np.arange(n_nodes)]] = True
+        last |= (degree == 2) & (n_full == 1) & (facing == 1)
+        for k in (0, 1):
+            o, i = segments[:, k], segments[:, 1 - k]
+            merge = full & last[o] & (n_full[o] == 1) & (n_full[i] == 2)
+            rows[o[merge]] = i[merge]
+        rows = rows[rows]
+    return rows
+
+
 def gauss_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
     """n-point Gauss-Legendre points and weights on [0, 1]."""
     x, w = np.polynomial.legendre.leggauss(n)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .geometry import Surface, radial_weight, segment_lengths
-from .operator import ContactOperator, assemble, gauss_unit, linear_shape
+from .operator import ContactOperator, assemble, end_rows, gauss_unit, linear_shape
 from .search import project
 
 GAUSS_POINTS = 4
@@ -34,11 +34,15 @@ def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOp
     # No cutting at passive nodes: a segment straddling a passive node or kink is integrated
     # as if the integrand were smooth (the method's known source of oscillations).
     f = np.flatnonzero(found)
+    # End modification (operator.end_rows): a segment whose first (last) Gauss point is found
+    # reaches its node 0 (1); the node beyond the passive end merges into its inside neighbour.
+    hit = found.reshape(-1, GAUSS_POINTS)
+    ends = end_rows(active.segments, active.n_nodes, hit.any(axis=1), hit[:, [0, -1]])
     return assemble(
         active,
         passive,
         ndofs,
-        rows=nodes[f],
+        rows=ends[nodes[f]],
         row_coef=w[f, None] * na[f],
         act_nodes=nodes[f],
         act_coef=na[f],
