@@ -193,11 +193,11 @@ def _end_rows(active: Surface, seg_a: np.ndarray, xi_int: np.ndarray) -> np.ndar
 
 
 def _gauss_points(
-    active: Surface, passive: Surface
+    active: Surface, passive: Surface, ends: bool = True
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Gauss points on all sub-segments: (active seg, passive seg, xi, eta, weight), end rows."""
     seg_a, seg_p, xi_int = subsegments(active, passive)
-    ends = _end_rows(active, seg_a, xi_int)
+    rows = _end_rows(active, seg_a, xi_int) if ends else np.arange(active.n_nodes)
     gx, gw = gauss_unit(GAUSS_POINTS)
     span = xi_int[:, 1] - xi_int[:, 0]
     xi = (xi_int[:, :1] + span[:, None] * gx).ravel()
@@ -213,7 +213,7 @@ def _gauss_points(
     xa, xb = passive.x[passive.segments[seg_p, 0]], passive.x[passive.segments[seg_p, 1]]
     ab = xb - xa
     eta = np.einsum("pd,pd->p", x - xa, ab) / np.einsum("pd,pd->p", ab, ab)
-    return seg_a, seg_p, xi, eta, w, ends
+    return seg_a, seg_p, xi, eta, w, rows
 
 
 def _check_basis(basis: str) -> None:
@@ -268,7 +268,7 @@ def _dual_values(
 
 
 def _multiplier_points(
-    active: Surface, passive: Surface, basis: str
+    active: Surface, passive: Surface, basis: str, ends: bool = True
 ) -> tuple[np.ndarray, ...]:
     """Gauss points (seg_a, seg_p, xi, eta, w), multiplier shape values (p, 2), rows (p, 2).
 
@@ -276,8 +276,8 @@ def _multiplier_points(
     itself, or its inside neighbour at an end of the passive surface (`_end_rows`).
     """
     _check_basis(basis)
-    seg_a, seg_p, xi, eta, w, ends = _gauss_points(active, passive)
-    rows = ends[active.segments[seg_a]]
+    seg_a, seg_p, xi, eta, w, end_map = _gauss_points(active, passive, ends)
+    rows = end_map[active.segments[seg_a]]
     if basis == "standard":
         return seg_a, seg_p, xi, eta, w, linear_shape(xi), rows
     psi, keep = _dual_values(active.n_segments, seg_a, xi, w)
@@ -327,11 +327,11 @@ def overlap_weights(
 
 
 def mortar_matrices(
-    active: Surface, passive: Surface, basis: str = "standard"
+    active: Surface, passive: Surface, basis: str = "standard", ends: bool = True
 ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """D = int phi_j N_k (n_active x n_active), M = int phi_j N_A (n_active x n_passive)."""
     # phi = N (standard) or psi (dual: D is diagonal up to round-off; a solver takes D.diagonal()).
-    seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis)
+    seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis, ends)
     nj = phi * w[:, None]
     d_vals = nj[:, :, None] * linear_shape(xi)[:, None, :]
     m_vals = nj[:, :, None] * linear_shape(eta)[:, None, :]
@@ -349,11 +349,11 @@ def mortar_matrices(
 
 
 def contact_operator(
-    active: Surface, passive: Surface, ndofs: int, basis: str = "standard"
+    active: Surface, passive: Surface, ndofs: int, basis: str = "standard", ends: bool = True
 ) -> ContactOperator:
     """Mortar operator: exact Gauss integration on sub-segments, normal of the paired segment."""
     # Row j = int phi_j n . (x_active - x_passive), phi = N_j (standard) or psi_j (dual).
-    seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis)
+    seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis, ends)
     na = linear_shape(xi)
     nodes = active.segments[seg_a]
     return assemble(
