@@ -27,13 +27,19 @@ the dual operator and from its D, M and weights: keeping them with the standard 
 choice would break the diagonal D that the dual basis exists for (and lumping would make the
 two rows of the segment proportional). The dropped overlap is reported by `dual_coefficients`.
 
-End nodes of the active surface: a node with no overlap gets no row (weight 0), as in the
-standard basis. Nodes on partly overlapped end segments keep their own multiplier, with the
-consistent psi above. Wohlmuth's end modification (dropping the end multiplier and setting the
-neighbour's psi to 1 on the end segment) is NOT applied: it is meant for end nodes that carry no
-multiplier (crosspoints, Dirichlet ends), which this kernel does not know about, and it would put
-an entry D_(j, end) off the diagonal. Without it every segment still has psi_0 + psi_1 = 1, so
-the patch test stays exact.
+Ends of the passive surface (both bases): a node with no overlap gets no row (weight 0). The
+nodes whose support the passive surface covers only partly (beyond its end, lying on it, or
+the last node before it) give their rows to the first node inside whose support it covers
+wholly (operator.end_rows; Wohlmuth's modified dual basis at interface ends, the boundary
+modification of Popp et al. and of Cichosz and Bischoff). Its basis there is the sum of the
+merged ones: N_i + N_o = 1 or psi_i + psi_o = 1 on the end segments, so a constant is still
+reproduced and the patch tests stay exact; the dual D stays diagonal on the nodes that keep
+rows, a merged node's column holding int psi_i N_o (it is eliminated like a passive node).
+Without the merge the multipliers of the segment straddling the end, restricted to its short
+facing part, fit a corner's load by a steep slope: the node beyond the end carried 10-60x the
+corner's pressure and its neighbour inside was released (docs/edges.md). `ends=False` gives
+the unmodified basis (its properties are tested on their own); `dual_coefficients` and
+`overlap_weights` are always the unmodified ones.
 """
 
 from __future__ import annotations
