@@ -11,7 +11,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 
-from corner_exponent import (  # noqa: E402  (benchmarks/ is not a package)
+from corner_exponent import (  # benchmarks/ is not a package: on sys.path above
     _fields,
     edge_exponent,
     free_corner_determinant,
