@@ -17,7 +17,12 @@ For every method it reads, from the solve's JSON interface (what a user reads):
 Writes benchmarks/edge_refinement.json and docs/figures/edge_refinement.png; docs/edges.md
 has the table. Exits 1 if a method's fitted exponent is off s by more than 0.05.
 
-Run: python benchmarks/edge_refinement.py   (serial, about a minute)
+`--placements`: instead, at hc = 0.005, the top edge with a node on the hub's end and the
+bottom edge with the nearest node f_bot = 0, 0.001, 0.25, 0.5, 0.72, 0.9, 0.999 cells beyond
+it: each method's peaks and the largest ratio of the two edges' peaks
+(benchmarks/edge_placements.json).
+
+Run: python benchmarks/edge_refinement.py [--placements]   (serial, about a minute each)
 """
 
 from __future__ import annotations
@@ -116,6 +121,34 @@ def chart(data: dict[str, Any], path: Path) -> None:
     fig.savefig(path, dpi=120)
 
 
+PLACEMENTS = [0.0, 0.001, 0.25, 0.5, 0.72, 0.9, 0.999]
+
+
+def placements(path: Path) -> int:
+    """Both edges' peaks as the shaft's nodes move across the bottom end (hc = 0.005)."""
+    from contactfx import run_scene
+
+    out: dict[str, Any] = {"hc": 0.005, "f_top": 0.0, "f_bot": PLACEMENTS, "methods": {}}
+    with tempfile.TemporaryDirectory() as tmp:
+        scenes = [press_fit(Path(tmp), hc=0.005, f_top=0.0, f_bot=f) for f in PLACEMENTS]
+        for name, (method, basis) in METHODS.items():
+            top, bottom = [], []
+            for scene in scenes:
+                _, summary = run_scene(scene, method, basis=basis)
+                vals = edge_values(summary.to_json()["contacts"][0]["interface"], 0.05)
+                top.append(vals["peak_top"])
+                bottom.append(vals["peak_bottom"])
+            peaks = np.array(top + bottom)
+            ratio = float(peaks.max() / peaks.min())
+            out["methods"][name] = {"peak_top": top, "peak_bottom": bottom, "max_ratio": ratio}
+            row = " ".join(f"{v:6.1f}" for v in bottom)
+            span = f"{min(top):6.1f}-{max(top):6.1f}"
+            print(f"{name:12s} top {span} bottom {row}  max/min {ratio:.3f}")
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    print(f"wrote {path}")
+    return 0
+
+
 def main() -> int:
     """Run the study, write the JSON and the chart, check the exponents."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -123,7 +156,10 @@ def main() -> int:
     ap.add_argument("--ell", type=float, default=0.05, help="length of the edge load")
     ap.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "edge_refinement.json")
     ap.add_argument("--chart", type=Path, default=ROOT / "docs" / "figures" / "edge_refinement.png")
+    ap.add_argument("--placements", action="store_true", help="the placement sweep instead")
     args = ap.parse_args()
+    if args.placements:
+        return placements(ROOT / "benchmarks" / "edge_placements.json")
     from contactfx import run_scene
 
     s = edge_exponent()
