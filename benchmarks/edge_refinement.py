@@ -23,6 +23,12 @@ it: each method's peaks and the largest ratio of the two edges' peaks
 (benchmarks/edge_placements.json).
 
 Run: python benchmarks/edge_refinement.py [--placements]   (serial, about a minute each)
+
+benchmarks/edge_refinement_0.10.1.json is this study on 0.10.1's kernels (before the end
+rows: `git archive 4ab0f58 contactfx | tar -x -C OLD`, then `PYTHONPATH=OLD python
+benchmarks/edge_refinement.py --json benchmarks/edge_refinement_0.10.1.json --chart X.png`):
+the top edge grew at 0.222 (mortar), the bottom one read 2,847-3,780 (mortar), 8,462-14,072
+(sts), its node inside the hub released.
 """
 
 from __future__ import annotations
