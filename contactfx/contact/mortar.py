@@ -34,7 +34,8 @@ wholly (operator.end_rows; Wohlmuth's modified dual basis at interface ends, the
 modification of Popp et al. and of Cichosz and Bischoff). Its basis there is the sum of the
 merged ones: N_i + N_o = 1 or psi_i + psi_o = 1 on the end segments, so a constant is still
 reproduced and the patch tests stay exact; the dual D stays diagonal on the nodes that keep
-rows, a merged node's column holding int psi_i N_o (it is eliminated like a passive node).
+rows, a merged node's column holding int psi_i N_o (a condensing solver keeps that node's
+displacement as a free unknown, like a passive node's).
 Without the merge the multipliers of the segment straddling the end, restricted to its short
 facing part, fit a corner's load by a steep slope: the node beyond the end carried 10-60x the
 corner's pressure and its neighbour inside was released (docs/edges.md). `ends=False` gives
