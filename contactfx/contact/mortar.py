@@ -37,10 +37,10 @@ reproduced and the patch tests stay exact; the dual D stays diagonal on the node
 rows, a merged node's column holding int psi_i N_o (a condensing solver keeps that node's
 displacement as a free unknown, like a passive node's).
 Without the merge the multipliers of the segment straddling the end, restricted to its short
-facing part, fit a corner's load by a steep slope: the node beyond the end carried 10-60x the
-corner's pressure and its neighbour inside was released (docs/edges.md). `ends=False` gives
-the unmodified basis (its properties are tested on their own); `dual_coefficients` and
-`overlap_weights` are always the unmodified ones.
+facing part, fit a corner's load by a steep slope: on a press fit the node beyond the end
+carried 10-40x the corner's pressure and its neighbour inside was released (docs/edges.md).
+`ends=False` gives the unmodified basis (its properties are tested on their own);
+`dual_coefficients` and `overlap_weights` are always the unmodified ones.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ tests/scenes/press_fit.geo: an axisymmetric steel shaft longer than its steel hu
 nodes placed f_top, f_bot edge cells beyond the hub's two ends. The edges are the same corner
 (mirror images), so their peak pressures may differ only by where the nodes fall: within 25 %
 (docs/edges.md). Before the end rows (contact/operator.py, `end_rows`) the node beyond an end
-carried 10-60x the other edge's peak and its neighbour inside was released.
+carried 10-40x the other edge's peak and its neighbour inside was released.
 """
 
 from pathlib import Path
