@@ -27,13 +27,20 @@ the dual operator and from its D, M and weights: keeping them with the standard 
 choice would break the diagonal D that the dual basis exists for (and lumping would make the
 two rows of the segment proportional). The dropped overlap is reported by `dual_coefficients`.
 
-End nodes of the active surface: a node with no overlap gets no row (weight 0), as in the
-standard basis. Nodes on partly overlapped end segments keep their own multiplier, with the
-consistent psi above. Wohlmuth's end modification (dropping the end multiplier and setting the
-neighbour's psi to 1 on the end segment) is NOT applied: it is meant for end nodes that carry no
-multiplier (crosspoints, Dirichlet ends), which this kernel does not know about, and it would put
-an entry D_(j, end) off the diagonal. Without it every segment still has psi_0 + psi_1 = 1, so
-the patch test stays exact.
+Ends of the passive surface (both bases): a node with no overlap gets no row (weight 0). The
+nodes whose support the passive surface covers only partly (beyond its end, lying on it, or
+the last node before it) give their rows to the first node inside whose support it covers
+wholly (operator.end_rows; Wohlmuth's modified dual basis at interface ends, the boundary
+modification of Popp et al. and of Cichosz and Bischoff). Its basis there is the sum of the
+merged ones: N_i + N_o = 1 or psi_i + psi_o = 1 on the end segments, so a constant is still
+reproduced and the patch tests stay exact; the dual D stays diagonal on the nodes that keep
+rows, a merged node's column holding int psi_i N_o (a condensing solver keeps that node's
+displacement as a free unknown, like a passive node's).
+Without the merge the multipliers of the segment straddling the end, restricted to its short
+facing part, fit a corner's load by a steep slope: on a press fit the node beyond the end
+carried 10-40x the corner's pressure and its neighbour inside was released (docs/edges.md).
+`ends=False` gives the unmodified basis (its properties are tested on their own);
+`dual_coefficients` and `overlap_weights` are always the unmodified ones.
 """
 
 from __future__ import annotations
@@ -43,7 +50,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import Surface, chains, nodal_normals, radial_weight, segment_lengths
-from .operator import ContactOperator, assemble, gauss_unit, linear_shape
+from .operator import REACH, ContactOperator, assemble, end_rows, gauss_unit, linear_shape
 from .search import project
 
 if TYPE_CHECKING:
@@ -180,11 +187,24 @@ def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
 
 
+def _end_rows(active: Surface, seg_a: np.ndarray, xi_int: np.ndarray) -> np.ndarray:
+    """Each active node's row after the end modification (operator.end_rows), from the cuts."""
+    m = active.n_segments
+    some = np.bincount(seg_a, minlength=m) > 0
+    lo = np.full(m, np.inf)
+    hi = np.full(m, -np.inf)
+    np.minimum.at(lo, seg_a, xi_int[:, 0])
+    np.maximum.at(hi, seg_a, xi_int[:, 1])
+    reach = np.stack([lo <= REACH, hi >= 1.0 - REACH], axis=1) & some[:, None]
+    return end_rows(active.segments, active.n_nodes, some, reach)
+
+
 def _gauss_points(
-    active: Surface, passive: Surface
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Gauss points on all sub-segments: (active seg, passive seg, xi, eta, weight)."""
+    active: Surface, passive: Surface, ends: bool = True
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Gauss points on all sub-segments: (active seg, passive seg, xi, eta, weight), end rows."""
     seg_a, seg_p, xi_int = subsegments(active, passive)
+    rows = _end_rows(active, seg_a, xi_int) if ends else np.arange(active.n_nodes)
     gx, gw = gauss_unit(GAUSS_POINTS)
     span = xi_int[:, 1] - xi_int[:, 0]
     xi = (xi_int[:, :1] + span[:, None] * gx).ravel()
@@ -200,7 +220,7 @@ def _gauss_points(
     xa, xb = passive.x[passive.segments[seg_p, 0]], passive.x[passive.segments[seg_p, 1]]
     ab = xb - xa
     eta = np.einsum("pd,pd->p", x - xa, ab) / np.einsum("pd,pd->p", ab, ab)
-    return seg_a, seg_p, xi, eta, w
+    return seg_a, seg_p, xi, eta, w, rows
 
 
 def _check_basis(basis: str) -> None:
@@ -255,23 +275,28 @@ def _dual_values(
 
 
 def _multiplier_points(
-    active: Surface, passive: Surface, basis: str
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Gauss points (seg_a, seg_p, xi, eta, w) and the multiplier shape values there (p, 2)."""
+    active: Surface, passive: Surface, basis: str, ends: bool = True
+) -> tuple[np.ndarray, ...]:
+    """Gauss points (seg_a, seg_p, xi, eta, w), multiplier shape values (p, 2), rows (p, 2).
+
+    rows[p, k] is the multiplier row that node k of the point's segment weights: the node
+    itself, or its inside neighbour at an end of the passive surface (`_end_rows`).
+    """
     _check_basis(basis)
-    seg_a, seg_p, xi, eta, w = _gauss_points(active, passive)
+    seg_a, seg_p, xi, eta, w, end_map = _gauss_points(active, passive, ends)
+    rows = end_map[active.segments[seg_a]]
     if basis == "standard":
-        return seg_a, seg_p, xi, eta, w, linear_shape(xi)
+        return seg_a, seg_p, xi, eta, w, linear_shape(xi), rows
     psi, keep = _dual_values(active.n_segments, seg_a, xi, w)
     # Whole segments are dropped, so the runs of GAUSS_POINTS points stay intact.
-    return seg_a[keep], seg_p[keep], xi[keep], eta[keep], w[keep], psi[keep]
+    return seg_a[keep], seg_p[keep], xi[keep], eta[keep], w[keep], psi[keep], rows[keep]
 
 
 def dual_coefficients(active: Surface, passive: Surface) -> tuple[np.ndarray, np.ndarray]:
     """Dual coefficients A (m, 2, 2), psi_j = sum_k A[e, j, k] N_k on segment e, and usable (m,)."""
     # A[e, j, k] is the value of psi_j at node k. Segments with no overlap or dropped as near
     # singular (usable False) have A = 0.
-    seg_a, _, xi, _, w = _gauss_points(active, passive)
+    seg_a, _, xi, _, w, _ = _gauss_points(active, passive)
     a, b, c, usable = _dual_affine(active.n_segments, seg_a, xi, w)
     node_xi = np.array([0.0, 1.0])
     A = a[:, :, None] + b[:, :, None] * (node_xi - c[:, None])[:, None, :]
@@ -309,16 +334,15 @@ def overlap_weights(
 
 
 def mortar_matrices(
-    active: Surface, passive: Surface, basis: str = "standard"
+    active: Surface, passive: Surface, basis: str = "standard", ends: bool = True
 ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
     """D = int phi_j N_k (n_active x n_active), M = int phi_j N_A (n_active x n_passive)."""
     # phi = N (standard) or psi (dual: D is diagonal up to round-off; a solver takes D.diagonal()).
-    seg_a, seg_p, xi, eta, w, phi = _multiplier_points(active, passive, basis)
+    seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis, ends)
     nj = phi * w[:, None]
-    rows = active.segments[seg_a]
     d_vals = nj[:, :, None] * linear_shape(xi)[:, None, :]
     m_vals = nj[:, :, None] * linear_shape(eta)[:, None, :]
-    d_cols = np.broadcast_to(rows[:, None, :], d_vals.shape)
+    d_cols = np.broadcast_to(active.segments[seg_a][:, None, :], d_vals.shape)
     m_cols = np.broadcast_to(passive.segments[seg_p][:, None, :], m_vals.shape)
     r = np.broadcast_to(rows[:, :, None], d_vals.shape).ravel()
     na, npas = active.n_nodes, passive.n_nodes
@@ -332,18 +356,18 @@ def mortar_matrices(
 
 
 def contact_operator(
-    active: Surface, passive: Surface, ndofs: int, basis: str = "standard"
+    active: Surface, passive: Surface, ndofs: int, basis: str = "standard", ends: bool = True
 ) -> ContactOperator:
     """Mortar operator: exact Gauss integration on sub-segments, normal of the paired segment."""
     # Row j = int phi_j n . (x_active - x_passive), phi = N_j (standard) or psi_j (dual).
-    seg_a, seg_p, xi, eta, w, phi = _multiplier_points(active, passive, basis)
+    seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis, ends)
     na = linear_shape(xi)
     nodes = active.segments[seg_a]
     return assemble(
         active,
         passive,
         ndofs,
-        rows=nodes,
+        rows=rows,
         row_coef=w[:, None] * phi,
         act_nodes=nodes,
         act_coef=na,

@@ -34,6 +34,58 @@ def overlap_tolerance(weights: np.ndarray) -> float:
     return 1e-12 * max(float(np.max(weights, initial=0.0)), 1e-300)
 
 
+# Where the facing part of an active segment ends within this fraction of the segment from a
+# node, it reaches that node: a sliver left by the geometry (the drawn overlap of a fit seen
+# along a tilted end normal: ~5e-4 on the shrink-fit rings) does not move a row.
+REACH = 1e-2
+
+
+def end_rows(segments: np.ndarray, n_nodes: int, some: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """The multiplier row of each active node after the end modification (docs/edges.md).
+
+    `some` (m,): active segment e faces the passive surface somewhere; `reach` (m, 2): the
+    facing part of e reaches node k of e. At an end of the passive surface the active
+    segment that straddles it faces only partly: restricted to that part its two basis
+    functions are nearly dependent, their two multipliers fit the corner's load by a steep
+    slope, the node beyond the end carries a large value and its neighbour inside turns
+    tensile and is released. Here, as in the boundary modification of the mortar literature
+    (Wohlmuth's modified dual basis; Popp et al.; Cichosz and Bischoff), the nodes whose
+    support the passive surface covers only partly leave the multiplier space and their basis
+    functions merge into the first node whose support it covers wholly:
+
+    - a node o beyond the end (its only facing segment reaches the other node but not o) and
+    - the last node reached (o's neighbour inside, or a node lying on the end itself: one
+      segment faces wholly, the other not at all)
+
+    both give their rows to the next node inside, whose multiplier is then constant from one
+    cell inside to the end (sum of the merged N, or psi for the dual basis, = 1 there). The
+    constant part is 1 to 2 cells long wherever the nodes fall, so the end value reads the
+    corner's load over a length ~h (merging the node beyond only would leave 0 to 1 cell:
+    the end value then swings by ~1.6x as the nodes move across the end). A constant is
+    still reproduced (patch tests exact). A segment facing only strictly inside (both nodes
+    beyond a passive surface shorter than a segment) keeps its two rows; an active surface
+    that ends inside the passive one (a one-segment node) is left alone.
+    Returns `rows` (n_nodes,): rows[j] = j, or the node j's row merged into.
+    """
+    rows = np.arange(n_nodes)
+    facing = np.bincount(segments[some].ravel(), minlength=n_nodes)
+    full = reach[:, 0] & reach[:, 1]
+    degree = np.bincount(segments.ravel(), minlength=n_nodes)
+    n_full = np.bincount(segments[full].ravel(), minlength=n_nodes)
+    for k in (0, 1):
+        o, i = segments[:, k], segments[:, 1 - k]
+        beyond = some & reach[:, 1 - k] & ~reach[:, k] & (facing[o] == 1)
+        rows[o[beyond]] = i[beyond]
+    last = np.zeros(n_nodes, dtype=bool)
+    last[rows[rows != np.arange(n_nodes)]] = True
+    last |= (degree == 2) & (n_full == 1) & (facing == 1)
+    for k in (0, 1):
+        o, i = segments[:, k], segments[:, 1 - k]
+        inward = full & last[o] & (n_full[o] == 1) & (n_full[i] == 2)
+        rows[o[inward]] = i[inward]
+    return rows[rows]
+
+
 def gauss_unit(n: int) -> tuple[np.ndarray, np.ndarray]:
     """n-point Gauss-Legendre points and weights on [0, 1]."""
     x, w = np.polynomial.legendre.leggauss(n)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .geometry import Surface, radial_weight, segment_lengths
-from .operator import ContactOperator, assemble, gauss_unit, linear_shape
+from .operator import ContactOperator, assemble, end_rows, gauss_unit, linear_shape
 from .search import project
 
 GAUSS_POINTS = 4
@@ -26,7 +26,9 @@ def gauss_points(active: Surface) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return w, na, nodes
 
 
-def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOperator:
+def contact_operator(
+    active: Surface, passive: Surface, ndofs: int, ends: bool = True
+) -> ContactOperator:
     """STS operator: row j = sum_gp w N_j n . (e_active(gp) - sum_A N_A(xi_gp) e_A)."""
     w, na, nodes = gauss_points(active)
     points = np.einsum("pk,pkd->pd", na, active.x[nodes])
@@ -34,11 +36,19 @@ def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOp
     # No cutting at passive nodes: a segment straddling a passive node or kink is integrated
     # as if the integrand were smooth (the method's known source of oscillations).
     f = np.flatnonzero(found)
+    # End modification (operator.end_rows): a segment whose first (last) Gauss point is found
+    # reaches its node 0 (1); the node beyond the passive end merges into its inside neighbour.
+    hit = found.reshape(-1, GAUSS_POINTS)
+    end_map = (
+        end_rows(active.segments, active.n_nodes, hit.any(axis=1), hit[:, [0, -1]])
+        if ends
+        else np.arange(active.n_nodes)
+    )
     return assemble(
         active,
         passive,
         ndofs,
-        rows=nodes[f],
+        rows=end_map[nodes[f]],
         row_coef=w[f, None] * na[f],
         act_nodes=nodes[f],
         act_coef=na[f],

@@ -5,6 +5,17 @@ that enter and leave, record and log the iteration, stop when the set is station
 the complementarity residual) or raise at the limit. What differs between the multiplier
 methods and penalty is the `Iteration` they pass: how a set is solved and, for the multiplier
 methods with a direct solver, which set to try next (probes and the small LCP predictor).
+
+At the end of a passive surface (a hub's edge, a narrower block's corner) the loop decides
+nothing of its own: it sees only the kernels' rows. The nodes whose support the passive
+surface covers only partly (beyond its end, on it, or the last before it) have no row
+(contact/operator.py, `end_rows`): their basis functions are merged into the first node
+inside, whose multiplier is constant out to the end. That row is active or released by the
+same test as every other (its multiplier's sign, its weighted gap's sign), so in a fit whose
+interface is closed from end to end no row between two rows in contact is released unless
+its own weighted gap is open. Before that merge the node beyond the end carried the corner's
+load as a large multiplier and its neighbour inside turned tensile and was released with a
+closed gap (docs/edges.md).
 """
 
 from __future__ import annotations

@@ -94,8 +94,10 @@ def _roles(scene: Scene, el: Elasticity, gathered: list[Any]) -> Roles:
 
 def _transfer(r: Roles, ndofs: int, comm: MPI.Comm) -> Transfer:
     """The mortar matrices of the pair with the Dirichlet body as slave, and the layout."""
-    op2 = contact_operator(Kernel.MORTAR, r.surf2.surface, r.surf1.surface, ndofs)
-    D_all, M_all = mortar_matrices(r.surf2.surface, r.surf1.surface)
+    # The unmodified basis (ends=False): the transfer maps the whole interface, every node
+    # with its own row, and the full-contact check needs no corner treatment.
+    op2 = contact_operator(Kernel.MORTAR, r.surf2.surface, r.surf1.surface, ndofs, ends=False)
+    D_all, M_all = mortar_matrices(r.surf2.surface, r.surf1.surface, ends=False)
     keep = np.flatnonzero(op2.overlapping)
     if keep.size == 0:
         raise GeometryError(
@@ -116,7 +118,7 @@ def _transfer(r: Roles, ndofs: int, comm: MPI.Comm) -> Transfer:
         surf_a, op = r.surf2, op2
     else:
         surf_a = r.surf1
-        op = contact_operator(Kernel.MORTAR, r.surf1.surface, r.surf2.surface, ndofs)
+        op = contact_operator(Kernel.MORTAR, r.surf1.surface, r.surf2.surface, ndofs, ends=False)
     layout, order = multiplier_layout(comm, surf_a, op)
     import scipy.sparse.linalg as spla  # only where used (first-answer time: docs/scale.md)
 
@@ -259,7 +261,7 @@ def _report(
         pressure = lam2[order]
     else:
         # Same force on B1's nodes, expressed as the traction of B1's own mortar multipliers.
-        Da, _ = mortar_matrices(r.surf1.surface, r.surf2.surface)
+        Da, _ = mortar_matrices(r.surf1.surface, r.surf2.surface, ends=False)
         force = tr.M.T @ lam
         import scipy.sparse.linalg as spla  # only where used: docs/scale.md
 

@@ -163,9 +163,11 @@ def dof_vector(nd: int, u, *surfaces: Surface) -> np.ndarray:
 @FAST
 @given(pairs)
 def test_dual_D_is_diagonal_and_M_is_psi_times_passive_shapes(pair):
+    # The consistent dual basis itself (ends=False: no end modification); with the end rows
+    # (test_merged_dual_D_is_diagonal_on_the_rows_nodes) the merged nodes' columns couple.
     active, passive, _ = pair
-    D, M = mortar_matrices(active, passive, "dual")
-    Ds, _ = mortar_matrices(active, passive)
+    D, M = mortar_matrices(active, passive, "dual", ends=False)
+    Ds, _ = mortar_matrices(active, passive, ends=False)
     assert offdiag_ratio(D) < 1e-12
     assert Ds.nnz == 0 or offdiag_ratio(Ds) > 1e-3  # the standard D is a genuine band
     d = D.diagonal()
@@ -175,6 +177,22 @@ def test_dual_D_is_diagonal_and_M_is_psi_times_passive_shapes(pair):
     np.testing.assert_allclose(
         np.asarray(M.sum(axis=1)).ravel(), d, rtol=1e-12, atol=1e-13 * d.max(initial=0)
     )
+
+
+@FAST
+@given(pairs)
+def test_merged_dual_D_is_diagonal_on_the_rows_nodes(pair):
+    # End rows (operator.end_rows): a merged node has no row, and its column holds the
+    # anchor's int psi_anchor N_o; on the nodes that keep rows D stays diagonal, and every
+    # row sum is int psi_j = int N_j of the merged (standard) basis.
+    active, passive, nd = pair
+    D, _ = mortar_matrices(active, passive, "dual")
+    Ds, _ = mortar_matrices(active, passive)
+    rows = contact_operator(active, passive, nd, "dual").rows
+    assert offdiag_ratio(D[rows][:, rows].tocsr()) < 1e-12
+    ref = np.asarray(Ds.sum(axis=1)).ravel()
+    d = np.asarray(D.sum(axis=1)).ravel()
+    np.testing.assert_allclose(d, ref, rtol=1e-12, atol=1e-13 * ref.max(initial=0))
 
 
 @FAST
@@ -252,7 +270,9 @@ def test_dual_gap_is_weight_times_nodal_gap_for_linear_gaps(seed, slope, g0):
     xa = steps(rng, rng.integers(3, 10), rng.uniform(-0.6, 0.4))
     ya = g0 + slope * xa + 0.02 * rng.uniform(-1, 1, len(xa)) * rng.integers(0, 2)
     active, passive, nd = flat_pair(xp, xa, ya)
-    op = contact_operator(active, passive, nd, "dual")
+    # The consistent dual basis before the end modification (ends=False); merged end rows
+    # weight several nodal gaps (tests/contact/test_passive_ends.py).
+    op = contact_operator(active, passive, nd, "dual", ends=False)
     # dGamma on a tilted active segment is stretch * dx; hats integrate to the clipped lengths.
     lo, hi = xp.min(), xp.max()
     length = np.hypot(np.diff(xa), np.diff(ya))
@@ -293,12 +313,12 @@ def test_linear_field_rows_against_independent_integral():
         x, w = gauss(lo, hi)
         psi = hats(x) @ reference_dual([(lo, hi)]).T
         ref[k : k + 2] += stretch * h * (w * G[1, 1] * (g0 + slope * (xa[k] + h * x))) @ psi
-    op = contact_operator(active, passive, nd, "dual")
+    op = contact_operator(active, passive, nd, "dual", ends=False)  # the unmodified dual basis
     np.testing.assert_allclose(op.B @ u, ref, rtol=1e-12, atol=1e-16)
     # The gap is linear on each segment, so the dual weighted gap is weight * nodal gap; the
     # standard one mixes neighbouring nodal gaps.
     np.testing.assert_allclose(op.gap, op.weights * (g0 + slope * xa), rtol=1e-13)
-    std = contact_operator(active, passive, nd)
+    std = contact_operator(active, passive, nd, ends=False)
     assert np.max(np.abs(std.gap - std.weights * (g0 + slope * xa))) > 1e-5
     x0, x1 = 0.0, 1.0
     total = stretch * G[1, 1] * (g0 * (x1 - x0) + slope * (x1**2 - x0**2) / 2)
@@ -370,18 +390,26 @@ def test_end_nodes_rows_and_weights():
     active, passive, nd = flat_pair(xp, xa, 0.01 + 0 * xa)
     op = contact_operator(active, passive, nd, "dual")
     std = contact_operator(active, passive, nd)
-    np.testing.assert_array_equal(op.rows, [2, 3, 4, 5, 6])  # no end modification: all rows kept
+    # End rows: nodes 2, 6 lie beyond the ends, 3 and 5 are the last reached: only node 4's
+    # support [0.2, 0.8] is wholly covered, and it takes every row (psi_4 = 1 on [0, 1]).
+    np.testing.assert_array_equal(op.rows, [4])
     np.testing.assert_array_equal(op.rows, std.rows)
-    assert op.B.rows(np.array([0, 1])).nnz == 0 and np.all(op.weights[:2] == 0)
+    np.testing.assert_allclose(op.weights, [0, 0, 0, 0, 1.0, 0, 0], rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(op.B.toarray(), std.B.toarray(), atol=1e-14)
+    # Without the modification every node facing the surface keeps a row.
+    raw = contact_operator(active, passive, nd, "dual", ends=False)
+    np.testing.assert_array_equal(raw.rows, [2, 3, 4, 5, 6])
+    assert raw.B.rows(np.array([0, 1])).nnz == 0 and np.all(raw.weights[:2] == 0)
     edge, inner = 0.02 / 0.3, 0.04 / 0.3 + 0.15
-    np.testing.assert_allclose(op.weights, [0, 0, edge, inner, 0.3, inner, edge], rtol=1e-13)
+    np.testing.assert_allclose(raw.weights, [0, 0, edge, inner, 0.3, inner, edge], rtol=1e-13)
+    np.testing.assert_allclose(raw.B.toarray().sum(axis=0), op.B.toarray()[4], atol=1e-14)
     A, usable = dual_coefficients(active, passive)
     assert usable.tolist() == [False, False, True, True, True, True]
     ends = sub_intervals(active, passive)
     for e in (2, 5):
         assert_same_psi(A[e], reference_dual(ends[e]), ends[e], 1e-12)
     np.testing.assert_allclose(ends[2][0][0], 1 / 3, rtol=1e-14)  # only [0, 0.2] of [-0.1, 0.2]
-    D, _ = mortar_matrices(active, passive, "dual")
+    D, _ = mortar_matrices(active, passive, "dual", ends=False)
     assert offdiag_ratio(D) < 1e-13
 
 
