@@ -15,9 +15,10 @@ from u_z (the shear no longer moves the surface normally).
 This is route (b) of docs/friction.md; route (a) is friction_references.spence_stick_ratio (the
 self-similar reduction to a flat-punch increment). Run:
 
-    python benchmarks/spence_bem.py --json benchmarks/spence_bem.json
+    OPENBLAS_NUM_THREADS=1 python benchmarks/spence_bem.py --json benchmarks/spence_bem.json
 
-(about a minute on one core) prints, per (mu, nu), both routes and Goodman's, and writes them.
+(about ten minutes on one loaded core) prints, per (mu, nu), both routes and Goodman's, and
+writes them; `--table benchmarks/spence_bem.json` prints docs/friction.md's table from them.
 """
 
 from __future__ import annotations
@@ -142,28 +143,51 @@ def stick_ratio(history: dict[str, np.ndarray]) -> float:
     return float(slope)
 
 
+def table(rows: list[dict[str, float]]) -> str:
+    """The docs' markdown table (docs/friction.md) of the recorded rows."""
+    out = [
+        "| mu | nu | beta | mu / beta | c/a (a) self-similar | c/a (b) BEM | (a) - (b) "
+        "| Goodman (a) | Goodman (b) |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        out.append(
+            f"| {r['mu']:.2f} | {r['nu']:.2f} | {r['beta']:.4f} | {r['mu'] / r['beta']:.3f} "
+            f"| {r['self_similar']:.4f} | {r['bem']:.4f} | {r['self_similar'] - r['bem']:+.4f} "
+            f"| {r['goodman_self_similar']:.4f} | {r['goodman_bem']:.4f} |"
+        )
+    return "\n".join(out)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Both routes and Goodman's for each case; print a table and write the JSON."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cells", type=int, default=400)
     ap.add_argument("--steps", type=int, default=160)
     ap.add_argument("--json", type=Path)
+    ap.add_argument("--table", type=Path, help="print the markdown table of a recorded JSON")
     args = ap.parse_args(argv)
+    if args.table:
+        print(table(json.loads(args.table.read_text())["rows"]))
+        return 0
     rows = []
-    print(f"{'mu':>5} {'nu':>5} {'beta':>7} {'mu/beta':>8} {'(a) SSR':>9} {'(b) BEM':>9} "
-          f"{'Goodman (a)':>12} {'Goodman (b)':>12}")
     for mu, nu in CASES:
         bem = stick_ratio(loading_history(mu, nu, args.cells, args.steps))
         good_bem = stick_ratio(loading_history(mu, nu, args.cells, args.steps, coupled=False))
         ssr = spence_stick_ratio(mu, nu)
         good = spence_stick_ratio(mu, nu, coupled=False)
-        beta = coupling_beta(nu)
-        rows.append({
-            "mu": mu, "nu": nu, "beta": beta, "self_similar": ssr, "bem": bem,
-            "goodman_self_similar": good, "goodman_bem": good_bem,
-        })
-        print(f"{mu:5.2f} {nu:5.2f} {beta:7.4f} {mu / beta:8.4f} {ssr:9.4f} {bem:9.4f} "
-              f"{good:12.4f} {good_bem:12.4f}", flush=True)
+        row = {
+            "mu": mu,
+            "nu": nu,
+            "beta": coupling_beta(nu),
+            "self_similar": ssr,
+            "bem": bem,
+            "goodman_self_similar": good,
+            "goodman_bem": good_bem,
+        }
+        rows.append(row)
+        print(table([row]).splitlines()[-1], flush=True)
+    print(table(rows))
     if args.json:
         meta = {"cells": args.cells, "steps": args.steps, "command": " ".join(sys.argv)}
         args.json.write_text(json.dumps({"meta": meta, "rows": rows}, indent=1) + "\n")

@@ -141,4 +141,3 @@ def linearize(
     dt[slip, 1] = 1.0
     dt[slip, 2] = mu_row[slip] * s * c_n
     return FrictionRows(status=status, cn=cn, ct=ct, dn=dn, dt=dt)
-

@@ -148,7 +148,8 @@ def half_plane_influence(
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(y == 0.0, 0.0, y * np.log(np.abs(y))) - y
 
-    # u_z(x) = -(2 / (pi E*)) int p(s) ln|x - s| ds; int_lo^hi ln|x - s| ds = prim(x-lo) - prim(x-hi)
+    # u_z(x) = -(2 / (pi E*)) int p(s) ln|x - s| ds, and over a cell
+    # int_lo^hi ln|x - s| ds = prim(x - lo) - prim(x - hi).
     G = -(2.0 / (np.pi * E_star)) * (prim(x - lo) - prim(x - hi))
     # int_lo^hi sgn(x - s) ds = (length left of x) - (length right of x)
     left = np.clip(x, lo, hi) - lo
@@ -158,7 +159,7 @@ def half_plane_influence(
 
 
 def _graded(lo: float, hi: float, n: int) -> np.ndarray:
-    """n cells on [lo, hi] clustered towards both ends (cosine spacing)."""
+    """Edges of n cells on [lo, hi], clustered towards both ends (cosine spacing)."""
     t = 0.5 * (1.0 - np.cos(np.linspace(0.0, np.pi, n + 1)))
     return lo + (hi - lo) * t
 
@@ -166,14 +167,15 @@ def _graded(lo: float, hi: float, n: int) -> np.ndarray:
 def _flat_punch_increment(
     kappa: float, mu: float, beta: float, n: int, coupled: bool
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The load increment d/da of the self-similar problem, on 0 < x < 1 (a = 1), for stick ratio
-    kappa: (cells' edges, midpoints, dp, dq, du_x).
+    """The load increment d/da of the self-similar problem for the stick ratio kappa.
+
+    On 0 < x < 1 (a = 1); returns the cells' edges, midpoints, dp, dq and du_x.
 
     d/da turns the Hertz problem into a flat punch: du_z = 1 on the whole contact, du_x = 0 on
     the stick zone, dq = mu dp on the slip zone (shear outwards), dp = dq = 0 outside. Symmetry
     (p even, q odd) halves the unknowns: a cell at x > 0 has a mirror at -x.
     """
-    ns = min(max(int(round(n * kappa)), n // 4), n - n // 4)
+    ns = min(max(round(n * kappa), n // 4), n - n // 4)
     e_in = np.concatenate([_graded(-kappa, kappa, 2 * ns)[ns:], _graded(kappa, 1.0, n - ns)[1:]])
     # Both halves of the mirror: cell edges on (-1, 1), the x > 0 ones first.
     xm = 0.5 * (e_in[:-1] + e_in[1:])
@@ -210,7 +212,7 @@ def _flat_punch_increment(
 
 def _edge_slip(kappa: float, mu: float, beta: float, n: int, coupled: bool) -> float:
     """Slip rate du_x at the first slip cell past the stick edge, scaled by the largest."""
-    _, xm, dp, _, dux = _flat_punch_increment(kappa, mu, beta, n, coupled)
+    _, xm, _, _, dux = _flat_punch_increment(kappa, mu, beta, n, coupled)
     first = int(np.flatnonzero(xm > kappa)[0])
     scale = np.abs(dux).max()
     return float(dux[first] / scale)

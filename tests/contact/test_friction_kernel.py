@@ -15,8 +15,6 @@ positive = st.floats(0.05, 20.0)
 value = st.floats(-5.0, 5.0)
 
 
-
-
 def pair_surfaces(xp, yp, xa, ya):
     """Passive lower surface (normal +y), active upper surface (normal -y), total dof count."""
     passive = polyline(np.asarray(xp), np.asarray(yp), True, 0)

@@ -48,18 +48,26 @@ def solve_steps(k_v: np.ndarray, mu: float, pushes: np.ndarray, c: float = 1.0):
         f[0::2] = K_S * s
         f[1::2] = -k_v * DELTA
         u_prev = u.copy()
-        for its in range(1, 40):
+        for its in range(1, 40):  # noqa: B007  (its: the count of the last step)
             g, ut = Bn @ u, Bt @ (u - u_prev)
             rows = linearize(lam_n, lam_t, g, ut, mu, c, c)
             # Equilibrium: K u = f + Bn^T lambda_n - Bt^T lambda_t (friction opposes the slip).
             r = np.concatenate([K @ u - f - Bn.T @ lam_n + Bt.T @ lam_t, rows.cn, rows.ct])
-            J = np.block([
-                [K, -Bn.T, Bt.T],
-                [rows.dn[:, 2:3] * Bn + rows.dn[:, 3:4] * Bt, np.diag(rows.dn[:, 0]),
-                 np.diag(rows.dn[:, 1])],
-                [rows.dt[:, 2:3] * Bn + rows.dt[:, 3:4] * Bt, np.diag(rows.dt[:, 0]),
-                 np.diag(rows.dt[:, 1])],
-            ])
+            J = np.block(
+                [
+                    [K, -Bn.T, Bt.T],
+                    [
+                        rows.dn[:, 2:3] * Bn + rows.dn[:, 3:4] * Bt,
+                        np.diag(rows.dn[:, 0]),
+                        np.diag(rows.dn[:, 1]),
+                    ],
+                    [
+                        rows.dt[:, 2:3] * Bn + rows.dt[:, 3:4] * Bt,
+                        np.diag(rows.dt[:, 0]),
+                        np.diag(rows.dt[:, 1]),
+                    ],
+                ]
+            )
             if np.linalg.norm(r) <= 1e-12 * (1.0 + np.linalg.norm(f)):
                 break
             d = np.linalg.solve(J, -r)
@@ -76,7 +84,7 @@ def test_block_sticks_until_mu_p_then_slips_everywhere():
     k_v = np.full(N, 2.0)
     s_slip = mu * 2.0 * DELTA / K_S  # k_s s = mu lambda_n at every node at once
     pushes = s_slip * np.array([0.25, 0.5, 0.9, 1.1, 1.5, 2.0])
-    for s, (u, lam_n, lam_t, status, its) in zip(pushes, solve_steps(k_v, mu, pushes)):
+    for s, (u, lam_n, lam_t, status, its) in zip(pushes, solve_steps(k_v, mu, pushes), strict=True):
         np.testing.assert_allclose(lam_n, 2.0 * DELTA, rtol=1e-12)
         np.testing.assert_allclose(u[1::2], 0.0, atol=1e-14)
         P, Q = lam_n.sum(), lam_t.sum()
@@ -106,7 +114,7 @@ def test_partial_slip_obeys_coulomb_at_every_node(c):
     pushes = s_first * np.array([0.5, 0.99, 1.2, 1.6, 2.2, 3.0, 4.0, 6.0])
     prev = np.zeros(2 * N)
     results = solve_steps(k_v, mu, pushes, c)
-    for s, (u, lam_n, lam_t, status, _) in zip(pushes, results):
+    for s, (u, lam_n, lam_t, status, _) in zip(pushes, results, strict=True):
         np.testing.assert_allclose(lam_n, k_v * DELTA, rtol=1e-12)
         slip = u[0::2] - prev[0::2]
         stick = status == Status.STICK
@@ -127,7 +135,7 @@ def test_partial_slip_obeys_coulomb_at_every_node(c):
 def test_frictionless_prototype():
     """mu = 0: lambda_t = 0, every contact node slips, and each node follows the plate freely."""
     k_v = np.array([1.0, 1.5, 2.0, 2.5, 3.0, 4.0])
-    (u, lam_n, lam_t, status, _), = solve_steps(k_v, 0.0, np.array([0.05]))
+    ((u, lam_n, lam_t, status, _),) = solve_steps(k_v, 0.0, np.array([0.05]))
     np.testing.assert_array_equal(lam_t, 0.0)
     assert np.all(status == Status.SLIP)
     np.testing.assert_allclose(u[0::2], 0.05, rtol=1e-12)
