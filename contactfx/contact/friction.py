@@ -34,6 +34,8 @@ from enum import IntEnum
 
 import numpy as np
 
+from .sparse import CSR
+
 #: Column order of the rows' derivatives: d/d(lambda_n, lambda_t, g_n, u_t).
 VARIABLES = ("lambda_n", "lambda_t", "g_n", "u_t")
 
@@ -141,3 +143,22 @@ def linearize(
     dt[slip, 1] = 1.0
     dt[slip, 2] = mu_row[slip] * s * c_n
     return FrictionRows(status=status, cn=cn, ct=ct, dn=dn, dt=dt)
+
+
+def displacement_rows(rows: FrictionRows, normal: CSR, tangent: CSR) -> tuple[CSR, CSR]:
+    """The Newton step's dC_n/du and dC_t/du, sparse like the contact operator's rows.
+
+    The rows' g_n and u_t derivatives times the normal (d g_n = B_n du) and tangential
+    (d u_t = B_t du) rows of the same kernel.
+    """
+    if normal.shape != tangent.shape or normal.shape[0] != rows.status.shape[0]:
+        raise ValueError("displacement_rows: B_n, B_t and the rows must have the same rows")
+    r = np.concatenate([normal.entry_rows, tangent.entry_rows])
+    c = np.concatenate([normal.indices, tangent.indices])
+    out = []
+    for d in (rows.dn, rows.dt):
+        vals = np.concatenate(
+            [normal.data * d[normal.entry_rows, 2], tangent.data * d[tangent.entry_rows, 3]]
+        )
+        out.append(CSR.from_coo(r, c, vals, normal.shape, drop_zeros=True))
+    return out[0], out[1]

@@ -16,7 +16,8 @@ gives (uy and ux decouple):
 import numpy as np
 import pytest
 
-from contactfx.contact.friction import Status, linearize
+from contactfx.contact.friction import Status, displacement_rows, linearize
+from contactfx.contact.sparse import CSR
 
 N = 6
 K_H, K_S = 3.0, 1.0
@@ -41,6 +42,7 @@ def solve_steps(k_v: np.ndarray, mu: float, pushes: np.ndarray, c: float = 1.0):
     Bn[np.arange(N), 2 * np.arange(N) + 1] = 1.0  # gap = uy (floor normal +y, weight 1)
     Bt = np.zeros((N, 2 * N))
     Bt[np.arange(N), 2 * np.arange(N)] = 1.0  # slip along t = +x
+    Bn_csr, Bt_csr = (CSR.from_coo(*np.nonzero(B), B[B != 0], B.shape) for B in (Bn, Bt))
     u, lam_n, lam_t = np.zeros(2 * N), np.zeros(N), np.zeros(N)
     out = []
     for s in pushes:
@@ -53,16 +55,20 @@ def solve_steps(k_v: np.ndarray, mu: float, pushes: np.ndarray, c: float = 1.0):
             rows = linearize(lam_n, lam_t, g, ut, mu, c, c)
             # Equilibrium: K u = f + Bn^T lambda_n - Bt^T lambda_t (friction opposes the slip).
             r = np.concatenate([K @ u - f - Bn.T @ lam_n + Bt.T @ lam_t, rows.cn, rows.ct])
+            # The kernel's sparse rows, checked against the dense product of the set's rows.
+            jn, jt = (j.toarray() for j in displacement_rows(rows, Bn_csr, Bt_csr))
+            np.testing.assert_array_equal(jn, rows.dn[:, 2:3] * Bn + rows.dn[:, 3:4] * Bt)
+            np.testing.assert_array_equal(jt, rows.dt[:, 2:3] * Bn + rows.dt[:, 3:4] * Bt)
             J = np.block(
                 [
                     [K, -Bn.T, Bt.T],
                     [
-                        rows.dn[:, 2:3] * Bn + rows.dn[:, 3:4] * Bt,
+                        jn,
                         np.diag(rows.dn[:, 0]),
                         np.diag(rows.dn[:, 1]),
                     ],
                     [
-                        rows.dt[:, 2:3] * Bn + rows.dt[:, 3:4] * Bt,
+                        jt,
                         np.diag(rows.dt[:, 0]),
                         np.diag(rows.dt[:, 1]),
                     ],
