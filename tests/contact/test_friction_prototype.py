@@ -15,7 +15,9 @@ gives (uy and ux decouple):
 
 import numpy as np
 import pytest
+from conftest import polyline
 
+from contactfx.contact import contact_operator
 from contactfx.contact.friction import Status, displacement_rows, linearize
 from contactfx.contact.sparse import CSR
 
@@ -35,13 +37,36 @@ def chain_stiffness(k_v: np.ndarray) -> np.ndarray:
     return K
 
 
-def solve_steps(k_v: np.ndarray, mu: float, pushes: np.ndarray, c: float = 1.0):
+def nodal_rows() -> tuple[np.ndarray, np.ndarray]:
+    """Hand-written rows: gap = uy (floor normal +y, weight 1), slip along t = +x."""
+    Bn = np.zeros((N, 2 * N))
+    Bn[np.arange(N), 2 * np.arange(N) + 1] = 1.0
+    Bt = np.zeros((N, 2 * N))
+    Bt[np.arange(N), 2 * np.arange(N)] = 1.0
+    return Bn, Bt
+
+
+def kernel_rows(kernel: str, **options: str) -> tuple[np.ndarray, np.ndarray]:
+    """The library's normal and tangential rows of the chain (active, nodes 0..N-1 at y = 0) on
+    a floor surface (passive, held fixed: its columns dropped)."""
+    floor = polyline(np.array([-1.0, 2.3, N + 0.0]), np.zeros(3), True, 2 * N)
+    chain = polyline(np.arange(N, dtype=float), np.zeros(N), False, 0)
+    nd = 2 * N + 6
+    Bn = contact_operator(kernel, chain, floor, nd, **options).B.toarray()[:, : 2 * N]
+    Bt = contact_operator(kernel, chain, floor, nd, direction="tangent", **options)
+    return Bn, Bt.B.toarray()[:, : 2 * N]
+
+
+def solve_steps(
+    k_v: np.ndarray,
+    mu: float,
+    pushes: np.ndarray,
+    c: float = 1.0,
+    rows_B: tuple[np.ndarray, np.ndarray] | None = None,
+):
     """Semismooth Newton per load step; returns per step (u, lambda_n, lambda_t, status, its)."""
     K = chain_stiffness(k_v)
-    Bn = np.zeros((N, 2 * N))
-    Bn[np.arange(N), 2 * np.arange(N) + 1] = 1.0  # gap = uy (floor normal +y, weight 1)
-    Bt = np.zeros((N, 2 * N))
-    Bt[np.arange(N), 2 * np.arange(N)] = 1.0  # slip along t = +x
+    Bn, Bt = nodal_rows() if rows_B is None else rows_B
     Bn_csr, Bt_csr = (CSR.from_coo(*np.nonzero(B), B[B != 0], B.shape) for B in (Bn, Bt))
     u, lam_n, lam_t = np.zeros(2 * N), np.zeros(N), np.zeros(N)
     out = []
@@ -146,3 +171,31 @@ def test_frictionless_prototype():
     assert np.all(status == Status.SLIP)
     np.testing.assert_allclose(u[0::2], 0.05, rtol=1e-12)
     np.testing.assert_allclose(lam_n, k_v * DELTA, rtol=1e-12)
+
+
+@pytest.mark.parametrize(("kernel", "options"), [("nts", {}), ("mortar", {"basis": "dual"})])
+def test_block_with_the_kernels_rows(kernel, options):
+    """The same block with the library's rows (nts; dual mortar, whose D is diagonal): the
+    multipliers are pressures, lambda_n = k_v delta / w_j with w_j the node's weight (1, 1/2 at
+    the chain's ends), and the block still sticks until Q = sum w lambda_t reaches mu P, then
+    slips with lambda_t = mu lambda_n at every node."""
+    mu = 0.4
+    Bn, Bt = kernel_rows(kernel, **options)
+    w = np.r_[0.5, np.ones(N - 2), 0.5]
+    np.testing.assert_allclose(Bn[np.arange(N), 2 * np.arange(N) + 1], w, rtol=1e-13)
+    np.testing.assert_allclose(Bt[np.arange(N), 2 * np.arange(N)], w, rtol=1e-13)
+    k_v = np.full(N, 2.0)
+    s_slip = mu * 2.0 * DELTA / K_S
+    pushes = s_slip * np.array([0.5, 0.95, 1.05, 1.5])
+    for s, (_, lam_n, lam_t, status, _) in zip(
+        pushes, solve_steps(k_v, mu, pushes, rows_B=(Bn, Bt)), strict=True
+    ):
+        np.testing.assert_allclose(lam_n, 2.0 * DELTA / w, rtol=1e-12)
+        P, Q = w @ lam_n, w @ lam_t
+        if s < s_slip:
+            assert np.all(status == Status.STICK) and Q < mu * P
+            np.testing.assert_allclose(lam_t, K_S * s / w, rtol=1e-12)
+        else:
+            assert np.all(status == Status.SLIP)
+            np.testing.assert_allclose(lam_t, mu * lam_n, rtol=1e-12)
+            np.testing.assert_allclose(Q, mu * P, rtol=1e-12)
