@@ -71,6 +71,51 @@ class CattaneoMindlin:
         return np.abs(np.asarray(x, dtype=float)) < self.c
 
 
+@dataclass(frozen=True)
+class CattaneoErrors:
+    """A computed interface against Cattaneo-Mindlin (line contact)."""
+
+    shear_l2: float  # ||q_h - q|| / ||q|| over the contact, q_h piecewise linear in the nodes
+    c: float  # stick half-width read from the statuses (edges halfway to the slip neighbours)
+    c_exact: float
+    slip_law: float  # max over slip nodes of ||q_h| - mu p_h| / (mu p0)
+
+
+def cattaneo_errors(
+    ref: CattaneoMindlin,
+    x: np.ndarray,
+    shear: np.ndarray,
+    pressure: np.ndarray,
+    stick: np.ndarray,
+) -> CattaneoErrors:
+    """Compare nodal shear, pressure and stick flags at x (across the line, centred) with ref."""
+    if ref.geometry != "cylinder":
+        raise ValueError("cattaneo_errors: line contacts only")
+    order = np.argsort(x)
+    x, q, p, st = (np.asarray(v)[order] for v in (x, shear, pressure, stick))
+    # Gauss points on every node interval, split at the closed form's kinks (+-c, +-a).
+    cuts = np.unique(np.concatenate([x, [-ref.a, -ref.c, ref.c, ref.a]]))
+    cuts = cuts[(cuts >= min(x[0], -ref.a)) & (cuts <= max(x[-1], ref.a))]
+    gx, gw = np.polynomial.legendre.leggauss(16)
+    mid, half = 0.5 * (cuts[1:] + cuts[:-1]), 0.5 * np.diff(cuts)
+    pts = (mid[:, None] + half[:, None] * gx).ravel()
+    wts = (half[:, None] * gw).ravel()
+    exact = ref.shear(pts)
+    computed = np.interp(pts, x, q, left=0.0, right=0.0)
+    l2 = np.sqrt(wts @ (computed - exact) ** 2) / np.sqrt(wts @ exact**2)
+    c = 0.0
+    idx = np.flatnonzero(st)
+    if idx.size:
+        lo, hi = idx[0], idx[-1]
+        left = 0.5 * (x[lo] + x[lo - 1]) if lo > 0 else x[lo]
+        right = 0.5 * (x[hi] + x[hi + 1]) if hi + 1 < len(x) else x[hi]
+        c = 0.5 * (right - left)
+    slip = ~st & (p > 0)
+    excess = np.abs(np.abs(q[slip]) - ref.mu * p[slip])
+    slip_law = float(excess.max(initial=0.0) / (ref.mu * ref.p0))
+    return CattaneoErrors(shear_l2=float(l2), c=float(c), c_exact=ref.c, slip_law=slip_law)
+
+
 def _ellipse(x: np.ndarray, half: float) -> np.ndarray:
     """sqrt(1 - x^2/half^2) inside |x| < half, 0 outside (and 0 everywhere if half is 0)."""
     if half <= 0.0:

@@ -9,6 +9,7 @@ from conftest import ROOT
 from scipy.integrate import quad
 
 from contactfx.results.friction_references import (
+    cattaneo_errors,
     cattaneo_mindlin,
     coupling_beta,
     half_plane_influence,
@@ -79,6 +80,29 @@ def test_hertz_half_width_textbook():
     np.testing.assert_allclose(np.pi * a * (a * E / (2 * R)) / 2, P, rtol=1e-14)
     a = hertz_half_width(P, R, E, "sphere")
     np.testing.assert_allclose(4 * E * a**3 / (3 * R), P, rtol=1e-14)
+
+
+def test_cattaneo_errors_of_sampled_solutions():
+    """The interface measures on nodal samples of the closed form: the shear's L2 error (the
+    interpolation error of the sqrt kinks at +-c, +-a, ~h^1.5 up to where the nodes fall) is
+    below 0.5 % at 320 cells, 8x below 40 cells; the stick half-width is read within half a
+    cell; the slip law holds exactly; a shear 1 % too large reads so."""
+    ref = cattaneo_mindlin(1.0, 0.4, 0.5, 1.0, 1.0)
+    errors = []
+    for n in (40, 320):
+        x = np.linspace(-1.5 * ref.a, 1.5 * ref.a, n + 1)
+        e = cattaneo_errors(ref, x, ref.shear(x), ref.pressure(x), ref.stick(x))
+        assert abs(e.c - ref.c) <= 0.5 * (x[1] - x[0]) + 1e-12
+        assert e.slip_law < 1e-14
+        errors.append(e.shear_l2)
+    assert errors[1] < 0.005 and errors[1] < errors[0] / 8
+    # 1 % too much shear: 1 % up to the interpolation error (triangle inequality); on the slip
+    # nodes |q| - mu p = 0.01 mu p, largest next to the stick zone.
+    x = np.linspace(-1.5 * ref.a, 1.5 * ref.a, 321)
+    p = ref.pressure(x)
+    off = cattaneo_errors(ref, x, 1.01 * ref.shear(x), p, ref.stick(x))
+    assert abs(off.shear_l2 - 0.01) <= 1.01 * errors[1] + 1e-12
+    np.testing.assert_allclose(off.slip_law, 0.01 * p[~ref.stick(x)].max() / ref.p0, rtol=1e-9)
 
 
 def test_cattaneo_bad_input():
