@@ -50,7 +50,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .geometry import Surface, chains, nodal_normals, radial_weight, segment_lengths
-from .operator import REACH, ContactOperator, assemble, end_rows, gauss_unit, linear_shape
+from .operator import (
+    REACH,
+    ContactOperator,
+    assemble,
+    end_rows,
+    gauss_unit,
+    linear_shape,
+    row_directions,
+)
 from .search import project
 
 if TYPE_CHECKING:
@@ -356,9 +364,18 @@ def mortar_matrices(
 
 
 def contact_operator(
-    active: Surface, passive: Surface, ndofs: int, basis: str = "standard", ends: bool = True
+    active: Surface,
+    passive: Surface,
+    ndofs: int,
+    basis: str = "standard",
+    ends: bool = True,
+    direction: str = "normal",
 ) -> ContactOperator:
-    """Mortar operator: exact Gauss integration on sub-segments, normal of the paired segment."""
+    """Mortar operator: exact Gauss integration on sub-segments, normal of the paired segment.
+
+    direction="tangent": the same D/M weights with the paired segment's tangent (the weighted
+    slip rows of friction; `gap` is then the weighted tangential offset, not a gap).
+    """
     # Row j = int phi_j n . (x_active - x_passive), phi = N_j (standard) or psi_j (dual).
     seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis, ends)
     na = linear_shape(xi)
@@ -373,6 +390,6 @@ def contact_operator(
         act_coef=na,
         pas_nodes=passive.segments[seg_p],
         pas_coef=linear_shape(eta),
-        normal=passive.normals[seg_p],
+        normal=row_directions(passive.normals[seg_p], direction),
         group=GAUSS_POINTS,
     )

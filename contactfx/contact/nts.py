@@ -6,7 +6,7 @@ import numpy as np
 
 from .geometry import Surface
 from .mortar import overlap_weights
-from .operator import ContactOperator, assemble, linear_shape
+from .operator import ContactOperator, assemble, linear_shape, row_directions
 from .search import project
 
 # Active nodes beyond the passive surface's end by more than this (in passive segment lengths)
@@ -14,8 +14,15 @@ from .search import project
 TOL = 1e-8
 
 
-def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOperator:
-    """NTS operator: row j = w_j n . (e_j - sum_A N_A(xi_j) e_A), w_j the overlapped int N_j."""
+def contact_operator(
+    active: Surface, passive: Surface, ndofs: int, direction: str = "normal"
+) -> ContactOperator:
+    """NTS operator: row j = w_j n . (e_j - sum_A N_A(xi_j) e_A), w_j the overlapped int N_j.
+
+    direction="tangent" gives the same rows with the passive segment's tangent t instead of n
+    (operator.tangents): the weighted slip of friction; its `gap` is the weighted tangential
+    offset of the reference configuration, not a gap.
+    """
     seg, xi, found = project(active.x, passive, TOL)
     # Scaling by int N_j turns the multiplier into a traction comparable with STS and mortar.
     w = overlap_weights(active, passive, seg)
@@ -31,5 +38,5 @@ def contact_operator(active: Surface, passive: Surface, ndofs: int) -> ContactOp
         act_coef=np.ones((len(j), 1)),
         pas_nodes=passive.segments[s],
         pas_coef=linear_shape(xi[j]),
-        normal=passive.normals[s],
+        normal=row_directions(passive.normals[s], direction),
     )

@@ -97,6 +97,24 @@ def linear_shape(xi: np.ndarray) -> np.ndarray:
     return np.stack([1.0 - xi, xi], axis=-1)
 
 
+#: Directions of a contact operator's rows: the normal (the gap) or the tangent (the slip).
+DIRECTIONS = ("normal", "tangent")
+
+
+def tangents(normals: np.ndarray) -> np.ndarray:
+    """Unit tangents t = (n_y, -n_x) of unit normals (m, 2): +x for the upward normal (0, 1)."""
+    return np.stack([normals[:, 1], -normals[:, 0]], axis=1)
+
+
+def row_directions(normals: np.ndarray, direction: str) -> np.ndarray:
+    """The normals themselves (the gap rows) or their tangents (the slip rows of friction)."""
+    if direction == "normal":
+        return normals
+    if direction == "tangent":
+        return tangents(normals)
+    raise ValueError(f"unknown row direction {direction!r} (known: {', '.join(DIRECTIONS)})")
+
+
 def assemble(
     active: Surface,
     passive: Surface,
