@@ -213,7 +213,7 @@ def test_freeing_the_products_is_a_field() -> None:
     from contactfx.methods.solvers import reuses_interpolation
 
     assert SOLVERS["condensed"].free_products
-    assert not SOLVERS["mumps"].free_products and not SOLVERS["condensed-direct"].free_products
+    assert not SOLVERS["mumps"].free_products and SOLVERS["condensed-gamg"].free_products
     assert not reuses_interpolation(SOLVERS["condensed"].petsc)
     for value, reuses in (("1", True), ("true", True), ("0", False), ("False", False)):
         spec = SOLVERS["condensed"].with_petsc([f"pc_gamg_reuse_interpolation={value}"])
