@@ -115,6 +115,13 @@ for v in edges:
         strong(v)
 for c in comps:
     problems.append("import cycle: " + " <-> ".join(c))
+# The wheel's package list (pyproject.toml names them, to map meshes/ in) against the tree.
+import tomllib  # noqa: E402
+
+listed = set(tomllib.loads(Path("pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+found = {".".join(p.parent.parts) for p in root.rglob("__init__.py")} | {"contactfx.meshes.geo"}
+for name in sorted(found ^ listed):
+    problems.append(f"pyproject.toml: package {name} {'not listed' if name in found else 'not found'}")
 for p in warnings + problems:
     print(p)
 print(
