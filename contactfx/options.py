@@ -15,7 +15,7 @@ from typing import Self
 
 from .contact import Kernel
 from .errors import InputError
-from .option_sets import GAMG, GEOMETRIC_MG, MUMPS_LDLT, MUMPS_LU
+from .option_sets import GAMG, MUMPS_LDLT, MUMPS_LU
 
 
 def _unknown(enum: type[StrEnum], value: object, what: str) -> InputError:
@@ -246,6 +246,15 @@ TRAITS: Mapping[SolverKind, KindTraits] = MappingProxyType(
 )
 
 
+class Multigrid(StrEnum):
+    """A condensed solver's multigrid on the displacements."""
+
+    GAMG = "gamg"  # PETSc's algebraic multigrid, the bodies' rigid modes as near-nullspace
+    # The scene's coarser meshes: a structured grid's own (Scene.grid), else its remeshes (a
+    # recipe), with the option set GEOMETRIC_MG; GAMG where the scene has neither.
+    GEOMETRIC = "geometric"
+
+
 class SchurPre(StrEnum):
     """A Schur-complement fieldsplit's preconditioning matrix for S."""
 
@@ -276,14 +285,13 @@ class SolverSpec:
     schur: SchurPre | None = None
     linear: Linear | None = None
     free_products: bool = False  # GAMG's setup frees its products' data (methods/solvers.py)
-    # A condensed solver's options where the scene has coarser grids: the structured grid's
-    # own (Scene.grid) or its remeshes (a recipe): a geometric multigrid; None: `petsc`
-    # (GAMG) on every mesh, also where the scene has neither.
-    geometric: Mapping[str, object] | None = None
+    multigrid: Multigrid | None = None  # a condensed solver's (None there: GAMG)
 
     def __post_init__(self) -> None:
         if self.linear is None:
             object.__setattr__(self, "linear", self.traits.default_linear)
+        if self.multigrid is None and self.system is System.CONDENSED:
+            object.__setattr__(self, "multigrid", Multigrid.GAMG)
         self._check()
         petsc = dict(self.petsc)
         if self.schur is not None:
@@ -310,6 +318,8 @@ class SolverSpec:
             )
         if self.schur is not None and self.kind is not SolverKind.FIELDSPLIT:
             raise InputError(f"solver '{self.name}': a Schur preconditioner needs a fieldsplit")
+        if self.multigrid is not None and self.system is not System.CONDENSED:
+            raise InputError(f"solver '{self.name}': a multigrid choice needs the condensed system")
         traits, pc = self.traits, self.petsc.get("pc_type")
         factorizes = traits.factorizes
         bad = {
@@ -356,7 +366,6 @@ class SolverSpec:
         pc_type (lu, cholesky) and a Krylov solver's ksp_type (cg, gmres) set `linear`.
         """
         petsc = dict(self.petsc)
-        geometric = None if self.geometric is None else dict(self.geometric)
         rtol, schur, linear = self.rtol, self.schur, self.linear
         factorizes = self.traits.factorizes
         for item in items:
@@ -381,13 +390,9 @@ class SolverSpec:
             if not factorizes and key == "ksp_type":
                 linear = _KRYLOV_KSP.get(value, linear)
             petsc[key] = value
-            if geometric is not None and not key.startswith(("pc_type", "pc_gamg")):
-                geometric[key] = value  # e.g. the smoother's steps: both multigrids
         if self.kind is SolverKind.FIELDSPLIT:
             petsc.pop(SCHUR_KEY, None)
-        return replace(
-            self, petsc=petsc, rtol=rtol, schur=schur, geometric=geometric, linear=linear
-        )
+        return replace(self, petsc=petsc, rtol=rtol, schur=schur, linear=linear)
 
 
 # Multipliers eliminated (D diagonal: NTS or dual mortar), CG on the SPD displacement system,
@@ -401,7 +406,7 @@ CONDENSED = SolverSpec(
     loose_rtol=1e-4,
     name="condensed",
     free_products=True,  # never reused: docs/scale.md, "Memory of the condensed path"
-    geometric=GEOMETRIC_MG,
+    multigrid=Multigrid.GEOMETRIC,
 )
 
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
@@ -457,7 +462,7 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
         ),
         "condensed": CONDENSED,
         # The same with GAMG on every mesh (the structured grid's levels unused).
-        "condensed-gamg": replace(CONDENSED, name="condensed-gamg", geometric=None),
+        "condensed-gamg": replace(CONDENSED, name="condensed-gamg", multigrid=Multigrid.GAMG),
     }
 )
 

@@ -5,6 +5,7 @@ The methods turn a SolverSpec into a solver here; contactfx/linalg itself knows 
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Mapping
 from functools import partial
 
@@ -19,9 +20,12 @@ from ..linalg.nullspace import near_nullspace
 from ..linalg.policy import FactorizationPolicy
 from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
-from ..options import SchurPre, SolverKind, SolverSpec, System
+from ..option_sets import GAMG, GEOMETRIC_MG
+from ..options import Multigrid, SchurPre, SolverKind, SolverSpec, System
 from ..request import direct_path
 from ..scenes import Scene
+
+log = logging.getLogger("contactfx")
 
 # MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the ordering below on
 # the host; parallel analysis with PT-Scotch orders worse on these meshes
@@ -71,6 +75,23 @@ def reuses_interpolation(petsc: Mapping[str, object]) -> bool:
     return str(value).strip().lower() not in ("0", "false", "no", "off")
 
 
+def geometric_options(petsc: Mapping[str, object]) -> dict[str, object]:
+    """A geometric multigrid's options: GEOMETRIC_MG with the spec's own changes to GAMG's set.
+
+    The keys a user gave (--petsc-option) that the GAMG set lacks or sets otherwise, except
+    GAMG's own (pc_type, pc_gamg_*): e.g. the smoother's steps apply to both multigrids.
+    """
+    own = {
+        k: v
+        for k, v in petsc.items()
+        if GAMG.get(k, _MISSING) != v and not k.startswith(("pc_type", "pc_gamg"))
+    }
+    return {**GEOMETRIC_MG, **own}
+
+
+_MISSING = object()
+
+
 def augmentation(spec: SolverSpec, e_max: float, h: float) -> float:
     """Gamma of A00 = K + gamma B^T B: E_max / h^2 for a fieldsplit (scales as K), else 0."""
     return e_max / h**2 if spec.augmented else 0.0
@@ -95,7 +116,7 @@ def make_solver(
     displacements); `node_dofs` (m, 2): the dofs of each multiplier row's active node (the
     condensed solver's pivots); `reuse` False: a throwaway solver for one set; `grid()`: the
     prolongations of the scene's coarser grids, if it has them (a condensed spec with
-    `geometric` options then runs a geometric multigrid). An `auto` spec must be resolved
+    `Multigrid.GEOMETRIC` then runs a geometric multigrid). An `auto` spec must be resolved
     first (methods/autosolve.py); here it is its direct path.
     """
     spec = direct_path(spec)
@@ -103,14 +124,16 @@ def make_solver(
     if traits.system is System.CONDENSED:
         from ..linalg.condensed import CondensedSolver  # not on the direct path: docs/scale.md
 
-        levels = grid() if grid is not None and spec.geometric is not None else None
+        geometric = spec.multigrid is Multigrid.GEOMETRIC
+        levels = grid() if grid is not None and geometric else None
+        if reuse and K.getComm().tompi4py().rank == 0:
+            how = f"geometric, {len(levels)} coarser levels" if levels else "GAMG (algebraic)"
+            log.info("multigrid: %s", how)
         return CondensedSolver(
             K,
             B,
             f,
-            spec.geometric
-            if levels and spec.geometric
-            else with_ordering(spec.petsc, K.getSize()[0]),
+            geometric_options(spec.petsc) if levels else with_ordering(spec.petsc, K.getSize()[0]),
             node_dofs,
             [] if levels or not traits.rigid_modes else modes(),
             rtol=spec.rtol,

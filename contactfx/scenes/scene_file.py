@@ -14,7 +14,7 @@ from typing import Any
 from mpi4py import MPI
 
 from ..errors import InputError
-from .gmsh_io import SceneParts, scene_from_gmsh
+from .gmsh_io import SceneParts, scene_from_parts
 from .model import (
     ContactPair,
     Dirichlet,
@@ -267,4 +267,4 @@ def load_scene_file(
     """The Scene of a TOML scene file (mesh path relative to the file)."""
     path = Path(path)
     mesh, parts = parse_scene_file(path)
-    return scene_from_gmsh(mesh, parts, comm, size_factor, {"scene_file": str(path)})
+    return scene_from_parts(mesh, parts, comm, size_factor, {"scene_file": str(path)})
