@@ -31,7 +31,7 @@ from .model import (
     UniformStress,
     Units,
 )
-from .obstacle import OBSTACLE_SHAPES
+from .obstacle import OBSTACLE_SHAPES, Shape
 from .schema import SECTIONS, TYPE_ERRORS, allowed, required
 
 # The allowed keys of each section, from the one table the reference page is generated from.
@@ -88,10 +88,11 @@ def _vector(where: str, value: Any) -> tuple[float, float]:
 
 
 def _obstacle(k: int, entry: Any) -> Obstacle:
-    shape = entry.get("shape") if isinstance(entry, dict) else None
-    if shape not in OBSTACLE_SHAPES:
+    given = entry.get("shape") if isinstance(entry, dict) else None
+    if not isinstance(given, str) or given not in OBSTACLE_SHAPES:
         choices = ", ".join(f"'{s}'" for s in OBSTACLE_SHAPES)
-        raise InputError(f"obstacle {k}: shape must be one of {choices} (got {shape!r})")
+        raise InputError(f"obstacle {k}: shape must be one of {choices} (got {given!r})")
+    shape = Shape(given)
     where = f"obstacle {k} ({shape})"
     takes = set(OBSTACLE_SHAPES[shape])
     e = _keys(where, entry, SECTION_KEYS["obstacle"] | takes, required("obstacle") | takes)
