@@ -123,7 +123,7 @@ def _coarse_bound(
     assert needed is not None and avail is not None and est is not None
     ran = CONDENSED if choice is Choice.CONDENSED else direct.name
     record = SolverChoice(ran, needed, avail, est.seconds, coarse_dofs=coarse_dofs)
-    return _condensed(setup, scene, request, record)
+    return _condensed(setup, scene.comm, request, record)
 
 
 def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: Timers) -> Prepared:
@@ -148,14 +148,11 @@ def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: T
     linear.destroy()  # frees MUMPS' analysis before the other path runs
     assert needed is not None and avail is not None  # a known estimate that does not fit
     ran = CONDENSED if choice is Choice.CONDENSED else direct.solver.name
-    return _condensed(setup, scene, request, SolverChoice(ran, needed, avail, seconds))
+    return _condensed(setup, scene.comm, request, SolverChoice(ran, needed, avail, seconds))
 
 
 def _condensed(
-    setup: ContactSetup,
-    scene: Scene,
-    request: SolveRequest,
-    record: SolverChoice,
+    setup: ContactSetup, comm: MPI.Comm, request: SolveRequest, record: SolverChoice
 ) -> Prepared:
     """The condensed path where MUMPS does not fit; a one-line refusal where D is not diagonal."""
     if record.ran != CONDENSED:
@@ -167,8 +164,8 @@ def _condensed(
             f"(margin x{SAFETY:g}); use --method mortar --basis dual (or nts) for the "
             "condensed path, or fewer DOFs"
         )
-    _say(record, scene.comm)
-    if request.solver.petsc != SOLVERS["auto"].petsc and scene.comm.rank == 0:
+    _say(record, comm)
+    if request.solver.petsc != SOLVERS["auto"].petsc and comm.rank == 0:
         log.info("solver: the --petsc-option values were for MUMPS: not applied")
     return Prepared(setup, replace(request, solver=SOLVERS[CONDENSED]), None, record)
 

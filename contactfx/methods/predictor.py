@@ -78,10 +78,10 @@ def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
 DIRECT_PREDICTOR_DOFS = 2_000_000
 
 
-def predictor_solver(spec: SolverSpec, coarse: Scene) -> SolverSpec:
+def predictor_solver(spec: SolverSpec, coarse_dofs: int) -> SolverSpec:
     """The solver of the coarse solve: the kind's `coarse_solver` up to DIRECT_PREDICTOR_DOFS."""
     name = spec.traits.coarse_solver
-    if name is not None and scene_dofs(coarse) <= DIRECT_PREDICTOR_DOFS:
+    if name is not None and coarse_dofs <= DIRECT_PREDICTOR_DOFS:
         return SOLVERS[name]
     return spec
 
@@ -226,7 +226,7 @@ def predict(
     with timers("predictor"), stage("predictor"):
         coarse, factor = _remeshed(scene, coarse_factor(spec, scene))
         coarse_request = replace(
-            request, solver=predictor_solver(spec, coarse), reference_timing=False
+            request, solver=predictor_solver(spec, scene_dofs(coarse)), reference_timing=False
         )
         sol = solve_contact(coarse, coarse_request, aso=aso, label="predictor")
         return initial_set(sol, spec, factor)
