@@ -145,6 +145,10 @@ def test_a_request_travels_alone() -> None:
     assert sol.penalty.eps == 1e7
     with pytest.raises(InputError, match="beside a SolveRequest"):
         solve(scene, request, max_iterations=3)
+    with pytest.raises(InputError, match="beside a SolveRequest"):
+        run_case("blocks", MATCHING, request, comm=MPI.COMM_SELF, solver="mumps")
+    with pytest.raises(InputError, match="unknown solve option tolerance"):
+        solve(scene, "nts", tolerance=1e-3)  # type: ignore[call-arg]
 
 
 def assert_refused(proc: subprocess.CompletedProcess[str], needle: str, out: Path) -> None:
