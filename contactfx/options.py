@@ -153,11 +153,6 @@ class Linear(StrEnum):
         """Whether it accepts an unsymmetric system (a frictional one is)."""
         return self in (Linear.LU, Linear.GMRES)
 
-    @property
-    def factorizes(self) -> bool:
-        """Whether it is a factorization (its pc_type: lu or cholesky)."""
-        return self in (Linear.LU, Linear.LDLT)
-
 
 # The pc_type of each factorization, and the ksp_types of each Krylov method.
 _FACTOR_PC = {Linear.LU: "lu", Linear.LDLT: "cholesky"}
@@ -183,8 +178,8 @@ class KindTraits:
     """
 
     system: System
-    linear: frozenset[Linear]  # the linear solvers it accepts (the first: its default)
-    default_linear: Linear
+    linear: frozenset[Linear]  # the linear solvers it accepts
+    default_linear: Linear  # a spec's linear solver when it names none
     factorizes: bool  # the whole saddle point factorized: probes exact, release steps
     augmented: bool  # A00 = K + gamma B^T B (a fieldsplit's A00 must be invertible alone)
     rigid_modes: bool  # its multigrid (GAMG) gets the bodies' rigid modes as near-nullspace
