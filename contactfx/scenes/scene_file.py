@@ -7,6 +7,7 @@ allowed there (the keys, types and defaults: schema.py, printed in docs/referenc
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -202,7 +203,8 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
     _section(str(path.name), doc, "")
     if "contact" not in doc and "obstacle" not in doc:
         raise InputError(f"{path.name}: missing key 'contact' (or 'obstacle')")
-    mesh = path.parent / _string("mesh", doc["mesh"])
+    # Relative to the file; `..` collapsed (the demo scenes name ../../meshes/*.geo).
+    mesh = Path(os.path.normpath(path.parent / _string("mesh", doc["mesh"])))
     name = str(doc.get("name", path.stem))
     model = Model.parse(_string("model", doc.get("model", Model.PLANE_STRAIN.value)))
     units = _units(doc.get("units", {}))
