@@ -177,7 +177,7 @@ def warn_if_too_big(
 
     The analysis is the one its first factorization reuses (no cost beyond a collective).
     """
-    if request.solver.kind is not SolverKind.DIRECT or not isinstance(linear, SaddleSolver):
+    if not request.solver.traits.factorizes or not isinstance(linear, SaddleSolver):
         return
     with timers("solve"):
         estimate = linear.mumps_estimate()
