@@ -44,7 +44,7 @@ from contactfx.linalg.nullspace import orthonormalize
 from contactfx.linalg.petsc_options import PrefixedOptions, global_options
 from contactfx.linalg.pivots import pivots
 from contactfx.methods.multipliers import _timed_fresh_solve
-from contactfx.options import SOLVERS, Basis, SolverSpec
+from contactfx.options import SOLVERS, Basis, Multigrid, SolverSpec
 from contactfx.scenes import HertzParams, hertz
 from contactfx.timers import Timers
 
@@ -171,7 +171,9 @@ def spec_for(name: str) -> SolverSpec:
     if name == "gamg":
         return SOLVERS["condensed-gamg"]
     # GAMG with these options on every mesh (no geometric levels).
-    return replace(preset, petsc={**BASE, **SETS[name]}, name=f"condensed-{name}", geometric=None)
+    return replace(
+        preset, petsc={**BASE, **SETS[name]}, name=f"condensed-{name}", multigrid=Multigrid.GAMG
+    )
 
 
 def split_global(spec: SolverSpec) -> tuple[SolverSpec, dict[str, object]]:

@@ -3,7 +3,7 @@
 `[mpirun -n R] python benchmarks/mumps_memory.py [--analysis-only] H [H ...]` meshes the
 accurate Hertz family (structured, `--refine H --h-far 10H`, dual mortar) and, per size,
 runs the loop's direct solver as `--solver auto` does: the analysis alone (linalg/saddle.py
-`mumps_estimate`), then the first factorization and solve. One JSON line per size: the
+`SaddleSolver.mumps_estimate`), then the first factorization and solve. One JSON line per size: the
 estimate (INFO(15) summed over the ranks, INFOG(16), INFOG(17)), the analysis seconds,
 MUMPS' allocated (INFOG(18/19)) and effectively used (INFOG(21/22)) memory after the
 factorization, and the growth of the resident memory (VmHWM after minus VmRSS before the
@@ -22,7 +22,7 @@ import numpy as np
 from mpi4py import MPI
 
 from contactfx.discretize.setup import prepare_contact
-from contactfx.linalg.saddle import SaddleSolver, mumps_estimate
+from contactfx.linalg.saddle import SaddleSolver
 from contactfx.methods.solvers import setup_solver
 from contactfx.options import SOLVERS, Basis, Method
 from contactfx.scenes import HertzParams, build_scene
@@ -46,7 +46,7 @@ def measure(h: float, comm: MPI.Comm, analysis_only: bool = False) -> dict[str, 
     solver = setup_solver(setup, SOLVERS["mumps"], scene, reuse=True)
     assert isinstance(solver, SaddleSolver)
     rss0 = status_mb("VmRSS")
-    estimate = mumps_estimate(solver)
+    estimate = solver.mumps_estimate()
     assert estimate is not None
     rss1 = status_mb("VmRSS")  # `auto` reads MemAvailable here, after the analysis
     dofs = setup.elasticity.K.getSize()[0]

@@ -37,12 +37,16 @@ DELTA, B = 0.01, 1.0
 
 def scene_with(tmp: Path, name: str, field: str) -> Path:
     """rigid_punch.toml on a copy of rigid_block.geo whose size field is `field` (MathEval)."""
-    geo = (SCENES / "rigid_block.geo").read_text()
+    geo = (ROOT / "meshes" / "rigid_block.geo").read_text()
     start = geo.index("Field[1].F")
     end = geo.index("Background Field")
     geo = geo[:start] + f'Field[1].F = "{field}";\n' + geo[end:]
     (tmp / f"{name}.geo").write_text(geo)
-    toml = (SCENES / "rigid_punch.toml").read_text().replace("rigid_block.geo", f"{name}.geo")
+    toml = (
+        (SCENES / "rigid_punch.toml")
+        .read_text()
+        .replace("../../meshes/rigid_block.geo", f"{name}.geo")
+    )
     (tmp / f"{name}.toml").write_text(toml)
     return tmp / f"{name}.toml"
 

@@ -54,8 +54,8 @@ from .scenes import (
     Scene,
     UniformStress,
     load_scene_file,
+    scene_from_gmsh,
 )
-from .scenes import from_gmsh as scene_from_gmsh
 
 __version__ = _version("contactfx")
 

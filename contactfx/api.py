@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import resource
 import time
+from typing import Unpack
 
 from mpi4py import MPI
 
@@ -18,8 +19,8 @@ from .methods.autosolve import prepare_solver
 from .methods.multipliers import solve_contact
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.solution import Solution
-from .options import Basis, Enforcement, Method, Predictor, SolverKind, SolverSpec
-from .request import DEFAULT_MAX_ITERATIONS, DEFAULT_SOLVER, SchwarzOptions, SolveRequest
+from .options import Enforcement, Method, SolverKind
+from .request import RequestOptions, SolveRequest
 from .results.records import RunSummary
 from .results.summary import summary
 from .scenes import BlockParams, HertzParams, Scene, build_scene
@@ -29,100 +30,47 @@ TIME_KEYS = ("mesh", "assemble", "search", "contact", "solve")
 
 
 def as_request(
-    method: SolveRequest | Method | str = Method.MORTAR,
-    *,
-    enforcement: Enforcement | str | None = None,
-    solver: SolverSpec | str | None = None,
-    basis: Basis | str | None = None,
-    predictor: Predictor | str | None = None,
-    max_iterations: int | None = None,
-    penalty: float | None = None,
-    schwarz: SchwarzOptions | None = None,
-    reference_timing: bool | None = None,
+    request: SolveRequest | Method | str = Method.MORTAR, **options: Unpack[RequestOptions]
 ) -> SolveRequest:
-    """`method` itself if it is a request (no option beside it), else the parsed request.
-
-    The options are `solve`'s; None takes the default.
-    """
-    if isinstance(method, SolveRequest):
-        given = {
-            "enforcement": enforcement,
-            "solver": solver,
-            "basis": basis,
-            "predictor": predictor,
-            "max_iterations": max_iterations,
-            "penalty": penalty,
-            "schwarz": schwarz,
-            "reference_timing": reference_timing,
-        }
-        named = [k for k, v in given.items() if v is not None]
-        if named:
-            raise InputError(f"option {named[0]} given beside a SolveRequest: set it in it")
-        return method
-    return SolveRequest.parse(
-        method,
-        enforcement=enforcement,
-        solver=DEFAULT_SOLVER if solver is None else solver,
-        basis=Basis.STANDARD if basis is None else basis,
-        predictor=Predictor.AUTO if predictor is None else predictor,
-        max_iterations=DEFAULT_MAX_ITERATIONS if max_iterations is None else max_iterations,
-        penalty=penalty,
-        schwarz=schwarz,
-        reference_timing=bool(reference_timing),
-    )
+    """`request` itself if it is a SolveRequest (no option beside it), else the parsed one."""
+    if not isinstance(request, SolveRequest):
+        return SolveRequest.parse(request, **options)
+    if options:
+        raise InputError(f"option {next(iter(options))} given beside a SolveRequest: set it in it")
+    return request
 
 
 def solve(
     scene: Scene,
-    method: SolveRequest | Method | str = Method.MORTAR,
+    request: SolveRequest | Method | str = Method.MORTAR,
     *,
-    enforcement: Enforcement | str | None = None,
-    solver: SolverSpec | str | None = None,
-    basis: Basis | str | None = None,
-    predictor: Predictor | str | None = None,
-    max_iterations: int | None = None,
-    penalty: float | None = None,
-    schwarz: SchwarzOptions | None = None,
-    reference_timing: bool | None = None,
     timers: Timers | None = None,
     initial: Solution | None = None,
+    **options: Unpack[RequestOptions],
 ) -> Solution:
-    """Solve the frictionless contact problem of `scene` as `method` asks.
+    """Solve the frictionless contact problem of `scene` as `request` asks.
 
     Args:
         scene: The scene (a built-in scene, a scene file, or `scene_from_gmsh`).
-        method: A SolveRequest, or a method's name: nts, sts, mortar (multipliers), penalty
+        request: A SolveRequest, or a method's name: nts, sts, mortar (multipliers), penalty
             or schwarz (mortar with that enforcement).
-        enforcement: multipliers, penalty or schwarz on the discretization `method` names.
-        solver: A preset name of `SOLVERS` or a SolverSpec (default auto: mumps unless its
-            memory estimate does not fit, then condensed; docs/scale.md).
-        basis: Mortar's multiplier basis: standard or dual (biorthogonal, D diagonal).
-        predictor: auto, coarse (a first active set from a coarser solve of the same scene)
-            or none; the converged solution does not depend on it.
-        max_iterations: Limit of the active-set (or Schwarz) iterations (default 50).
-        penalty: The penalty method's normal stiffness (default 1e3 E_max / h).
-        schwarz: The Schwarz method's controls.
-        reference_timing: Also time one fresh solve of the final system (the cost floor).
         timers: Where the labelled times go (a new Timers if None).
         initial: A solution of the same scene on another mesh (an adaptive loop's previous
             level): its active set is the first guess of a multiplier method, in place of
             the predictor's (penalty and schwarz have no active-set guess to take).
+        options: With a method's name, the request's options (`RequestOptions`, the
+            defaults of `SolveRequest.parse`): enforcement (multipliers, penalty or schwarz
+            on the discretization named), solver (a preset of `SOLVERS` or a SolverSpec;
+            default auto: mumps unless its memory estimate does not fit, then condensed),
+            basis (standard or dual), predictor (auto, coarse or none; the converged
+            solution does not depend on it), max_iterations (default 50), penalty (default
+            1e3 E_max / h), schwarz (its controls), reference_timing (also time one fresh
+            solve of the final system) and available_mb.
 
     Returns:
         The Solution: displacement, multipliers per pair, history and costs.
     """
-    request = as_request(
-        method,
-        enforcement=enforcement,
-        solver=solver,
-        basis=basis,
-        predictor=predictor,
-        max_iterations=max_iterations,
-        penalty=penalty,
-        schwarz=schwarz,
-        reference_timing=reference_timing,
-    )
-    return solve_request(scene, request, timers, initial)
+    return solve_request(scene, as_request(request, **options), timers, initial)
 
 
 def solve_request(
@@ -164,48 +112,31 @@ def solve_request(
 
 def run_scene(
     scene: Scene,
-    method: SolveRequest | Method | str = Method.MORTAR,
+    request: SolveRequest | Method | str = Method.MORTAR,
     *,
-    enforcement: Enforcement | str | None = None,
-    solver: SolverSpec | str | None = None,
-    basis: Basis | str | None = None,
-    predictor: Predictor | str | None = None,
-    max_iterations: int | None = None,
-    penalty: float | None = None,
-    schwarz: SchwarzOptions | None = None,
-    reference_timing: bool | None = None,
     t_start: float | None = None,
     timers: Timers | None = None,
     paper_interface: bool = False,
     initial: Solution | None = None,
+    **options: Unpack[RequestOptions],
 ) -> tuple[Solution, RunSummary]:
     """Solve `scene` and return the solution with its summary (times from `t_start`).
 
-    `method` and the options are `solve`'s; `paper_interface` adds the x-sorted `interface`
+    `request` and the options are `solve`'s; `paper_interface` adds the x-sorted `interface`
     block of pair 0 (the paper's scenes: one horizontal contact line). The summary's
     `to_json()` is the JSON of `contactfx solve --json`.
     """
     t_start = time.perf_counter() if t_start is None else t_start
     timers = timers or Timers()
-    request = as_request(
-        method,
-        enforcement=enforcement,
-        solver=solver,
-        basis=basis,
-        predictor=predictor,
-        max_iterations=max_iterations,
-        penalty=penalty,
-        schwarz=schwarz,
-        reference_timing=reference_timing,
-    )
-    sol = solve_request(scene, request, timers, initial)
+    req = as_request(request, **options)
+    sol = solve_request(scene, req, timers, initial)
     times = {k: timers.seconds.get(k, 0.0) for k in TIME_KEYS}
     for key in ("predictor", "reference_solve", "reference_lu", "reference_ldlt"):
         if key in timers.seconds:
             times[key] = timers.seconds[key]
     times["total"] = time.perf_counter() - t_start
     return sol, summary(
-        sol, times, request=request, memory=peak_memory(scene.comm), paper_interface=paper_interface
+        sol, times, request=req, memory=peak_memory(scene.comm), paper_interface=paper_interface
     )
 
 
@@ -222,39 +153,18 @@ def peak_memory(comm: MPI.Comm) -> dict[str, float]:
 def run_case(
     kind: str,
     params: BlockParams | HertzParams,
-    method: SolveRequest | Method | str,
+    request: SolveRequest | Method | str,
     active: int = 2,
     comm: MPI.Comm = MPI.COMM_WORLD,
-    *,
-    enforcement: Enforcement | str | None = None,
-    solver: SolverSpec | str | None = None,
-    basis: Basis | str | None = None,
-    predictor: Predictor | str | None = None,
-    max_iterations: int | None = None,
-    penalty: float | None = None,
-    schwarz: SchwarzOptions | None = None,
-    reference_timing: bool | None = None,
+    **options: Unpack[RequestOptions],
 ) -> tuple[Solution, RunSummary]:
     """Mesh, assemble and solve a built-in scene; return the solution and its summary.
 
-    `method` and the options are `solve`'s; the summary carries the paper's `interface` block.
+    `request` and the options are `solve`'s; the summary carries the paper's `interface` block.
     """
     t_start = time.perf_counter()
     timers = Timers()
+    req = as_request(request, **options)  # refused before the mesh is made
     with timers("mesh"):
         scene = build_scene(kind, params, active=active, comm=comm)
-    return run_scene(
-        scene,
-        method,
-        enforcement=enforcement,
-        solver=solver,
-        basis=basis,
-        predictor=predictor,
-        max_iterations=max_iterations,
-        penalty=penalty,
-        schwarz=schwarz,
-        reference_timing=reference_timing,
-        t_start=t_start,
-        timers=timers,
-        paper_interface=True,
-    )
+    return run_scene(scene, req, t_start=t_start, timers=timers, paper_interface=True)

@@ -15,7 +15,7 @@ from typing import Self
 
 from .contact import Kernel
 from .errors import InputError
-from .option_sets import GAMG, GEOMETRIC_MG, MUMPS_LDLT, MUMPS_LU
+from .option_sets import GAMG, MUMPS_LDLT, MUMPS_LU
 
 
 def _unknown(enum: type[StrEnum], value: object, what: str) -> InputError:
@@ -91,11 +91,6 @@ class Method(_Choice):
         """The discrete contact operator (B, weighted gap) this method is built on."""
         return self.pair[0].kernel
 
-    @property
-    def has_multipliers(self) -> bool:
-        """Whether the method solves saddle points with Lagrange multipliers."""
-        return self.pair[1] is Enforcement.MULTIPLIERS
-
 
 _ALIASES: Mapping[Method, tuple[Discretization, Enforcement]] = MappingProxyType(
     {
@@ -125,31 +120,134 @@ class Predictor(_Choice):
 
 
 class SolverKind(StrEnum):
-    """Which linear solver handles the saddle points."""
+    """Which linear solver handles the saddle points (its traits: `SolverKind.traits`)."""
 
     DIRECT = "direct"  # a factorization of the whole [[K, B^T], [B, C]] (MUMPS)
     FIELDSPLIT = "fieldsplit"  # PCFIELDSPLIT Schur on A00 = K + gamma B^T B
     CONDENSED = "condensed"  # active multipliers eliminated (D diagonal), CG + multigrid on u
-    CONDENSED_DIRECT = "condensed-direct"  # the same system factorized (Cholesky)
-    # One MUMPS factorization of K + gamma B^T B with every multiplier row as its Schur
-    # variables; each active set a dense solve on that block (serial; linalg/schur.py).
-    DIRECT_SCHUR = "direct-schur"
     AUTO = "auto"  # DIRECT unless MUMPS' own estimate does not fit, then CONDENSED (autosolve)
 
     @property
-    def factorizes_saddle(self) -> bool:
-        """Whether a MUMPS factorization of the whole saddle point answers (probes exact)."""
-        return self in (SolverKind.DIRECT, SolverKind.DIRECT_SCHUR)
+    def traits(self) -> KindTraits:
+        """What the rest of the code asks of this kind (the TRAITS table)."""
+        return TRAITS[self]
+
+
+class System(StrEnum):
+    """Which linear system a solver kind solves (4C's SYSTEM: saddlepoint | condensed)."""
+
+    SADDLE = "saddle"  # [[K, B^T], [B, C]] [u; mu] = [f; -g]
+    CONDENSED = "condensed"  # the active multipliers eliminated: displacements only (D diagonal)
+
+
+class Linear(StrEnum):
+    """The linear solver of a system: a factorization or a Krylov method (4C's LINEAR_SOLVER)."""
+
+    LU = "lu"
+    LDLT = "ldlt"  # symmetric (indefinite) factorization: PETSc's pc_type cholesky
+    CG = "cg"
+    GMRES = "gmres"  # GMRES or FGMRES
 
     @property
-    def augmented(self) -> bool:
-        """Whether A00 = K + gamma B^T B (a fieldsplit's A00 must be invertible alone)."""
-        return self is SolverKind.FIELDSPLIT
+    def unsymmetric(self) -> bool:
+        """Whether it accepts an unsymmetric system (a frictional one is)."""
+        return self in (Linear.LU, Linear.GMRES)
+
+
+# The pc_type of each factorization, and the ksp_types of each Krylov method.
+_FACTOR_PC = {Linear.LU: "lu", Linear.LDLT: "cholesky"}
+_KRYLOV_KSP = {"cg": Linear.CG, "gmres": Linear.GMRES, "fgmres": Linear.GMRES}
+
+
+class CoarseStart(StrEnum):
+    """When `--predictor auto` starts the loop from a coarser solve (methods/predictor.py)."""
+
+    ROWS = "rows"  # a remeshable scene with more than PROBE_ALL_ROWS multiplier rows
+    ALWAYS = "always"  # every remeshable scene (a loop without probes)
+    DOFS = "dofs"  # from COARSE_PREDICTOR_DOFS DOFs
+
+
+@dataclass(frozen=True)
+class KindTraits:
+    """A solver kind's answers to the questions the methods ask of it.
+
+    `coarse_*` are the coarse predictor's rules (methods/predictor.py, measured in
+    docs/scale.md#measured-constants): how much coarser its mesh is (`coarse_factor`; a
+    factorization doubles it until the coarse rows are few), how many coarse elements of
+    margin its first set gets, and the preset its coarse solve runs (None: the same spec).
+    """
+
+    system: System
+    linear: frozenset[Linear]  # the linear solvers it accepts
+    default_linear: Linear  # a spec's linear solver when it names none
+    factorizes: bool  # the whole saddle point factorized: probes exact, release steps
+    augmented: bool  # A00 = K + gamma B^T B (a fieldsplit's A00 must be invertible alone)
+    rigid_modes: bool  # its multigrid (GAMG) gets the bodies' rigid modes as near-nullspace
+    coarse_start: CoarseStart
+    coarse_factor: float
+    coarse_margin: float
+    coarse_solver: str | None = None
 
     @property
-    def condensed(self) -> bool:
-        """Whether the multipliers are eliminated (the displacement-only SPD system)."""
-        return self in (SolverKind.CONDENSED, SolverKind.CONDENSED_DIRECT)
+    def needs_diagonal_d(self) -> bool:
+        """Whether the multipliers' block D must be diagonal (they are eliminated)."""
+        return self.system is System.CONDENSED
+
+
+# A factorization probes the fine band (selected inverse entries): a band twice as wide costs
+# it less than the coarse solve saves at x16, and a generous margin costs it nothing ("Coarse
+# factor", "Coarse predictor"). The condensed loop pays a whole solve per ring of nodes it
+# adds or releases: a sharper prediction (1/16 of the DOFs, half a coarse element) pays for
+# itself, and its coarse set is a guess that MUMPS finds fastest ("Direct predictor").
+_DIRECT = KindTraits(
+    System.SADDLE,
+    frozenset((Linear.LDLT, Linear.LU)),
+    Linear.LDLT,
+    factorizes=True,
+    augmented=False,
+    rigid_modes=False,
+    coarse_start=CoarseStart.ROWS,
+    coarse_factor=16.0,
+    coarse_margin=1.5,
+)
+TRAITS: Mapping[SolverKind, KindTraits] = MappingProxyType(
+    {
+        SolverKind.DIRECT: _DIRECT,
+        SolverKind.AUTO: _DIRECT,  # its direct path; it is resolved before the loop
+        SolverKind.FIELDSPLIT: KindTraits(
+            System.SADDLE,
+            frozenset((Linear.GMRES,)),
+            Linear.GMRES,
+            factorizes=False,
+            augmented=True,
+            rigid_modes=True,
+            coarse_start=CoarseStart.DOFS,
+            coarse_factor=8.0,
+            coarse_margin=1.5,
+        ),
+        SolverKind.CONDENSED: KindTraits(
+            System.CONDENSED,
+            frozenset((Linear.CG, Linear.GMRES)),
+            Linear.CG,
+            factorizes=False,
+            augmented=False,
+            rigid_modes=True,
+            coarse_start=CoarseStart.ALWAYS,
+            coarse_factor=4.0,
+            coarse_margin=0.5,
+            coarse_solver="mumps",
+        ),
+    }
+)
+
+
+class Multigrid(StrEnum):
+    """A condensed solver's multigrid on the displacements."""
+
+    GAMG = "gamg"  # PETSc's algebraic multigrid, the bodies' rigid modes as near-nullspace
+    # The scene's coarser meshes: a structured grid's own (Scene.grid), else its remeshes (a
+    # recipe), with the option set GEOMETRIC_MG; GAMG where the scene has neither.
+    GEOMETRIC = "geometric"
 
 
 class SchurPre(StrEnum):
@@ -163,26 +261,15 @@ SCHUR_KEY = "pc_fieldsplit_schur_precondition"
 
 
 @dataclass(frozen=True)
-class LowRank:
-    """MUMPS' block low-rank factorization of a direct saddle point from `from_dofs` DOFs.
-
-    CNTL(7) = `tolerance`, ICNTL(35) = `variant`: the factors are approximate, so every solve
-    on them is GMRES to full-rank accuracy (linalg/saddle.py: APPROX_RTOL).
-    """
-
-    from_dofs: int = 0
-    tolerance: float = 1e-8
-    variant: int = 2  # ICNTL(35): 1 automatic, 2 factors and solve compressed, 3 factors only
-
-
-@dataclass(frozen=True)
 class SolverSpec:
     """A linear solver: its kind, its PETSc options and the tolerances the code applies.
 
-    `petsc` holds PETSc keys only (no leading dash). `rtol` is the final relative tolerance
-    of an iterative solver (the condensed solver's CG); `loose_rtol` the relative reduction
-    the condensed loop's solves stop at before the set is stationary (None: solve to rtol).
-    `schur` is a fieldsplit's Schur preconditioner; its PETSc option is derived from it.
+    `petsc` holds PETSc keys only (no leading dash). `linear` is the linear solver of the
+    kind's system (None: the kind's default); a factorization's pc_type is derived from it.
+    `rtol` is the final relative tolerance of an iterative solver (the condensed solver's
+    CG); `loose_rtol` the relative reduction the condensed loop's solves stop at before the
+    set is stationary (None: solve to rtol). `schur` is a fieldsplit's Schur preconditioner;
+    its PETSc option is derived from it.
     """
 
     kind: SolverKind
@@ -191,22 +278,33 @@ class SolverSpec:
     loose_rtol: float | None = None
     name: str = "custom"
     schur: SchurPre | None = None
+    linear: Linear | None = None
     free_products: bool = False  # GAMG's setup frees its products' data (methods/solvers.py)
-    low_rank: LowRank | None = None  # a direct solver's BLR factorization (methods/solvers.py)
-    # A condensed solver's options where the scene has coarser grids: the structured grid's
-    # own (Scene.grid) or its remeshes (a recipe): a geometric multigrid; None: `petsc`
-    # (GAMG) on every mesh, also where the scene has neither.
-    geometric: Mapping[str, object] | None = None
+    multigrid: Multigrid | None = None  # a condensed solver's (None there: GAMG)
 
     def __post_init__(self) -> None:
+        if self.linear is None:
+            object.__setattr__(self, "linear", self.traits.default_linear)
+        if self.multigrid is None and self.system is System.CONDENSED:
+            object.__setattr__(self, "multigrid", Multigrid.GAMG)
         self._check()
         petsc = dict(self.petsc)
         if self.schur is not None:
             petsc[SCHUR_KEY] = self.schur.value
         object.__setattr__(self, "petsc", MappingProxyType(petsc))
 
+    @property
+    def traits(self) -> KindTraits:
+        """The kind's traits (the TRAITS table)."""
+        return TRAITS[self.kind]
+
+    @property
+    def system(self) -> System:
+        """The linear system this solver solves: the saddle point or the condensed one."""
+        return self.traits.system
+
     def _check(self) -> None:
-        """Refuse PETSc options that contradict the kind or the Schur preconditioner."""
+        """Refuse PETSc options that contradict the kind, the linear solver or the Schur pre."""
         given = self.petsc.get(SCHUR_KEY)
         if given is not None and (self.schur is None or str(given) != self.schur.value):
             raise InputError(
@@ -215,26 +313,35 @@ class SolverSpec:
             )
         if self.schur is not None and self.kind is not SolverKind.FIELDSPLIT:
             raise InputError(f"solver '{self.name}': a Schur preconditioner needs a fieldsplit")
-        pc = self.petsc.get("pc_type")
+        if self.multigrid is not None and self.system is not System.CONDENSED:
+            raise InputError(f"solver '{self.name}': a multigrid choice needs the condensed system")
+        traits, pc = self.traits, self.petsc.get("pc_type")
+        factorizes = traits.factorizes
         bad = {
-            SolverKind.DIRECT: pc not in ("lu", "cholesky"),
             SolverKind.FIELDSPLIT: pc != "fieldsplit",
             SolverKind.CONDENSED: pc in ("fieldsplit", "lu", "cholesky"),
-            SolverKind.CONDENSED_DIRECT: pc not in ("lu", "cholesky"),
-            SolverKind.DIRECT_SCHUR: pc not in ("lu", "cholesky"),
-        }[SolverKind.DIRECT if self.kind is SolverKind.AUTO else self.kind]
+        }.get(self.kind, pc not in ("lu", "cholesky"))
         if bad:
             fix = {
-                SolverKind.DIRECT: "a direct solver factorizes (pc_type lu or cholesky)",
                 SolverKind.FIELDSPLIT: "a fieldsplit solver needs pc_type fieldsplit",
-                SolverKind.CONDENSED: "it preconditions by multigrid (condensed-direct factorizes)",
-            }.get(self.kind, "it factorizes (pc_type cholesky or lu)")
+                SolverKind.CONDENSED: "it preconditions by multigrid",
+            }.get(self.kind, "a direct solver factorizes (pc_type lu or cholesky)")
             raise InputError(
                 f"solver '{self.name}' ({self.kind.value}): PETSc option pc_type={pc} "
                 f"contradicts it: {fix}; choose the solver with --solver instead"
             )
-        if self.low_rank is not None and not 0.0 < self.low_rank.tolerance < 1.0:
-            raise InputError(f"solver '{self.name}': the low-rank tolerance must lie in (0, 1)")
+        assert self.linear is not None
+        if self.linear not in traits.linear:
+            accepted = ", ".join(sorted(m.value for m in traits.linear))
+            raise InputError(
+                f"solver '{self.name}' ({self.kind.value}): linear solver {self.linear.value} "
+                f"does not apply (choose {accepted})"
+            )
+        if factorizes and pc != _FACTOR_PC[self.linear]:
+            raise InputError(
+                f"solver '{self.name}': PETSc option pc_type={pc} contradicts its linear solver "
+                f"({self.linear.value}: pc_type {_FACTOR_PC[self.linear]})"
+            )
         if not (0.0 < self.rtol < 1.0) or (
             self.loose_rtol is not None and not 0.0 < self.loose_rtol < 1.0
         ):
@@ -243,24 +350,25 @@ class SolverSpec:
     @property
     def augmented(self) -> bool:
         """Whether A00 = K + gamma B^T B."""
-        return self.kind.augmented
+        return self.traits.augmented
 
     def with_petsc(self, items: Iterable[str]) -> SolverSpec:
         """The spec with PETSc options KEY=VALUE added (checked against the kind).
 
         For the condensed solver `ksp_rtol` is the tolerance the code applies itself (its
         final solves), so it sets `rtol` rather than a PETSc option that would be overridden;
-        for a fieldsplit pc_fieldsplit_schur_precondition sets `schur`.
+        for a fieldsplit pc_fieldsplit_schur_precondition sets `schur`; a factorization's
+        pc_type (lu, cholesky) and a Krylov solver's ksp_type (cg, gmres) set `linear`.
         """
         petsc = dict(self.petsc)
-        geometric = None if self.geometric is None else dict(self.geometric)
-        rtol, schur = self.rtol, self.schur
+        rtol, schur, linear = self.rtol, self.schur, self.linear
+        factorizes = self.traits.factorizes
         for item in items:
             key, sep, value = item.partition("=")
             key = key.strip().lstrip("-")
             if not sep or not key:
                 raise InputError(f"--petsc-option expects KEY=VALUE, got '{item}'")
-            if self.kind.condensed and key == "ksp_rtol":
+            if self.system is System.CONDENSED and key == "ksp_rtol":
                 try:
                     rtol = float(value)
                 except ValueError:
@@ -272,12 +380,14 @@ class SolverSpec:
                     schur = SchurPre(value)
                 except ValueError:
                     raise _unknown(SchurPre, value, SCHUR_KEY) from None
+            if factorizes and key == "pc_type":
+                linear = {"lu": Linear.LU, "cholesky": Linear.LDLT}.get(value, linear)
+            if not factorizes and key == "ksp_type":
+                linear = _KRYLOV_KSP.get(value, linear)
             petsc[key] = value
-            if geometric is not None and not key.startswith(("pc_type", "pc_gamg")):
-                geometric[key] = value  # e.g. the smoother's steps: both multigrids
         if self.kind is SolverKind.FIELDSPLIT:
             petsc.pop(SCHUR_KEY, None)
-        return replace(self, petsc=petsc, rtol=rtol, schur=schur, geometric=geometric)
+        return replace(self, petsc=petsc, rtol=rtol, schur=schur, linear=linear)
 
 
 # Multipliers eliminated (D diagonal: NTS or dual mortar), CG on the SPD displacement system,
@@ -291,23 +401,14 @@ CONDENSED = SolverSpec(
     loose_rtol=1e-4,
     name="condensed",
     free_products=True,  # never reused: docs/scale.md, "Memory of the condensed path"
-    geometric=GEOMETRIC_MG,
+    multigrid=Multigrid.GEOMETRIC,
 )
 
 SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
     {
         "auto": SolverSpec(SolverKind.AUTO, MUMPS_LDLT, name="auto"),  # docs/scale.md
         "mumps": SolverSpec(SolverKind.DIRECT, MUMPS_LDLT, name="mumps"),
-        "mumps-lu": SolverSpec(SolverKind.DIRECT, MUMPS_LU, name="mumps-lu"),
-        # Opt-in: MUMPS' block low-rank LDL^T, every solve refined by GMRES to full-rank
-        # accuracy (docs/scale.md, "Block low-rank factorization").
-        "mumps-blr": SolverSpec(
-            SolverKind.DIRECT, MUMPS_LDLT, name="mumps-blr", low_rank=LowRank()
-        ),
-        # Opt-in (docs/scale.md, "The Schur route, measured"): MUMPS' Schur complement of
-        # every multiplier row, one factorization, each set a dense solve. Serial only: on
-        # several ranks the `mumps` path runs instead.
-        "mumps-schur": SolverSpec(SolverKind.DIRECT_SCHUR, MUMPS_LDLT, name="mumps-schur"),
+        "mumps-lu": SolverSpec(SolverKind.DIRECT, MUMPS_LU, name="mumps-lu", linear=Linear.LU),
         # Schur fieldsplit, A00 = K + gamma B^T B factorized by MUMPS, S by Jacobi-GMRES.
         "fieldsplit": SolverSpec(
             SolverKind.FIELDSPLIT,
@@ -356,23 +457,7 @@ SOLVERS: Mapping[str, SolverSpec] = MappingProxyType(
         ),
         "condensed": CONDENSED,
         # The same with GAMG on every mesh (the structured grid's levels unused).
-        "condensed-gamg": replace(CONDENSED, name="condensed-gamg", geometric=None),
-        # The same condensed system factorized: MUMPS Cholesky (SPD, SYM=1). Later sets run CG
-        # preconditioned by the kept factorization (a low-rank change: a few iterations)
-        # until the pivots have moved too far (linalg/condensed.py).
-        "condensed-direct": SolverSpec(
-            SolverKind.CONDENSED_DIRECT,
-            {
-                "ksp_type": "cg",
-                "ksp_norm_type": "unpreconditioned",
-                "ksp_max_it": 500,
-                "pc_type": "cholesky",
-                "pc_factor_mat_solver_type": "mumps",
-            },
-            rtol=1e-9,
-            loose_rtol=1e-4,
-            name="condensed-direct",
-        ),
+        "condensed-gamg": replace(CONDENSED, name="condensed-gamg", multigrid=Multigrid.GAMG),
     }
 )
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import NoReturn
+from typing import NoReturn, TypedDict, Unpack
 
 from .contact import Kernel
 from .errors import InputError
@@ -44,6 +44,20 @@ class SchwarzOptions:
     def __post_init__(self) -> None:
         if not 0.0 < self.relaxation <= 2.0:
             raise InputError(f"relaxation must lie in (0, 2] (got {self.relaxation})")
+
+
+class RequestOptions(TypedDict, total=False):
+    """The options of a request given by name (`SolveRequest.parse`, `contactfx.solve`)."""
+
+    enforcement: Enforcement | str | None
+    solver: SolverSpec | str
+    basis: Basis | str
+    predictor: Predictor | str
+    max_iterations: int
+    penalty: float | None
+    schwarz: SchwarzOptions | None
+    reference_timing: bool
+    available_mb: float | None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -80,19 +94,20 @@ class SolveRequest:
         if self.solver.kind is SolverKind.AUTO and self.enforcement is not Enforcement.MULTIPLIERS:
             # Penalty and Schwarz factorize with MUMPS: `auto` has nothing to choose there.
             object.__setattr__(self, "solver", direct_path(self.solver))
-        enf, kind = self.enforcement, self.solver.kind
+        enf = self.enforcement
         if self.available_mb is not None and not self.available_mb > 0:
             _refuse(f"the available memory must be positive (got {self.available_mb} MB)")
         if self.max_iterations < 1:
             _refuse(f"max_iterations must be at least 1 (got {self.max_iterations})")
         if self.basis is Basis.DUAL and self.method is not Method.MORTAR:
             _refuse("the dual multiplier basis applies to the mortar method only")
-        if enf is Enforcement.PENALTY and kind is not SolverKind.DIRECT:
+        factorizes = self.solver.traits.factorizes
+        if enf is Enforcement.PENALTY and not factorizes:
             _refuse(
                 "the penalty method has no multiplier block: it factorizes K + eps B^T W^-1 B "
                 f"(use --solver mumps or mumps-lu, not {self.solver.name})"
             )
-        if enf is Enforcement.SCHWARZ and kind is not SolverKind.DIRECT:
+        if enf is Enforcement.SCHWARZ and not factorizes:
             _refuse("schwarz factorizes each body with MUMPS: the solver option does not apply")
         if enf is Enforcement.SCHWARZ and self.discretization is not Discretization.MORTAR:
             _refuse("schwarz transfers through the mortar matrices: use the mortar discretization")
@@ -102,7 +117,11 @@ class SolveRequest:
             _refuse(f"the penalty parameter must be a positive number (got {self.penalty})")
         if self.schwarz is not None and enf is not Enforcement.SCHWARZ:
             _refuse("Schwarz controls apply to the schwarz enforcement only")
-        if kind.condensed and enf is Enforcement.MULTIPLIERS and not self.diagonal:
+        if (
+            self.solver.traits.needs_diagonal_d
+            and enf is Enforcement.MULTIPLIERS
+            and not self.diagonal
+        ):
             _refuse(
                 "the condensed solver needs a diagonal D: use --method nts or "
                 "--method mortar --basis dual"
@@ -110,53 +129,42 @@ class SolveRequest:
 
     @classmethod
     def parse(
-        cls,
-        method: Method | str = Method.MORTAR,
-        *,
-        enforcement: Enforcement | str | None = None,
-        solver: SolverSpec | str = DEFAULT_SOLVER,
-        basis: Basis | str = Basis.STANDARD,
-        predictor: Predictor | str = Predictor.AUTO,
-        max_iterations: int = DEFAULT_MAX_ITERATIONS,
-        penalty: float | None = None,
-        schwarz: SchwarzOptions | None = None,
-        reference_timing: bool = False,
-        available_mb: float | None = None,
+        cls, method: Method | str = Method.MORTAR, **options: Unpack[RequestOptions]
     ) -> SolveRequest:
         """The request named by strings (the CLI's and the Python API's).
 
         Args:
             method: nts, sts or mortar (a discretization), or penalty / schwarz (aliases of
                 mortar with that enforcement).
-            enforcement: multipliers, penalty or schwarz on a discretization named by
-                `method` (None: the method's own).
-            solver: A preset name of `SOLVERS` or a SolverSpec.
-            basis: standard or dual.
-            predictor: auto, coarse or none.
-            max_iterations: Limit of the active-set iterations.
-            penalty: The penalty's normal stiffness (None: the default).
-            schwarz: The Schwarz controls (None: the defaults).
-            reference_timing: Also time a fresh solve of the final system.
-            available_mb: The memory the `auto` solver may count on (None: MemAvailable).
+            options: `RequestOptions`, each defaulting to the request's own default:
+                enforcement (None: the method's own), solver (a preset name of `SOLVERS`
+                or a SolverSpec; DEFAULT_SOLVER), basis, predictor, max_iterations
+                (DEFAULT_MAX_ITERATIONS), penalty, schwarz, reference_timing and
+                available_mb (None: MemAvailable).
 
         Returns:
             The validated request (InputError naming the first rule it breaks).
         """
+        unknown = set(options) - set(RequestOptions.__annotations__)
+        if unknown:
+            _refuse(f"unknown solve option {sorted(unknown)[0]}")
         disc, own = Method.parse(method).pair
+        enforcement = options.get("enforcement")
         enf = own if enforcement is None else Enforcement.parse(enforcement)
         if own is not Enforcement.MULTIPLIERS and enf is not own:
             _refuse(f"--method {method} is {own.value} on {disc.value}: drop --enforcement")
+        penalty = options.get("penalty")
         return cls(
             discretization=disc,
             enforcement=enf,
-            basis=Basis.parse(basis),
-            predictor=Predictor.parse(predictor),
-            solver=solver_spec(solver),
-            max_iterations=max_iterations,
+            basis=Basis.parse(options.get("basis", Basis.STANDARD)),
+            predictor=Predictor.parse(options.get("predictor", Predictor.AUTO)),
+            solver=solver_spec(options.get("solver", DEFAULT_SOLVER)),
+            max_iterations=options.get("max_iterations", DEFAULT_MAX_ITERATIONS),
             penalty=None if penalty is None else float(penalty),
-            schwarz=schwarz,
-            reference_timing=reference_timing,
-            available_mb=available_mb,
+            schwarz=options.get("schwarz"),
+            reference_timing=options.get("reference_timing", False),
+            available_mb=options.get("available_mb"),
         )
 
     @property

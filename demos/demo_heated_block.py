@@ -39,7 +39,7 @@ import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "heated_block"
-SCENES = Path(__file__).resolve().parent / "scenes"
+MESHES = Path(__file__).resolve().parents[1] / "meshes"  # the scenes' gmsh geometry
 E, NU, ALPHA = 1000.0, 0.3, 1e-5
 METHODS = ["mortar", "sts", "nts", "penalty"]
 
@@ -52,7 +52,7 @@ def say(*args: object) -> None:
 def scene_text(dT: float, model: str) -> str:
     """The scene file for a temperature change dT in `model`."""
     return f'''model = "{model}"
-mesh = "{SCENES / "heated_block.geo"}"
+mesh = "{MESHES / "heated_block.geo"}"
 
 [bodies.block]
 E = {E}

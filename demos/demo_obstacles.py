@@ -7,7 +7,7 @@
 # works against it: `nts`, `sts`, `mortar` (standard or dual basis) and `penalty`.
 #
 # Two classic problems check it, each with only the elastic block meshed
-# (`demos/scenes/rigid_block.geo`: the block $[0, 20] \times [-20, 0]$, half model by
+# (`meshes/rigid_block.geo`: the block $[0, 20] \times [-20, 0]$, half model by
 # symmetry at $x = 0$, $E = 7000$, $\nu = 0.3$, plane strain):
 #
 # 1. **A rigid cylinder** ($R = 20$) pushed $0.05$ into the block: plane-strain Hertz with
@@ -46,6 +46,7 @@ import matplotlib.pyplot as plt
 comm = MPI.COMM_WORLD
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "obstacles"
 SCENES = Path(__file__).resolve().parent / "scenes"
+MESHES = Path(__file__).resolve().parents[1] / "meshes"  # the scenes' gmsh geometry
 METHODS = [
     ("nts", {}),
     ("sts", {}),
@@ -113,7 +114,7 @@ say(f"exact (E* = {h['E_star']:.2f}): a = {h['a_exact']:.4f}, p0 = {h['p0_exact'
 
 # +
 same = scene_from_gmsh(
-    SCENES / "rigid_block.geo",
+    MESHES / "rigid_block.geo",
     bodies={"block": {"E": 7000.0, "nu": 0.3}},
     dirichlet=[Dirichlet("symmetry", ux=0.0), Dirichlet("base", uy=0.0)],
     obstacles=[

@@ -34,7 +34,7 @@ import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "own_scene"
-TEMPLATE = Path(__file__).resolve().parent / "scenes" / "cylinder_between_blocks.geo"
+TEMPLATE = Path(__file__).resolve().parents[1] / "meshes" / "cylinder_between_blocks.geo"
 METHODS = ["nts", "sts", "mortar", "penalty"]
 
 
@@ -47,7 +47,7 @@ def say(*args: object) -> None:
 
 # ## The geometry: a `.geo` file
 #
-# The shipped `demos/scenes/cylinder_between_blocks.geo` is parametric (`DefineConstant`):
+# The shipped `meshes/cylinder_between_blocks.geo` is parametric (`DefineConstant`):
 # radius, block size, mesh size at the contacts. We write our own copy with the contact
 # sizes we want. What contactfx needs from a `.geo`: one physical surface per body, one
 # physical curve per contact surface, named groups for supports and loads, bodies built from

@@ -33,8 +33,6 @@ RELEASED_RTOL = 1e-8
 ROUNDOFF = 2.0
 # Refinement steps before giving up (each costs two back-substitutions).
 REFINEMENTS = 2
-# With approximate (block low-rank) factors each step gains about their accuracy.
-APPROX_REFINEMENTS = 8
 # Up to this many released rows numpy's gesv refactors the capacitance matrix for each solve
 # instead of keeping scipy.linalg's LU: a plain solve then never imports scipy.linalg, and a
 # refactorization costs less than the import up to here (docs/scale.md, "Time to the first
@@ -90,7 +88,6 @@ def released_solve(
     comm: MPI.Comm,
     first: np.ndarray | None,
     floor: float = 0.0,
-    target: float | None = None,
 ) -> tuple[int, float, int] | None:
     """Solve the new system (right-hand side `b_new`, set `active`) into x, or None.
 
@@ -98,8 +95,7 @@ def released_solve(
     system's residual and its relative norm; `responses(rows, local_mask)` the multiplier
     responses to unit shifts of the global `rows`; `first`, if given, the factorized set's
     own solution for these gaps (saves a back-substitution); `floor` the relative residual of
-    the factorization's own back-substitution; `target`, if given, the residual to reach
-    instead, in up to APPROX_REFINEMENTS steps (approximate factors). Returns
+    the factorization's own back-substitution. Returns
     (back-substitutions, relative residual, released rows), or None where the caller must
     refactor (a log line says why).
     """
@@ -111,8 +107,7 @@ def released_solve(
     b_new.copy(b)
     b.array[rows_l] = np.where(factored, -g, 0.0)
     applies = 1
-    steps = REFINEMENTS if target is None else APPROX_REFINEMENTS
-    target = max(RELEASED_RTOL, ROUNDOFF * floor) if target is None else target
+    target = max(RELEASED_RTOL, ROUNDOFF * floor)
     try:
         if first is not None:
             x.array[:] = first
@@ -126,7 +121,7 @@ def released_solve(
         apply(b, x)
         x.array[rows_r] = 0.0
         r, res = residual(x)
-        for _ in range(steps):
+        for _ in range(REFINEMENTS):
             if res <= target:
                 break
             # The correction solves the new system with the residual as right-hand side: the

@@ -36,7 +36,6 @@ from .elimination import (
 from .nullspace import orthonormalize
 from .petsc_options import PrefixedOptions, global_options, petsc_error_message, reason_name
 from .pivots import Pivots, pivots
-from .policy import Decision, FactorizationPolicy
 from .protocol import LoopTest, SaddleResult
 
 # Pivot changes since the multigrid was built (summed over ranks) below which it is reused,
@@ -79,8 +78,7 @@ class CondensedSolver:
 
     `node_dofs` (m, 2): global dofs of each owned row's active node. `rtol`: the final
     tolerance; `loose_rtol`: the relative reduction of the loop's solves.
-    `reuse` False: a throwaway solver (a new preconditioner for every set). `policy`: the
-    preconditioner is a factorization, kept while that is cheaper than a new one.
+    `reuse` False: a throwaway solver (a new preconditioner for every set).
     `free_products`: the preconditioner's setup frees its matrix products' intermediate data
     (PETSc's unprefixed mat_product_clear: GAMG's products carry no prefix).
     `interpolations`: a PCMG's prolongations, finest first (owned); None: GAMG's own.
@@ -98,7 +96,6 @@ class CondensedSolver:
         rtol: float,
         loose_rtol: float | None = None,
         reuse: bool = True,
-        policy: FactorizationPolicy | None = None,
         free_products: bool = False,
         interpolations: list[PETSc.Mat] | None = None,
     ) -> None:
@@ -120,8 +117,6 @@ class CondensedSolver:
         self.stats = {"factorizations": 0.0, "reused": 0.0, "setup_time": 0.0}
         self._built_for: np.ndarray | None = None  # the pivots the multigrid was built with
         self.reuse = reuse
-        # With a factorization as preconditioner: refactor by measured costs (policy.py).
-        self.policy = policy
         self._setup_options: dict[str, object] = (
             {"mat_product_clear": True} if free_products else {}
         )
@@ -228,9 +223,6 @@ class CondensedSolver:
             obj.destroy()
         if reuse:
             A.destroy()
-        elif self.policy is not None:
-            self.policy.factorized(t1 - t0, numeric_only=True)
-            self.policy.applied(t2 - t1, max(its, 1))
         self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
         return SaddleResult(u, mu, its, reason, not reuse, -1, 0, t1 - t0, t2 - t1, final=final)
@@ -258,8 +250,6 @@ class CondensedSolver:
         if not self.reuse or prev is None or self._interp:
             return False  # a geometric multigrid's setup costs a few CG iterations: rebuilt
         changed = self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
-        if self.policy is not None:
-            return self.policy.decide(changed, False, release=False) is Decision.LAGGED
         n_piv = self._mpi.allreduce(len(piv))
         return changed <= max(REBUILD_FRACTION * n_piv, REBUILD_CHANGES)
 

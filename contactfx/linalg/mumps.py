@@ -112,18 +112,6 @@ def analyze(F: PETSc.Mat, A: PETSc.Mat, cholesky: bool) -> MumpsEstimate | None:
     )
 
 
-def compressed(pc: PETSc.PC) -> bool:
-    """Whether the PC's factorization is MUMPS' block low-rank one with a nonzero threshold.
-
-    Read from the factor itself (ICNTL(35) in 1-3 and CNTL(7) > 0, however they were set):
-    its factors are approximate, so no single back-substitution with them is an answer.
-    """
-    if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
-        return False
-    F = pc.getFactorMatrix()
-    return F.getMumpsIcntl(35) in (1, 2, 3) and F.getMumpsCntl(7) > 0.0
-
-
 def _pattern(rows: np.ndarray, cols: np.ndarray, symmetric: bool) -> list[np.ndarray]:
     """The rows requested in each column: all of `rows`, or only half of the pairs in `cols`.
 
@@ -135,10 +123,6 @@ def _pattern(rows: np.ndarray, cols: np.ndarray, symmetric: bool) -> list[np.nda
     return [rows[~in_cols | (rows >= c)] for c in cols]
 
 
-INVERSE_BLOCK: int | None = None
-"""MUMPS ICNTL(27) while computing selected-inverse entries (restored afterwards); None:
-`inverse_block`'s rule (benchmarks/inverse_block.py sets it for its A/B)."""
-
 # Right-hand sides per block of the selected inverse, by the system's size: larger blocks
 # pay once the factors are large (PORD's sizes); measured in
 # docs/scale.md#measured-constants ("Selected-inverse block").
@@ -146,9 +130,10 @@ SMALL_BLOCK, LARGE_BLOCK, LARGE_FROM = 64, 256, 300_000
 
 
 def inverse_block(n: int) -> int:
-    """ICNTL(27) for the selected inverse of an n x n system (INVERSE_BLOCK if set)."""
-    if INVERSE_BLOCK is not None:
-        return INVERSE_BLOCK
+    """ICNTL(27) for the selected inverse of an n x n system (restored afterwards).
+
+    benchmarks/inverse_block.py replaces this rule for its A/B.
+    """
     return LARGE_BLOCK if n >= LARGE_FROM else SMALL_BLOCK
 
 

@@ -22,8 +22,8 @@ from petsc4py import PETSc
 
 from ..errors import SolverError
 from .blocks import SaddleBlocks
-from .capacitance import ROUNDOFF, released_solve
-from .mumps import MumpsEstimate, analyze_pc, compressed, petsc_library
+from .capacitance import released_solve
+from .mumps import MumpsEstimate, analyze_pc, petsc_library
 from .petsc_options import PrefixedOptions, petsc_error_message, reason_name
 from .policy import Decision, Factored, FactorizationPolicy
 from .protocol import LoopTest, SaddleResult
@@ -36,13 +36,6 @@ log = logging.getLogger("contactfx")
 # saddle points (docs/scale.md#measured-constants, "Back-substitution acceptance"). Above it
 # GMRES (rtol 1e-13) takes over from that solution.
 _APPLY_RTOL = 1e-7
-# Block low-rank factors (MUMPS ICNTL(35), CNTL(7) > 0) are approximate: 1e-7 is then no
-# test of accuracy (a compressed back-substitution passed it with the force balance off:
-# docs/scale.md). With them no single back-substitution is an answer: every solve is
-# GMRES to this rtol (its own estimate; the true residual then stops where a full-rank
-# back-substitution's does, at round-off), on a fresh or a lagged factorization
-# (docs/scale.md, "Block low-rank factorization").
-APPROX_RTOL = 1e-13
 # GMRES around the factorization: one iteration with a fresh one, a few with a lagged one
 # (the change is low-rank); right preconditioning tests the true residual, modified
 # Gram-Schmidt keeps the basis orthogonal down to round-off.
@@ -117,7 +110,6 @@ class SaddleSolver:
         self.factored = Factored()
         self._cache = ResponseCache()
         self._configured = False
-        self.approximate = False  # the factors are block low-rank (read after each setup)
 
     exact = True  # every solve is final: exact, or a fieldsplit Krylov solve to its rtol
 
@@ -187,11 +179,11 @@ class SaddleSolver:
                 return released
             decision = self.policy.decide(changed, subset, fresh, release=False)
         result = self._solve_factored(g, active, decision is Decision.REFACTOR, changed)
-        if result is None:  # the lagged (or compressed) factorization was not good enough
+        if result is None:  # the lagged factorization was not good enough
             log.info("saddle solver: GMRES on the factorization failed: refactoring")
             self.factored.active = None
             result = self._solve_factored(g, active, True, -1)
-            assert result is not None  # a fresh full-rank factorization raises instead
+            assert result is not None  # a fresh factorization raises instead
         return result
 
     def _solve_factored(
@@ -209,8 +201,6 @@ class SaddleSolver:
                 if refactor:
                     ksp.setUp()
                     self.factored.factorized(active)
-                    if self.direct:
-                        _check_compressed(self)
                 else:
                     self.stats["reused"] += 1
                 t1 = time.perf_counter()
@@ -218,9 +208,8 @@ class SaddleSolver:
                     m.x.set(0.0)
                 # A fresh factorization is applied once, as preonly would (GMRES's two
                 # iterations cost three back-substitutions); GMRES only if that is inexact.
-                # Approximate factors: GMRES from zero (its first iteration is that apply).
-                warm = refactor and self.policy.reuse and not self.approximate
-                single = warm and _apply_once(self)
+                warm = refactor and self.policy.reuse
+                single = warm and self._apply_once()
                 if not single:
                     ksp.setInitialGuessNonzero(warm)
                     ksp.solve(m.b, m.x)
@@ -241,15 +230,11 @@ class SaddleSolver:
         if not (reason > 0 and np.isfinite(m.x.norm())):
             if self.policy.reuse and not refactor:
                 return None
-            if refactor and _to_full_rank(self):
-                return None
             raise SolverError(
                 f"linear solve ({ksp.getType()}) did not converge: PETSc reason "
                 f"{reason} ({reason_name(reason)}) after {its} iterations"
             )
         if self.direct:
-            if refactor and self.approximate:  # the floor of later capacitance solves
-                self.factored.own_residual = _true_residual(m)
             self.factored.keep(active, g, m.x.array_r)
         u, mu = m.split()
         return SaddleResult(u, mu, its, reason, refactor, changed, 0, t1 - t0, t2 - t1)
@@ -286,8 +271,6 @@ class SaddleSolver:
             self._mpi,
             self.factored.solution_for(g),
             self.factored.own_residual,
-            # Approximate factors: to their fresh GMRES solve's round-off, not their own.
-            ROUNDOFF * self.factored.own_residual if self.approximate else None,
         )
         if done is None:
             return None
@@ -329,68 +312,23 @@ class SaddleSolver:
             self._cache.store(self.factored.count, probes, active, out, r0, self._mpi, rows)
         return out
 
+    def _apply_once(self) -> bool:
+        """One back-substitution with the fresh factorization into x; True if accurate."""
+        m = self._m
+        self._ksp.getPC().apply(m.b, m.x)
+        r, rel = m.residual(m.x)
+        r.destroy()
+        self.factored.own_residual = rel
+        return rel <= _APPLY_RTOL
 
-def _apply_once(solver: SaddleSolver) -> bool:
-    """One back-substitution with the fresh factorization into x; True if accurate.
+    def mumps_estimate(self) -> MumpsEstimate | None:
+        """MUMPS' analysis of the saddle point alone, before any factorization.
 
-    A function of this module: the class stays within its size.
-    """
-    m = solver._m
-    solver._ksp.getPC().apply(m.b, m.x)
-    r, rel = m.residual(m.x)
-    r.destroy()
-    solver.factored.own_residual = rel
-    return rel <= _APPLY_RTOL
-
-
-def _true_residual(m: SaddleBlocks) -> float:
-    """The relative residual of m.x."""
-    r, rel = m.residual(m.x)
-    r.destroy()
-    return rel
-
-
-def _to_full_rank(solver: SaddleSolver) -> bool:
-    """Compressed factors too coarse for GMRES: full rank (CNTL(7) = 0) from the next setup.
-
-    False if the factors were not compressed.
-    """
-    if not solver.approximate:
-        return False
-    solver._ksp.getPC().getFactorMatrix().setMumpsCntl(7, 0.0)
-    solver._m.A.assemble()  # a new state: the next setup refactors
-    return True
-
-
-def _check_compressed(solver: SaddleSolver) -> None:
-    """After a factorization: whether its factors are block low-rank (approximate).
-
-    Then a direct solver's preonly (a throwaway solver's; the loop's runs GMRES already) is
-    replaced by GMRES to APPROX_RTOL on the true residual, whatever set the factors up
-    (the typed low-rank choice or PETSc options given by hand).
-    """
-    ksp = solver._ksp
-    solver.approximate = compressed(ksp.getPC())
-    if not solver.approximate:
-        return
-    if ksp.getType() != "gmres":
-        ksp.setType("gmres")
-        ksp.setPCSide(cast(PETSc.PC.Side, PETSc.PC.Side.RIGHT))
-        # preonly's norm is none: GMRES must test the true residual.
-        ksp.setNormType(cast(PETSc.KSP.NormType, PETSc.KSP.NormType.UNPRECONDITIONED))
-        ksp.setGMRESRestart(_MAX_IT)
-    ksp.setTolerances(rtol=APPROX_RTOL, atol=0.0, max_it=_MAX_IT)
-    ksp.setUp()
-
-
-def mumps_estimate(solver: SaddleSolver) -> MumpsEstimate | None:
-    """MUMPS' analysis of the solver's saddle point alone, before any factorization.
-
-    Its memory estimate, or None (not a MUMPS factorization, or the analysis failed); the
-    solver's first factorization reuses the analysis (linalg/mumps.py: `analyze_pc`).
-    """
-    if not solver.direct:
-        return None
-    solver._configure()  # a function of this module: the class stays within its size
-    with solver._options.inserted():
-        return analyze_pc(solver._ksp.getPC(), solver._m.A)
+        Its memory estimate, or None (not a MUMPS factorization, or the analysis failed); the
+        first factorization reuses the analysis (linalg/mumps.py: `analyze_pc`).
+        """
+        if not self.direct:
+            return None
+        self._configure()
+        with self._options.inserted():
+            return analyze_pc(self._ksp.getPC(), self._m.A)

@@ -1,15 +1,22 @@
-"""Hertz scene (S5): quarter of a cylinder on an elastic block, half model by symmetry."""
-
-import math
+"""Hertz scene (S5): quarter of a cylinder on an elastic block, half model: meshes/hertz.geo."""
 
 import numpy as np
 
+from .geo_files import merge_geo
 from .size_field import apply_size_view, restore_options
 
-# Growth of the element size with distance from the refined zone (size per unit distance).
-# The elastic field decays like 1/r in 2D, so every decade of distance adds about the same
-# discretization error: the slope, not the far size, sets the error in the compliance.
+# Growth of the element size with distance from the refined zone (size per unit distance):
+# meshes/hertz.geo says why the slope sets the error.
 _SLOPE = 0.1
+# The mesh options meshes/hertz.geo sets.
+_OPTIONS = (
+    "Mesh.MeshSizeExtendFromBoundary",
+    "Mesh.MeshSizeFromPoints",
+    "Mesh.MeshSizeFromCurvature",
+    "Mesh.Algorithm",
+    "Mesh.RecombinationAlgorithm",
+    "Mesh.RecombineAll",
+)
 # gmsh element type of the 4-node quadrangle; anything else is a leftover triangle.
 QUAD4 = 3
 
@@ -28,6 +35,7 @@ def build_hertz(
 ) -> None:
     """Add the Hertz half model (quarter disc on a block) to the current gmsh model and mesh it.
 
+    The geometry and its size field are meshes/hertz.geo with these parameters.
     Size h_contact on both contact surfaces for x <= r_refine, h_edge at x_edge if `edge` =
     (x_edge, h_edge) (the contact edge: the pressure's square-root singularity), growing by
     `slope` per unit distance; or, `size_field` = (quads, sizes), sizes at the vertices of
@@ -44,87 +52,16 @@ def build_hertz(
     if not 0.0 < extent < min(width, R):
         raise ValueError(f"contact_extent={extent} must lie in (0, min(width, R))")
     h_far = max(h_far, h_contact)
-    # Plain floats: numpy scalars would print as np.float64(...) in the gmsh expression.
-    R, height, h_contact, r_refine, h_far, slope = map(
-        float, (R, height, h_contact, r_refine, h_far, slope)
-    )
-    edge = None if edge is None else (float(edge[0]), float(edge[1]))
-    yc = height + R
-    geo = gmsh.model.geo
-    # Block: the top is split at the end of the contact zone.
-    b00 = geo.addPoint(0.0, 0.0, 0.0)
-    b10 = geo.addPoint(width, 0.0, 0.0)
-    b11 = geo.addPoint(width, height, 0.0)
-    bce = geo.addPoint(extent, height, 0.0)
-    b01 = geo.addPoint(0.0, height, 0.0)
-    support = geo.addLine(b00, b10)
-    b_right = geo.addLine(b10, b11)
-    b_top_free = geo.addLine(b11, bce)
-    contact1 = geo.addLine(bce, b01)
-    b_sym = geo.addLine(b01, b00)
-    block = geo.addPlaneSurface([geo.addCurveLoop([support, b_right, b_top_free, contact1, b_sym])])
-
-    # Quarter disc from its own points (same location as b01, distinct tag): the bodies
-    # must not share nodes, contact needs duplicated interface nodes.
-    centre = geo.addPoint(0.0, yc, 0.0)
-    d_bot = geo.addPoint(0.0, height, 0.0)
-    d_ce = geo.addPoint(extent, yc - math.sqrt(R * R - extent * extent), 0.0)
-    d_right = geo.addPoint(R, yc, 0.0)
-    contact2 = geo.addCircleArc(d_bot, centre, d_ce)
-    arc_free = geo.addCircleArc(d_ce, centre, d_right)
-    load = geo.addLine(d_right, centre)
-    d_sym = geo.addLine(centre, d_bot)
-    disc = geo.addPlaneSurface([geo.addCurveLoop([contact2, arc_free, load, d_sym])])
-    geo.synchronize()
-
-    # The size grows linearly (at `slope`) with the distance from the part of the contact
-    # surfaces with x <= r_refine: fine where the pressure lives, coarse a few elements
-    # deeper. Each body's distance is to its own surface (the line y = height, the arc);
-    # the smaller of the two is the right one on both sides of the interface.
-    d_line = f"Abs(y - {height!r})"
-    d_arc = f"Abs({R!r} - Sqrt(x^2 + (y - {yc!r})^2))"
-    dist = f"Sqrt(Max(x - {r_refine!r}, 0)^2 + Min({d_line}, {d_arc})^2)"
-    size = f"{h_contact!r} + {slope!r} * {dist}"
-    if edge is not None:
-        xe, he = edge
-        de = f"Sqrt((x - {xe!r})^2 + Min({d_line}, {d_arc})^2)"
-        size = f"Min({size}, {he!r} + {slope!r} * {de})"
-    size_saved = {}
-    if size_field is None:
-        field = gmsh.model.mesh.field.add("MathEval")
-        gmsh.model.mesh.field.setString(field, "F", f"Min({h_far!r}, {size})")
-        gmsh.model.mesh.field.setAsBackgroundMesh(field)
-    else:
-        size_saved = apply_size_view(*size_field)
-    # The field alone sets the size: point sizes and curvature would override it.
-    options = {
-        "Mesh.MeshSizeExtendFromBoundary": 0,
-        "Mesh.MeshSizeFromPoints": 0,
-        "Mesh.MeshSizeFromCurvature": 0,
-        # Frontal-Delaunay for quads + Blossom full-quad recombination: no triangle left.
-        "Mesh.Algorithm": 8,
-        "Mesh.RecombinationAlgorithm": 3,
-        "Mesh.RecombineAll": 1,
-    }
-    # Options are global to the gmsh session: restore them so later models are unaffected.
-    saved = {name: gmsh.option.getNumber(name) for name in options}
-    for name, value in options.items():
-        gmsh.option.setNumber(name, value)
-    for surf in (block, disc):
-        gmsh.model.mesh.setRecombine(2, surf)
-
-    groups = [
-        (2, [block], "body1"),
-        (2, [disc], "body2"),
-        (1, [contact1], "contact1"),
-        (1, [contact2], "contact2"),
-        (1, [b_sym, d_sym], "symmetry"),
-        (1, [support], "support"),
-        (1, [load], "load"),
-    ]
-    for dim, tags, name in groups:
-        gmsh.model.addPhysicalGroup(dim, tags, name=name)
+    # The options the file sets are global to the gmsh session: restored after meshing.
+    saved = {name: gmsh.option.getNumber(name) for name in _OPTIONS}
+    size_saved: dict[str, float] = {}
     try:
+        numbers = dict(R=R, width=width, height=height, h_contact=h_contact, r_refine=r_refine)
+        sizes = dict(h_far=h_far, extent=extent, slope=slope)
+        at_edge = {} if edge is None else dict(edge=1, x_edge=edge[0], h_edge=edge[1])
+        merge_geo("hertz.geo", **numbers, **sizes, **at_edge, user_sizes=size_field is not None)
+        if size_field is not None:
+            size_saved = apply_size_view(*size_field)
         gmsh.model.mesh.generate(2)
     finally:
         for name, value in saved.items():

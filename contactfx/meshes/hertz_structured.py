@@ -240,7 +240,7 @@ class GridPart(NamedTuple):
 
 
 def _strip(n: int, part: int, nparts: int) -> np.ndarray:
-    # Item k goes to part (k nparts) // n: the equal-count strips of scenes/partition.py.
+    # Item k goes to part (k nparts) // n: the equal-count strips of scenes/gmsh_io.py.
     return np.arange(-(-part * n // nparts), -(-(part + 1) * n // nparts))
 
 
@@ -266,7 +266,7 @@ def hertz_grid_part(
     """Part `part` of `nparts` of `hertz_grid`'s mesh, made without the rest of the grid.
 
     The cells of each body are cut into `nparts` equal-count strips by cell midpoint x (then
-    y), the very strips `scenes/partition.body_strips` gives. Each part makes its cells and
+    y), the very strips `scenes.gmsh_io.body_strips` gives. Each part makes its cells and
     the coordinates of one block of nodes; it holds the block's cells and nodes of its own
     only, the disc's nodes whole (to cut the disc by x). With `nparts == 1`, `hertz_grid`'s
     arrays.

@@ -1,7 +1,7 @@
 """The default solver `auto`: MUMPS' factorization unless MUMPS says it would not fit.
 
 Before any factorization MUMPS' analysis alone runs on the loop's own saddle-point solver
-(linalg/saddle.py: `mumps_estimate`) and gives the memory its factorization will allocate.
+(`SaddleSolver.mumps_estimate`) and gives the memory its factorization will allocate.
 On each node the ranks' estimates add up against the memory available there; with room (the
 SAFETY factor) the direct path runs and its first factorization reuses that analysis, else
 the condensed path runs (multipliers eliminated, CG + GAMG) where D is diagonal, and
@@ -22,7 +22,7 @@ from ..discretize.mesh_utils import scene_dofs
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import InputError
 from ..linalg import LinearSolver
-from ..linalg.saddle import SaddleSolver, mumps_estimate
+from ..linalg.saddle import SaddleSolver
 from ..options import SOLVERS, SolverKind
 from ..request import SolveRequest, direct_path
 from ..scenes import Scene
@@ -107,7 +107,7 @@ def _coarse_bound(
         try:
             linear = setup_solver(csetup, direct, coarse, reuse=True)
             try:
-                est = mumps_estimate(linear) if isinstance(linear, SaddleSolver) else None
+                est = linear.mumps_estimate() if isinstance(linear, SaddleSolver) else None
             finally:
                 linear.destroy()
         finally:
@@ -123,7 +123,7 @@ def _coarse_bound(
     assert needed is not None and avail is not None and est is not None
     ran = CONDENSED if choice is Choice.CONDENSED else direct.name
     record = SolverChoice(ran, needed, avail, est.seconds, coarse_dofs=coarse_dofs)
-    return _condensed(setup, scene, request, record)
+    return _condensed(setup, scene.comm, request, record)
 
 
 def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: Timers) -> Prepared:
@@ -132,7 +132,7 @@ def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: T
     linear = setup_solver(setup, direct.solver, scene, reuse=True)
     try:
         with timers("solve"):
-            estimate = mumps_estimate(linear) if isinstance(linear, SaddleSolver) else None
+            estimate = linear.mumps_estimate() if isinstance(linear, SaddleSolver) else None
         needed, avail = node_budget(
             scene.comm, None if estimate is None else estimate.rank_mb, request.available_mb
         )
@@ -148,14 +148,11 @@ def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: T
     linear.destroy()  # frees MUMPS' analysis before the other path runs
     assert needed is not None and avail is not None  # a known estimate that does not fit
     ran = CONDENSED if choice is Choice.CONDENSED else direct.solver.name
-    return _condensed(setup, scene, request, SolverChoice(ran, needed, avail, seconds))
+    return _condensed(setup, scene.comm, request, SolverChoice(ran, needed, avail, seconds))
 
 
 def _condensed(
-    setup: ContactSetup,
-    scene: Scene,
-    request: SolveRequest,
-    record: SolverChoice,
+    setup: ContactSetup, comm: MPI.Comm, request: SolveRequest, record: SolverChoice
 ) -> Prepared:
     """The condensed path where MUMPS does not fit; a one-line refusal where D is not diagonal."""
     if record.ran != CONDENSED:
@@ -167,8 +164,8 @@ def _condensed(
             f"(margin x{SAFETY:g}); use --method mortar --basis dual (or nts) for the "
             "condensed path, or fewer DOFs"
         )
-    _say(record, scene.comm)
-    if request.solver.petsc != SOLVERS["auto"].petsc and scene.comm.rank == 0:
+    _say(record, comm)
+    if request.solver.petsc != SOLVERS["auto"].petsc and comm.rank == 0:
         log.info("solver: the --petsc-option values were for MUMPS: not applied")
     return Prepared(setup, replace(request, solver=SOLVERS[CONDENSED]), None, record)
 
@@ -180,10 +177,10 @@ def warn_if_too_big(
 
     The analysis is the one its first factorization reuses (no cost beyond a collective).
     """
-    if request.solver.kind is not SolverKind.DIRECT or not isinstance(linear, SaddleSolver):
+    if not request.solver.traits.factorizes or not isinstance(linear, SaddleSolver):
         return
     with timers("solve"):
-        estimate = mumps_estimate(linear)
+        estimate = linear.mumps_estimate()
     rank_mb = None if estimate is None else estimate.rank_mb
     needed, avail = node_budget(scene.comm, rank_mb, request.available_mb)
     if choose(needed, avail, True) is not Choice.DIRECT and scene.comm.rank == 0:

@@ -21,7 +21,7 @@ from mpi4py import MPI
 from ..discretize.setup import ContactSetup
 from ..errors import EliminationError, InputError
 from ..linalg import LinearSolver, SaddleResult
-from ..options import SolverKind, SolverSpec
+from ..options import Linear, SolverKind, SolverSpec
 from ..request import SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
@@ -35,7 +35,7 @@ from .active_set import (
 )
 from .autosolve import Prepared, prepare_solver, warn_if_too_big
 from .solution import Solution, finish
-from .solvers import BLR_KEYS, setup_solver
+from .solvers import setup_solver
 
 log = logging.getLogger("contactfx")
 
@@ -255,14 +255,12 @@ def _timed_fresh_solve(
 
 
 def floor_spec(spec: SolverSpec, pc: str) -> SolverSpec:
-    """The plain direct factorization (`pc`: lu or cholesky) with the spec's other options.
-
-    Full rank always: a floor is an exact factorization, whatever the spec compresses (its
-    low-rank choice, or MUMPS' BLR keys given as PETSc options).
-    """
-    petsc = {**{k: v for k, v in spec.petsc.items() if k not in BLR_KEYS}, "pc_type": pc}
-    name = f"{spec.name}:{pc}"
-    return replace(spec, kind=SolverKind.DIRECT, petsc=petsc, name=name, low_rank=None)
+    """The plain direct factorization (`pc`: lu or cholesky) with the spec's other options."""
+    linear = Linear.LU if pc == "lu" else Linear.LDLT
+    petsc = {**spec.petsc, "pc_type": pc}
+    return replace(
+        spec, kind=SolverKind.DIRECT, petsc=petsc, name=f"{spec.name}:{pc}", linear=linear
+    )
 
 
 def reference_solve(
@@ -276,8 +274,8 @@ def reference_solve(
     """
     res, seconds = _timed_fresh_solve(setup, spec, scene, active)
     timers.seconds["reference_solve"] = seconds
-    if spec.kind.factorizes_saddle:
-        # The plain factorizations (a Schur-complement solver's floor too).
+    if spec.traits.factorizes:
+        # The plain factorizations.
         for key, pc in (("reference_lu", "lu"), ("reference_ldlt", "cholesky")):
             floor = floor_spec(spec, pc)
             same = floor == replace(spec, name=floor.name)

@@ -17,7 +17,7 @@ from ..contact.zone import covered, edge_distances
 from ..discretize.mesh_utils import owned_facets, scene_dofs
 from ..errors import InputError, MeshError
 from ..logs import stage
-from ..options import SOLVERS, Predictor, SolverKind, SolverSpec
+from ..options import SOLVERS, CoarseStart, Predictor, SolverSpec, System
 from ..request import SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
@@ -27,19 +27,11 @@ from .solution import Solution
 
 log = logging.getLogger("contactfx")
 
-# Above this many DOFs, "auto" starts from a coarser solve (direct solvers on several ranks,
-# fieldsplit): one factorization then suffices.
+# Above this many DOFs, "auto" starts from a coarser solve where the kind says so
+# (CoarseStart.DOFS: fieldsplit): one factorization then suffices.
 COARSE_PREDICTOR_DOFS = 200_000
-# Mesh sizes of the coarse solve relative to the fine one (1/64 of the DOFs): its zone edge
-# is good to a coarse element, which the band probes cover.
+# The least coarsening of a user's scene that gmsh cannot mesh at the kind's factor.
 COARSE_FACTOR = 8.0
-# A direct solver probes the fine band (selected inverse entries): a band twice as wide costs
-# it less than the coarse solve saves at x16 (docs/scale.md#measured-constants, "Coarse
-# factor").
-DIRECT_COARSE_FACTOR = 16.0
-# The condensed loop pays a whole solve per ring of nodes it adds or releases: a sharper
-# prediction (1/16 of the DOFs) pays for itself.
-CONDENSED_COARSE_FACTOR = 4.0
 # The condensed first set reaches this many fine elements past each estimated zone edge
 # (issue 33: fitted on the cases of docs/scale.md, "An exact first set").
 EDGE_MARGIN = 0.17
@@ -64,49 +56,48 @@ def contact_facets(scene: Scene) -> int:
 def use_coarse(predictor: Predictor, scene: Scene, spec: SolverSpec) -> bool:
     """Whether `predictor` asks for a coarse solve of `scene` with this solver.
 
-    auto: for direct solves when the active surfaces hold more than PROBE_ALL_ROWS rows and
-    the scene can be remeshed (else every row is probed), always for the condensed solver
-    (no probes at all), above COARSE_PREDICTOR_DOFS otherwise.
+    auto: as the kind's `coarse_start` says: ROWS (a factorization) when the active surfaces
+    hold more than PROBE_ALL_ROWS rows and the scene can be remeshed (else every row is
+    probed), ALWAYS (the condensed loop has no probes), DOFS from COARSE_PREDICTOR_DOFS.
     """
-    if predictor is Predictor.AUTO:
-        if spec.kind is SolverKind.DIRECT_SCHUR and scene.comm.size == 1:
-            return False  # every row's responses come from the dense Schur block
-        if spec.kind.factorizes_saddle:
-            return scene.can_remesh and contact_facets(scene) > PROBE_ALL_ROWS
-        if spec.kind.condensed:
-            return True
-        return scene_dofs(scene) >= COARSE_PREDICTOR_DOFS
-    return predictor is Predictor.COARSE
+    if predictor is not Predictor.AUTO:
+        return predictor is Predictor.COARSE
+    start = spec.traits.coarse_start
+    if start is CoarseStart.ROWS:
+        return scene.can_remesh and contact_facets(scene) > PROBE_ALL_ROWS
+    if start is CoarseStart.ALWAYS:
+        return True
+    return scene_dofs(scene) >= COARSE_PREDICTOR_DOFS
 
 
 # The condensed loop runs unprobed: on its coarse mesh too it adds a ring of nodes, then
 # releases a few per step, each step CG with a lagged multigrid, which is slow
 # (docs/scale.md#measured-constants, "Direct predictor"). The coarse set is only a guess, so
-# it is solved by the direct default (one factorization, all rows probed) up to this many
-# coarse DOFs.
+# it is solved by the kind's `coarse_solver` (the direct default: one factorization, all
+# rows probed) up to this many coarse DOFs.
 DIRECT_PREDICTOR_DOFS = 2_000_000
 
 
-def predictor_solver(spec: SolverSpec, coarse: Scene) -> SolverSpec:
-    """The solver of the coarse solve: the direct default for the condensed kinds."""
-    if spec.kind.condensed and scene_dofs(coarse) <= DIRECT_PREDICTOR_DOFS:
-        return SOLVERS["mumps"]
+def predictor_solver(spec: SolverSpec, coarse_dofs: int) -> SolverSpec:
+    """The solver of the coarse solve: the kind's `coarse_solver` up to DIRECT_PREDICTOR_DOFS."""
+    name = spec.traits.coarse_solver
+    if name is not None and coarse_dofs <= DIRECT_PREDICTOR_DOFS:
+        return SOLVERS[name]
     return spec
 
 
 def coarse_factor(spec: SolverSpec, scene: Scene) -> float:
     """How much coarser the predictor's mesh is (every size times this; collective).
 
-    Direct solvers: DIRECT_COARSE_FACTOR, doubled until the coarse rows (about the fine ones
-    over the factor: the surfaces are curves) are at most COARSE_ROWS, since the coarse solve
-    probes them all; a wider fine band costs its probes little
-    (docs/scale.md#measured-constants, "Coarse factor"). Others: COARSE_FACTOR.
+    The kind's `coarse_factor`; a factorization's is doubled until the coarse rows (about
+    the fine ones over the factor: the surfaces are curves) are at most COARSE_ROWS, since
+    the coarse solve probes them all; a wider fine band costs its probes little
+    (docs/scale.md#measured-constants, "Coarse factor").
     """
-    if spec.kind.condensed:
-        return CONDENSED_COARSE_FACTOR
-    if not spec.kind.factorizes_saddle:
-        return COARSE_FACTOR
-    factor = DIRECT_COARSE_FACTOR
+    traits = spec.traits
+    factor = traits.coarse_factor
+    if not traits.factorizes:
+        return factor
     rows = contact_facets(scene)
     while rows / factor > COARSE_ROWS:
         factor *= 2.0
@@ -114,12 +105,12 @@ def coarse_factor(spec: SolverSpec, scene: Scene) -> float:
 
 
 def coarse_margin(spec: SolverSpec) -> float:
-    """Coarse elements of margin around the coarse zone.
+    """Coarse elements of margin around the coarse zone (the kind's `coarse_margin`).
 
     A direct solver probes the uncertain band, so a generous superset costs it nothing; the
     condensed loop pays a solve per ring it must release (docs/scale.md, "Coarse predictor").
     """
-    return 0.5 if spec.kind.condensed else 1.5
+    return spec.traits.coarse_margin
 
 
 def _coarse_radius(coarse: Solution, margin: float) -> float:
@@ -210,8 +201,8 @@ def sharp_initial_set(
 
 
 def initial_set(coarse: Solution, spec: SolverSpec, factor: float) -> InitialSet:
-    """The first set from the coarse solution: sharp for the condensed kinds (no probes)."""
-    if spec.kind.condensed:
+    """The first set from the coarse solution: sharp for the condensed system (no probes)."""
+    if spec.system is System.CONDENSED:
         return sharp_initial_set(coarse, factor, coarse_margin(spec))
     return coarse_initial_set(coarse, margin=coarse_margin(spec))
 
@@ -235,7 +226,7 @@ def predict(
     with timers("predictor"), stage("predictor"):
         coarse, factor = _remeshed(scene, coarse_factor(spec, scene))
         coarse_request = replace(
-            request, solver=predictor_solver(spec, coarse), reference_timing=False
+            request, solver=predictor_solver(spec, scene_dofs(coarse)), reference_timing=False
         )
         sol = solve_contact(coarse, coarse_request, aso=aso, label="predictor")
         return initial_set(sol, spec, factor)

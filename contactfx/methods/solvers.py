@@ -5,6 +5,7 @@ The methods turn a SolverSpec into a solver here; contactfx/linalg itself knows 
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Mapping
 from functools import partial
 
@@ -19,10 +20,12 @@ from ..linalg.nullspace import near_nullspace
 from ..linalg.policy import FactorizationPolicy
 from ..linalg.protocol import LinearSolver
 from ..linalg.saddle import SaddleSolver
-from ..linalg.schur import SchurSolver, schur_available
-from ..options import LowRank, SchurPre, SolverKind, SolverSpec
+from ..option_sets import GAMG, GEOMETRIC_MG
+from ..options import Multigrid, SchurPre, SolverKind, SolverSpec, System
 from ..request import direct_path
 from ..scenes import Scene
+
+log = logging.getLogger("contactfx")
 
 # MUMPS' analysis on several ranks: sequential (ICNTL(28) = 1), with the ordering below on
 # the host; parallel analysis with PT-Scotch orders worse on these meshes
@@ -55,31 +58,9 @@ def with_ordering(petsc: Mapping[str, object], ndofs: int) -> Mapping[str, objec
     return {**petsc, ORDERING_KEY: AMD if ndofs < PORD_FROM_DOFS else PORD}
 
 
-BLR_KEYS = ("mat_mumps_icntl_35", "mat_mumps_cntl_7")
-
-
-def with_low_rank(
-    petsc: Mapping[str, object], low_rank: LowRank | None, ndofs: int
-) -> Mapping[str, object]:
-    """A MUMPS factorization's options with the spec's block low-rank choice for `ndofs`.
-
-    Options that name ICNTL(35) or CNTL(7) themselves are left as they are (the solver reads
-    the factor's own settings: linalg/mumps.py `compressed`).
-    """
-    if (
-        low_rank is None
-        or ndofs < low_rank.from_dofs
-        or petsc.get("pc_factor_mat_solver_type") != "mumps"
-        or any(k in petsc for k in BLR_KEYS)
-    ):
-        return petsc
-    return {**petsc, BLR_KEYS[0]: low_rank.variant, BLR_KEYS[1]: low_rank.tolerance}
-
-
 def direct_options(spec: SolverSpec, K: PETSc.Mat) -> Mapping[str, object]:
-    """A direct saddle-point solver's options: ordering, low rank, on several ranks analysis."""
-    n = K.getSize()[0]
-    petsc = with_low_rank(with_ordering(spec.petsc, n), spec.low_rank, n)
+    """A direct saddle-point solver's options: ordering, on several ranks the analysis."""
+    petsc = with_ordering(spec.petsc, K.getSize()[0])
     return with_sequential_analysis(petsc, K.getComm().tompi4py().size)
 
 
@@ -92,6 +73,23 @@ def reuses_interpolation(petsc: Mapping[str, object]) -> bool:
     """Whether the options ask GAMG to reuse its interpolation (PETSc's reading of a bool)."""
     value = petsc.get(REUSE_INTERPOLATION, False)
     return str(value).strip().lower() not in ("0", "false", "no", "off")
+
+
+def geometric_options(petsc: Mapping[str, object]) -> dict[str, object]:
+    """A geometric multigrid's options: GEOMETRIC_MG with the spec's own changes to GAMG's set.
+
+    The keys a user gave (--petsc-option) that the GAMG set lacks or sets otherwise, except
+    GAMG's own (pc_type, pc_gamg_*): e.g. the smoother's steps apply to both multigrids.
+    """
+    own = {
+        k: v
+        for k, v in petsc.items()
+        if GAMG.get(k, _MISSING) != v and not k.startswith(("pc_type", "pc_gamg"))
+    }
+    return {**GEOMETRIC_MG, **own}
+
+
+_MISSING = object()
 
 
 def augmentation(spec: SolverSpec, e_max: float, h: float) -> float:
@@ -118,43 +116,39 @@ def make_solver(
     displacements); `node_dofs` (m, 2): the dofs of each multiplier row's active node (the
     condensed solver's pivots); `reuse` False: a throwaway solver for one set; `grid()`: the
     prolongations of the scene's coarser grids, if it has them (a condensed spec with
-    `geometric` options then runs a geometric multigrid). An `auto` spec must be resolved
+    `Multigrid.GEOMETRIC` then runs a geometric multigrid). An `auto` spec must be resolved
     first (methods/autosolve.py); here it is its direct path.
     """
     spec = direct_path(spec)
-    if spec.kind.condensed:
+    traits = spec.traits
+    if traits.system is System.CONDENSED:
         from ..linalg.condensed import CondensedSolver  # not on the direct path: docs/scale.md
 
-        factorized = spec.kind is SolverKind.CONDENSED_DIRECT
-        levels = grid() if grid is not None and spec.geometric is not None else None
+        geometric = spec.multigrid is Multigrid.GEOMETRIC
+        levels = grid() if grid is not None and geometric else None
+        if reuse and K.getComm().tompi4py().rank == 0:
+            how = f"geometric, {len(levels)} coarser levels" if levels else "GAMG (algebraic)"
+            log.info("multigrid: %s", how)
         return CondensedSolver(
             K,
             B,
             f,
-            spec.geometric
-            if levels and spec.geometric
-            else with_ordering(spec.petsc, K.getSize()[0]),
+            geometric_options(spec.petsc) if levels else with_ordering(spec.petsc, K.getSize()[0]),
             node_dofs,
-            [] if factorized or levels else modes(),
+            [] if levels or not traits.rigid_modes else modes(),
             rtol=spec.rtol,
             loose_rtol=spec.loose_rtol,
             reuse=reuse,
-            # A kept Cholesky factorization pays per CG iteration (one back-substitution):
-            # the cost rule of the saddle-point solver decides when to refactor.
-            policy=FactorizationPolicy(reuse) if factorized else None,
             free_products=spec.free_products and not reuses_interpolation(spec.petsc),
             interpolations=levels,
         )
-    direct = spec.kind.factorizes_saddle
-    if spec.kind is SolverKind.DIRECT_SCHUR and schur_available(K.getComm()):
-        # gamma as the fieldsplit's: K + gamma B^T B scales as K; the whole loop on one factor.
-        return SchurSolver(K, B, f, with_ordering(spec.petsc, K.getSize()[0]), e_max / h**2)
     nullspace = None
-    if spec.augmented:
+    if traits.rigid_modes:
         vectors = modes()
         nullspace = near_nullspace(vectors)
         for v in vectors:
             v.destroy()
+    direct = traits.factorizes
     return SaddleSolver(
         K,
         B,

@@ -12,7 +12,7 @@ from .builtin import (
     hertz_exact,
     validate,
 )
-from .gmsh_io import GeoRecipe, SceneParts, from_gmsh
+from .gmsh_io import GeoRecipe, SceneParts, scene_from_gmsh
 from .model import (
     Body,
     ContactPair,
@@ -63,10 +63,10 @@ __all__ = [
     "Units",
     "blocks",
     "build_scene",
-    "from_gmsh",
     "hertz",
     "hertz_exact",
     "load_scene_file",
     "parse_scene_file",
+    "scene_from_gmsh",
     "validate",
 ]

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from dolfinx.cpp.mesh import cell_num_vertices
 from dolfinx.graph import adjacencylist
 from dolfinx.io.gmsh import MeshData, model_to_mesh
 from mpi4py import MPI
@@ -35,7 +36,6 @@ from .model import (
     SizeField,
     Units,
 )
-from .partition import body_strips, cell_arrays
 
 
 def _gmsh_node_coordinates() -> np.ndarray:
@@ -53,6 +53,37 @@ def node_coordinates(tags: np.ndarray, xyz: np.ndarray) -> np.ndarray:
     x = np.zeros((int(tags.max()) if len(tags) else 0, 3))
     x[tags.astype(np.int64) - 1] = xyz.reshape(-1, 3)
     return x
+
+
+# -- cell partitions: equal-count strips per body, or every cell kept where it was made ------
+# The strips spread every body over all ranks (gmsh scenes); the structured Hertz grid is
+# generated on every rank already cut so (`meshes.hertz_grid_part`) and stays.
+
+
+def body_strips(dest: np.ndarray, cell_label: np.ndarray, mid: np.ndarray, nparts: int) -> None:
+    """Within each body (`cell_label`), equal-count strips by midpoint x (then y), into `dest`.
+
+    The contact line of each body is spread over all ranks, and the strips of the bodies
+    overlap.
+    """
+    for label in np.unique(cell_label):
+        ids = np.flatnonzero(cell_label == label)
+        order = ids[np.lexsort((mid[ids, 1], mid[ids, 0]))]
+        dest[order] = (np.arange(len(order)) * nparts) // len(order)
+
+
+def cell_arrays(cell_types: list[Any], cells: list[Any]) -> list[np.ndarray]:
+    """A partitioner's flat cell lists as (cells, vertices) int64 arrays, one per cell type."""
+    return [
+        np.asarray(c, dtype=np.int64).reshape(-1, cell_num_vertices(ct))
+        for ct, c in zip(cell_types, cells, strict=True)
+    ]
+
+
+def stay_on_rank(comm: MPI.Comm, nparts: int, cell_types: list[Any], cells: list[Any]) -> Any:
+    """Every cell stays on the rank that passed it to create_mesh (input made distributed)."""
+    num_cells = sum(len(c) for c in cell_arrays(cell_types, cells))
+    return adjacencylist(np.full(num_cells, comm.rank, dtype=np.int32))._cpp_object
 
 
 def balanced_partitioner(coordinates: np.ndarray | None = None) -> Callable[..., Any]:
@@ -267,12 +298,12 @@ class GeoRecipe:
 
     def build(self, comm: MPI.Comm) -> Scene:
         """Mesh the .geo and return the checked Scene."""
-        return scene_from_gmsh(
+        return scene_from_parts(
             self.path, self.parts, comm, self.size_factor, self.params, self.size_field
         )
 
 
-def scene_from_gmsh(
+def scene_from_parts(
     model_or_path: Any,
     parts: SceneParts,
     comm: MPI.Comm,
@@ -280,7 +311,10 @@ def scene_from_gmsh(
     params: Mapping[str, Any] | None = None,
     size_field: SizeField | None = None,
 ) -> Scene:
-    """Load the mesh, build the Scene and check it against the mesh's groups."""
+    """The checked Scene of `parts` on the mesh of `model_or_path` (see `scene_from_gmsh`).
+
+    Scene files (scene_file.py) and GeoRecipe.build come here with their parts made.
+    """
     for body, mat in parts.bodies.items():
         mat.check(f"body '{body}'")
     data = load_meshdata(model_or_path, comm, size_factor, size_field)
@@ -334,7 +368,7 @@ def _material(name: str, values: object) -> Material:
     return Material(float(values["E"]), float(values["nu"]), **thermal)
 
 
-def from_gmsh(
+def scene_from_gmsh(
     model_or_path: Any,
     *,
     bodies: Mapping[str, Material | Mapping[str, float]],
@@ -386,4 +420,4 @@ def from_gmsh(
         tuple(obstacles or ()),
         Model.parse(model),
     )
-    return scene_from_gmsh(model_or_path, parts, comm)
+    return scene_from_parts(model_or_path, parts, comm)

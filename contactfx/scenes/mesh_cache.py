@@ -30,6 +30,7 @@ from dolfinx.io.gmsh import MeshData
 from mpi4py import MPI
 
 from ..logs import log
+from ..meshes.geo_files import geo_path
 from .gmsh_io import balanced_partitioner, mesh_from_model, node_coordinates, to_dolfinx
 
 _NODES = "mesh.getNodes()"  # the call whose answer also gives the partitioner's coordinates
@@ -91,9 +92,12 @@ def _plain(v: object) -> bool:
 def _code_versions() -> str:
     """The mesh code's source and the versions of what turns it into a mesh."""
     root = Path(__file__).resolve().parents[1]
-    files = sorted((root / "meshes").glob("*.py")) + [
-        root / "scenes" / n for n in ("gmsh_io.py", "gmsh_checks.py", "mesh_cache.py")
-    ]
+    geo = [geo_path(f"{name}.geo") for name in ("blocks", "hertz")]  # meshes/*.geo
+    files = (
+        sorted((root / "meshes").glob("*.py"))
+        + geo
+        + [root / "scenes" / n for n in ("gmsh_io.py", "gmsh_checks.py", "mesh_cache.py")]
+    )
     h = hashlib.sha256()
     for f in files:
         h.update(f.read_bytes())

@@ -3,18 +3,32 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from enum import StrEnum
 from functools import cached_property
+from types import MappingProxyType
 
 from ..contact.rigid import Circle, Plane, Polyline, RigidShape
 from ..errors import InputError
 
+
+class Shape(StrEnum):
+    """The shape of a rigid obstacle (its parameters: OBSTACLE_SHAPES)."""
+
+    CIRCLE = "circle"
+    PLANE = "plane"
+    POLYLINE = "polyline"
+
+
 # The parameters each obstacle shape takes (besides name, shape, surface and displacement).
-OBSTACLE_SHAPES: dict[str, tuple[str, ...]] = {
-    "circle": ("center", "radius"),
-    "plane": ("point", "normal"),
-    "polyline": ("points",),
-}
+OBSTACLE_SHAPES: Mapping[Shape, tuple[str, ...]] = MappingProxyType(
+    {
+        Shape.CIRCLE: ("center", "radius"),
+        Shape.PLANE: ("point", "normal"),
+        Shape.POLYLINE: ("points",),
+    }
+)
 
 
 @dataclass(frozen=True)
@@ -28,7 +42,7 @@ class Obstacle:
     """
 
     name: str
-    shape: str
+    shape: Shape  # or its name: "circle", "plane", "polyline"
     surface: str
     center: tuple[float, float] | None = None
     radius: float | None = None
@@ -45,6 +59,7 @@ class Obstacle:
             raise InputError(
                 f"{where}: unknown shape {self.shape!r} (choose {', '.join(OBSTACLE_SHAPES)})"
             )
+        object.__setattr__(self, "shape", Shape(self.shape))
         takes = OBSTACLE_SHAPES[self.shape]
         for key in ("center", "radius", "point", "normal", "points"):
             given = getattr(self, key) is not None
@@ -74,10 +89,10 @@ class Obstacle:
     @cached_property
     def geometry(self) -> RigidShape:
         """The exact shape (contact.rigid) at the obstacle's reference position."""
-        if self.shape == "circle":
+        if self.shape is Shape.CIRCLE:
             assert self.center is not None and self.radius is not None  # checked above
             return Circle(self.center, self.radius)
-        if self.shape == "plane":
+        if self.shape is Shape.PLANE:
             assert self.point is not None and self.normal is not None
             return Plane(self.point, self.normal)
         assert self.points is not None

@@ -7,6 +7,7 @@ allowed there (the keys, types and defaults: schema.py, printed in docs/referenc
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -14,7 +15,7 @@ from typing import Any
 from mpi4py import MPI
 
 from ..errors import InputError
-from .gmsh_io import SceneParts, scene_from_gmsh
+from .gmsh_io import SceneParts, scene_from_parts
 from .model import (
     ContactPair,
     Dirichlet,
@@ -31,7 +32,7 @@ from .model import (
     UniformStress,
     Units,
 )
-from .obstacle import OBSTACLE_SHAPES
+from .obstacle import OBSTACLE_SHAPES, Shape
 from .schema import SECTIONS, TYPE_ERRORS, allowed, required
 
 # The allowed keys of each section, from the one table the reference page is generated from.
@@ -88,10 +89,11 @@ def _vector(where: str, value: Any) -> tuple[float, float]:
 
 
 def _obstacle(k: int, entry: Any) -> Obstacle:
-    shape = entry.get("shape") if isinstance(entry, dict) else None
-    if shape not in OBSTACLE_SHAPES:
+    given = entry.get("shape") if isinstance(entry, dict) else None
+    if not isinstance(given, str) or given not in OBSTACLE_SHAPES:
         choices = ", ".join(f"'{s}'" for s in OBSTACLE_SHAPES)
-        raise InputError(f"obstacle {k}: shape must be one of {choices} (got {shape!r})")
+        raise InputError(f"obstacle {k}: shape must be one of {choices} (got {given!r})")
+    shape = Shape(given)
     where = f"obstacle {k} ({shape})"
     takes = set(OBSTACLE_SHAPES[shape])
     e = _keys(where, entry, SECTION_KEYS["obstacle"] | takes, required("obstacle") | takes)
@@ -201,7 +203,8 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
     _section(str(path.name), doc, "")
     if "contact" not in doc and "obstacle" not in doc:
         raise InputError(f"{path.name}: missing key 'contact' (or 'obstacle')")
-    mesh = path.parent / _string("mesh", doc["mesh"])
+    # Relative to the file; `..` collapsed (the demo scenes name ../../meshes/*.geo).
+    mesh = Path(os.path.normpath(path.parent / _string("mesh", doc["mesh"])))
     name = str(doc.get("name", path.stem))
     model = Model.parse(_string("model", doc.get("model", Model.PLANE_STRAIN.value)))
     units = _units(doc.get("units", {}))
@@ -267,4 +270,4 @@ def load_scene_file(
     """The Scene of a TOML scene file (mesh path relative to the file)."""
     path = Path(path)
     mesh, parts = parse_scene_file(path)
-    return scene_from_gmsh(mesh, parts, comm, size_factor, {"scene_file": str(path)})
+    return scene_from_parts(mesh, parts, comm, size_factor, {"scene_file": str(path)})

@@ -11,7 +11,7 @@ from mpi4py import MPI
 
 from ..errors import InputError
 from ..meshes import GridLines, grid_geometry, hertz_grid_part
-from .partition import stay_on_rank
+from .gmsh_io import stay_on_rank
 
 # Physical groups, named like the gmsh scene's (the numbers themselves are free).
 TAGS = {

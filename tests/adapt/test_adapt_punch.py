@@ -25,10 +25,14 @@ SCENES = ROOT / "demos" / "scenes"
 
 def uniform_punch(tmp: Path, h: float) -> Path:
     """rigid_punch.toml on rigid_block.geo with every size h (an ungraded mesh)."""
-    geo = (SCENES / "rigid_block.geo").read_text()
+    geo = (ROOT / "meshes" / "rigid_block.geo").read_text()
     start, end = geo.index("Field[1].F"), geo.index("Background Field")
     (tmp / "block.geo").write_text(geo[:start] + f'Field[1].F = "{h}";\n' + geo[end:])
-    toml = (SCENES / "rigid_punch.toml").read_text().replace("rigid_block.geo", "block.geo")
+    toml = (
+        (SCENES / "rigid_punch.toml")
+        .read_text()
+        .replace("../../meshes/rigid_block.geo", "block.geo")
+    )
     (tmp / "punch.toml").write_text(toml)
     return tmp / "punch.toml"
 

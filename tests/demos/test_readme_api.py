@@ -90,3 +90,14 @@ def test_readme_says_what_a_run_summary_holds() -> None:
     names = {f.name for f in dataclasses.fields(RunSummary)} | set(dir(RunSummary))
     for name in ("hertz", "patch", "to_json", "with_estimate"):
         assert name in names, name
+
+
+def test_testing_page_counts_the_rank_cases() -> None:
+    """docs/testing.md gives the number of 2-rank cases: the registry's (it drifted once)."""
+    sys.path.insert(0, str(ROOT / "tests" / "ranks"))
+    try:
+        from rank_cases import CASES
+    finally:
+        sys.path.pop(0)
+    text = " ".join((ROOT / "docs" / "testing.md").read_text().split())
+    assert f"compares {len(CASES)} cases" in text

@@ -8,7 +8,7 @@ import pytest
 from conftest import ROOT, solver_for
 
 from contactfx import load_scene_file, solve
-from contactfx.options import SOLVERS, SolverKind
+from contactfx.options import SOLVERS, Linear, SolverKind
 
 TWO_CYLINDERS = ROOT / "tests" / "scenes" / "two_cylinders.toml"
 
@@ -22,11 +22,13 @@ def cylinders():
 def test_default_factorizes_symmetrically() -> None:
     """The default `mumps` is MUMPS' LDL^T of the saddle point; LU stays as `mumps-lu`."""
     assert SOLVERS["mumps"].kind is SolverKind.DIRECT
+    assert SOLVERS["mumps"].linear is Linear.LDLT and not Linear.LDLT.unsymmetric
     assert SOLVERS["mumps"].petsc["pc_type"] == "cholesky"
+    assert SOLVERS["mumps-lu"].linear is Linear.LU and Linear.LU.unsymmetric
     assert SOLVERS["mumps-lu"].petsc["pc_type"] == "lu"
 
 
-@pytest.mark.parametrize("solver", ["condensed", "condensed-direct"])
+@pytest.mark.parametrize("solver", ["condensed", "condensed-gamg"])
 @pytest.mark.parametrize(("method", "basis"), [("mortar", "dual"), ("nts", "standard")])
 def test_condensed_on_a_curved_passive_surface(cylinders, method, basis, solver) -> None:
     """Dual mortar on two cylinders couples neighbouring pivots: condensed = MUMPS to 1e-6."""

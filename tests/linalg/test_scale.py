@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -21,7 +22,7 @@ from contactfx.linalg.saddle import SaddleSolver
 from contactfx.meshes.hertz_structured import graded_points, hertz_grid
 from contactfx.methods.active_set import ActiveSetOptions
 from contactfx.methods.multipliers import solve_contact
-from contactfx.options import SOLVERS, Method, Predictor
+from contactfx.options import SOLVERS, Method, Predictor, SolverKind
 from contactfx.request import SolveRequest
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
 from contactfx.timers import Timers
@@ -399,19 +400,22 @@ def test_coarse_factor_keeps_the_coarse_rows_probeable(structured_pair, monkeypa
     COARSE_ROWS lowered so that its rows over 8 exceed it (x16, a 16-row coarse mesh);
     PROBE_ALL_ROWS too, so that auto starts from the coarse solve.
     """
+    from contactfx import options
     from contactfx.api import solve
     from contactfx.methods import predictor
 
     fine, _ = structured_pair
     rows = predictor.contact_facets(fine)
     mumps = SOLVERS["mumps"]
-    assert predictor.coarse_factor(mumps, fine) == predictor.DIRECT_COARSE_FACTOR
-    monkeypatch.setattr(predictor, "DIRECT_COARSE_FACTOR", 8.0)
+    direct = options.TRAITS[SolverKind.DIRECT]
+    assert predictor.coarse_factor(mumps, fine) == direct.coarse_factor == 16.0
+    eight = {**options.TRAITS, SolverKind.DIRECT: replace(direct, coarse_factor=8.0)}
+    monkeypatch.setattr(options, "TRAITS", eight)
     limit = int(rows / 12)  # between rows / 16 and rows / 8
     monkeypatch.setattr(predictor, "COARSE_ROWS", limit)
     monkeypatch.setattr(predictor, "PROBE_ALL_ROWS", limit)  # auto: the coarse start
     assert predictor.coarse_factor(mumps, fine) == 16.0
-    assert predictor.coarse_factor(SOLVERS["fieldsplit"], fine) == predictor.COARSE_FACTOR
+    assert predictor.coarse_factor(SOLVERS["fieldsplit"], fine) == 8.0
     plain = solve(fine, "mortar", solver="mumps", predictor="none")
     sol = solve(fine, "mortar", solver="mumps", predictor="auto")
     assert sum(h["probes"] for h in sol.history) < 0.5 * rows  # the band, not every row

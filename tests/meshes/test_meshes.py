@@ -225,7 +225,7 @@ def test_grid_parts_are_strips_of_each_body(nparts: int) -> None:
     """Each body's parts are the partitioner's strips by x (body_strips on hertz_grid's cell
     midpoints), the block's and the disc's, as equal as counts allow (within one cell)."""
     from contactfx.meshes import hertz_grid, hertz_grid_part
-    from contactfx.scenes.partition import body_strips
+    from contactfx.scenes.gmsh_io import body_strips
 
     grid = GRIDS[0]
     x, cells, n_block = hertz_grid(*grid)

@@ -19,6 +19,7 @@ from contactfx import run_scene
 from contactfx.api import as_request
 from contactfx.discretize.mesh_utils import scene_dofs
 from contactfx.errors import InputError
+from contactfx.linalg.saddle import SaddleSolver
 from contactfx.methods import solver_choice
 from contactfx.methods.solver_choice import (
     SAFETY,
@@ -142,7 +143,7 @@ def test_auto_coarse_bound(scene, monkeypatch, available: float, preset: str) ->
         calls.append(linear._m.A.getSize()[0])  # the saddle point analysed
         return estimate(linear)
 
-    estimate = autosolve.mumps_estimate
+    estimate = SaddleSolver.mumps_estimate
     remeshed = type(scene).remeshed
     meshes: list[float] = []
 
@@ -152,7 +153,7 @@ def test_auto_coarse_bound(scene, monkeypatch, available: float, preset: str) ->
 
     monkeypatch.setattr(autosolve, "COARSE_BOUND_DOFS", 0)
     monkeypatch.setattr(autosolve, "CHECK_KB_PER_DOF", 1e12)
-    monkeypatch.setattr(autosolve, "mumps_estimate", counted)
+    monkeypatch.setattr(SaddleSolver, "mumps_estimate", counted)
     monkeypatch.setattr(type(scene), "remeshed", counted_remesh)
     sol, data = _run(scene, "auto", available)
     seen = list(calls)  # the auto run's analyses (an explicit mumps run checks too)
@@ -181,9 +182,11 @@ def test_auto_coarse_check_only_where_it_could_decide(scene, monkeypatch) -> Non
     import contactfx.methods.autosolve as autosolve
 
     calls: list[int] = []
-    estimate = autosolve.mumps_estimate
+    estimate = SaddleSolver.mumps_estimate
     monkeypatch.setattr(autosolve, "COARSE_BOUND_DOFS", 0)
-    monkeypatch.setattr(autosolve, "mumps_estimate", lambda lin: calls.append(1) or estimate(lin))
+    monkeypatch.setattr(
+        SaddleSolver, "mumps_estimate", lambda lin: calls.append(1) or estimate(lin)
+    )
     _, data = _run(scene, "auto", 1e9)
     assert len(calls) == 1 and data.to_json()["solver_choice"]["coarse_dofs"] is None
     _, data = _run(scene, "auto", 1.0)  # no room even at CHECK_KB_PER_DOF: the check runs

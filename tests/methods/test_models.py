@@ -19,7 +19,14 @@ from contactfx.api import run_case, run_scene
 from contactfx.errors import InputError
 from contactfx.results.interface import u_at_points
 from contactfx.results.stress import body_stress_deviation, sigma_field, sigma_zz_field
-from contactfx.scenes import BLOCK_SCENES, HertzParams, Material, Model, from_gmsh, hertz_exact
+from contactfx.scenes import (
+    BLOCK_SCENES,
+    HertzParams,
+    Material,
+    Model,
+    hertz_exact,
+    scene_from_gmsh,
+)
 
 SCENES = ROOT / "tests" / "scenes"
 S4 = BLOCK_SCENES["S4"]
@@ -167,7 +174,7 @@ def test_sigma_zz_of_each_model() -> None:
 def test_axisymmetric_cell_at_negative_x_is_refused() -> None:
     """x is the radius: a mesh reaching x < 0 is an InputError (one line, exit 2 in the CLI)."""
     with pytest.raises(InputError, match="x is the radius"):
-        from_gmsh(
+        scene_from_gmsh(
             SCENES / "rotated_hertz.geo",
             bodies={"block": Material(7000.0, 0.3), "disc": Material(7000.0, 0.3)},
             contacts=[("disc_contact", "block_contact")],

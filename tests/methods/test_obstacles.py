@@ -184,7 +184,7 @@ def test_block_resting_on_a_rigid_floor_is_held() -> None:
     (sigma_yy = -p exactly); a wall on the side instead of the floor pushes along x only, so
     the free-body check names the translation along y before any solve (the side's bottom
     node on the floor would hold the block: the floor on "side" is no free-body case)."""
-    path = DEMO_SCENES / "rigid_block.geo"
+    path = ROOT / "meshes" / "rigid_block.geo"
     floor = Obstacle("floor", "plane", "base", point=(0.0, -20.0), normal=(0.0, 1.0))
     kwargs = {
         "bodies": {"block": {"E": 7000.0, "nu": 0.3}},

@@ -145,6 +145,10 @@ def test_a_request_travels_alone() -> None:
     assert sol.penalty.eps == 1e7
     with pytest.raises(InputError, match="beside a SolveRequest"):
         solve(scene, request, max_iterations=3)
+    with pytest.raises(InputError, match="beside a SolveRequest"):
+        run_case("blocks", MATCHING, request, comm=MPI.COMM_SELF, solver="mumps")
+    with pytest.raises(InputError, match="unknown solve option tolerance"):
+        solve(scene, "nts", tolerance=1e-3)  # type: ignore[call-arg]
 
 
 def assert_refused(proc: subprocess.CompletedProcess[str], needle: str, out: Path) -> None:
@@ -213,9 +217,73 @@ def test_freeing_the_products_is_a_field() -> None:
     from contactfx.methods.solvers import reuses_interpolation
 
     assert SOLVERS["condensed"].free_products
-    assert not SOLVERS["mumps"].free_products and not SOLVERS["condensed-direct"].free_products
+    assert not SOLVERS["mumps"].free_products and SOLVERS["condensed-gamg"].free_products
     assert not reuses_interpolation(SOLVERS["condensed"].petsc)
     for value, reuses in (("1", True), ("true", True), ("0", False), ("False", False)):
         spec = SOLVERS["condensed"].with_petsc([f"pc_gamg_reuse_interpolation={value}"])
         assert reuses_interpolation(spec.petsc) is reuses
     assert reuses_interpolation({"pc_gamg_reuse_interpolation": True})
+
+
+# ------------------------------------------------------------- the solver table (TRAITS)
+
+
+def test_every_kind_has_one_row_and_the_rules_read_it() -> None:
+    """One typed row per kind; the request's rules ask the row, not the kind's name."""
+    from contactfx.options import TRAITS, System
+
+    assert set(TRAITS) == set(SolverKind)
+    assert TRAITS[SolverKind.AUTO] == TRAITS[SolverKind.DIRECT]  # its direct path
+    condensed, direct = TRAITS[SolverKind.CONDENSED], TRAITS[SolverKind.DIRECT]
+    assert condensed.system is System.CONDENSED and condensed.needs_diagonal_d
+    assert direct.system is System.SADDLE and direct.factorizes and not direct.needs_diagonal_d
+    assert not TRAITS[SolverKind.FIELDSPLIT].factorizes and TRAITS[SolverKind.FIELDSPLIT].augmented
+    # A condensed row without a diagonal D is refused by the row's trait.
+    with pytest.raises(InputError, match="needs a diagonal D"):
+        SolveRequest.parse("sts", solver="condensed-gamg")
+    SolveRequest.parse("nts", solver="condensed-gamg")
+
+
+def test_the_rejected_presets_are_not_offered() -> None:
+    """mumps-schur, mumps-blr and condensed-direct left the package (benchmarks/README.md)."""
+    assert set(SOLVERS) == {
+        "auto", "mumps", "mumps-lu", "fieldsplit", "fieldsplit-gamg", "condensed", "condensed-gamg"
+    }  # fmt: skip
+    for name in ("mumps-schur", "mumps-blr", "condensed-direct"):
+        with pytest.raises(InputError, match="unknown solver"):
+            SolveRequest.parse("mortar", solver=name)
+
+
+def test_the_linear_solver_is_a_choice_of_its_own() -> None:
+    """LU, LDL^T, CG, GMRES: checked against the kind and a factorization's pc_type; which
+    of them take an unsymmetric (frictional) system is the table's answer."""
+    from contactfx.option_sets import GAMG, MUMPS_LU
+    from contactfx.options import Linear
+
+    assert SOLVERS["mumps"].linear is Linear.LDLT and SOLVERS["mumps-lu"].linear is Linear.LU
+    assert SOLVERS["mumps"].with_petsc(["pc_type=lu"]).linear is Linear.LU
+    assert SOLVERS["condensed"].linear is Linear.CG
+    assert SOLVERS["condensed"].with_petsc(["ksp_type=gmres"]).linear is Linear.GMRES
+    assert SOLVERS["fieldsplit"].linear is Linear.GMRES
+    assert {m for m in Linear if m.unsymmetric} == {Linear.LU, Linear.GMRES}
+    with pytest.raises(InputError, match="contradicts its linear solver"):
+        SolverSpec(SolverKind.DIRECT, MUMPS_LU)  # LU options, the default LDL^T
+    with pytest.raises(InputError, match="does not apply"):
+        SolverSpec(SolverKind.CONDENSED, GAMG, linear=Linear.LU)
+
+
+def test_the_multigrid_is_a_choice_not_a_second_option_set() -> None:
+    """condensed: geometric, condensed-gamg: GAMG; the geometric options are GEOMETRIC_MG
+    with the user's own changes (not GAMG's keys)."""
+    from contactfx.methods.solvers import geometric_options
+    from contactfx.option_sets import GEOMETRIC_MG
+    from contactfx.options import Multigrid
+
+    assert SOLVERS["condensed"].multigrid is Multigrid.GEOMETRIC
+    assert SOLVERS["condensed-gamg"].multigrid is Multigrid.GAMG
+    assert SOLVERS["mumps"].multigrid is None
+    assert geometric_options(SOLVERS["condensed"].petsc) == GEOMETRIC_MG
+    tuned = SOLVERS["condensed"].with_petsc(["mg_levels_ksp_max_it=2", "pc_gamg_threshold=0.1"])
+    assert geometric_options(tuned.petsc) == {**GEOMETRIC_MG, "mg_levels_ksp_max_it": "2"}
+    with pytest.raises(InputError, match="needs the condensed system"):
+        replace(SOLVERS["mumps"], multigrid=Multigrid.GAMG)

@@ -13,13 +13,12 @@ import pytest
 
 from contactfx import solve
 from contactfx.methods.multipliers import solve_contact
-from contactfx.methods.predictor import (
-    CONDENSED_COARSE_FACTOR,
-    coarse_initial_set,
-    sharp_initial_set,
-)
+from contactfx.methods.predictor import coarse_initial_set, sharp_initial_set
+from contactfx.options import SolverKind
 from contactfx.request import SolveRequest
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
+
+CONDENSED_COARSE_FACTOR = SolverKind.CONDENSED.traits.coarse_factor
 
 
 def coarse_and_fine(scene, method: str, basis: str):

@@ -15,6 +15,7 @@ from contactfx.results.interface import u_at_points
 from contactfx.scenes import Dirichlet, parse_scene_file
 
 DEMO_SCENES = ROOT / "demos" / "scenes"
+MESHES = ROOT / "meshes"
 INDENTER = DEMO_SCENES / "rigid_indenter.toml"
 HEAD = """mesh = "rigid_block.geo"
 [bodies.block]
@@ -33,7 +34,7 @@ CIRCLE = 'name = "ind"\nshape = "circle"\ncenter = [0.0, 20.0]\nradius = 20.0\ns
 
 def scene_file(tmp_path: Path, obstacle: str) -> Path:
     """A scene file next to a copy of rigid_block.geo with one [[obstacle]] table."""
-    shutil.copy(DEMO_SCENES / "rigid_block.geo", tmp_path / "rigid_block.geo")
+    shutil.copy(MESHES / "rigid_block.geo", tmp_path / "rigid_block.geo")
     path = tmp_path / "s.toml"
     path.write_text(HEAD + obstacle)
     return path
@@ -65,7 +66,7 @@ def test_scene_file_and_python_api_agree(tmp_path: Path) -> None:
     made = Obstacle("indenter", "circle", "top", center=(0, 20), radius=20, displacement=(0, -0.05))
     assert parsed == (made,)
     scene = scene_from_gmsh(
-        DEMO_SCENES / "rigid_block.geo",
+        MESHES / "rigid_block.geo",
         bodies={"block": {"E": 7000.0, "nu": 0.3}},
         dirichlet=[Dirichlet("symmetry", ux=0.0), Dirichlet("base", uy=0.0)],
         obstacles=[made],
