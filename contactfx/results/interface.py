@@ -2,12 +2,17 @@
 
 Stresses are each body's own FE stress, averaged at the surface nodes over the adjacent
 cells. Each body's traction sigma.m (m its outward normal, the passive one's turned to point
-out of the active body) is resolved on the contact frame of PairView.frame: nu, the normal
-the multipliers act along (the passive surface's), and tau perpendicular to it (the
-direction of increasing arc length s along the active surface). On a frictionless contact
-sigma_nt then tends to 0 and sigma_nn to -p at the discretization's order also on curved
-pairs, where the active surface's own normal differs from nu by the slope (docs/hertz.md).
-The records are assembled in results/summary.py.
+out of the active body) is resolved on the contact frame of `report_frame`: nu, the passive
+surface's normal at the node's projection, and tau perpendicular to it (the direction of
+increasing arc length s along the active surface). On a frictionless contact sigma_nt then
+tends to 0 and sigma_nn to -p at the discretization's order also on curved pairs, where the
+active surface's own normal differs from nu by the slope (docs/hertz.md).
+
+The normals are those of the curve the polygon samples, not of its facets (`curve_normals`:
+the circle through a node and its neighbours): a facet's normal is off the curve's by up to
+half the facet's turn, and the shear read in it is the hoop stress difference times that
+angle (p dtheta / 2 on the active side of a frictionless ring fit, (sigma_tt + p) dtheta / 2
+on the passive side). The records are assembled in results/summary.py.
 """
 
 from __future__ import annotations
@@ -16,8 +21,9 @@ from typing import Any
 
 import numpy as np
 
+from ..contact.geometry import Surface, nodal_normals
 from ..contact.search import project
-from ..methods.solution import Solution
+from ..methods.solution import PairView, Solution
 from .records import ContactSummary
 from .stress import nodal_stress, surface_stress
 
@@ -43,6 +49,87 @@ def resolve(
     return np.einsum("ki,ki->k", nu, tr), np.einsum("ki,ki->k", tau, tr)
 
 
+def curve_normals(surface: Surface) -> np.ndarray:
+    """Unit outward normal at each node of the curve through the surface's nodes, (n, 2).
+
+    The normal of the circle through the node and its two neighbours (at an end of a chain:
+    the next two nodes along it), oriented like the facets' mean normal, which it replaces
+    where the three points are collinear (a straight line, or a kink). On a circle it is the
+    radius at every node, ends included; on a line, the line's normal.
+    """
+    base = nodal_normals(surface)
+    out = base.copy()
+    nbrs: list[list[int]] = [[] for _ in range(surface.n_nodes)]
+    for a, b in surface.segments:
+        nbrs[int(a)].append(int(b))
+        nbrs[int(b)].append(int(a))
+    x = surface.x
+    for i, near in enumerate(nbrs):
+        if len(near) == 2:
+            j, k = near
+        elif len(near) == 1:
+            j = near[0]
+            further = [m for m in nbrs[j] if m != i]
+            if not further:
+                continue
+            k = further[0]
+        else:
+            continue
+        centre = _circumcentre(x[i], x[j], x[k])
+        if centre is None:
+            continue
+        n = x[i] - centre
+        n /= np.linalg.norm(n)
+        out[i] = n if n @ base[i] >= 0 else -n
+    return out
+
+
+def _circumcentre(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> np.ndarray | None:
+    """Centre of the circle through p, q, r; None if they are collinear or turn sharply.
+
+    A turn of the two chords by more than 30 degrees is a corner of the polygon, not a
+    sampled curve: the facets' mean normal is kept there.
+    """
+    u, v = q - p, r - p
+    cross = u[0] * v[1] - u[1] * v[0]
+    lu, lv = float(u @ u), float(v @ v)
+    if abs(cross) <= 1e-9 * lu**0.5 * lv**0.5:
+        return None
+    w, z = q - p, r - q
+    cos_turn = float(w @ z) / (np.linalg.norm(w) * np.linalg.norm(z))
+    if cos_turn < np.cos(np.pi / 6):
+        return None
+    d = 2.0 * cross
+    return p + np.array([v[1] * lu - u[1] * lv, u[0] * lv - v[0] * lu]) / d
+
+
+def report_frame(pv: PairView) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(n, nu, tau): the active curve's normal at each row's node and the contact frame.
+
+    nu is the passive curve's normal at the node's projection (`curve_normals` interpolated
+    along the facet and normalized), turned to point out of the active body; against a rigid
+    obstacle its exact normal; beyond the passive surface's end the active curve's normal.
+    tau is perpendicular to nu, along increasing s. On a straight passive surface nu is
+    PairView.frame's (the direction the multipliers act along).
+    """
+    n = curve_normals(pv.active.surface)[pv.nodes]
+    facet_nu, _, found = pv.frame
+    if pv.passive is None:
+        nu = facet_nu
+    else:
+        surf = pv.passive.surface
+        seg, xi, _ = project(pv.x, surf)
+        ends = surf.segments[seg]
+        cn = curve_normals(surf)
+        m = (1 - xi)[:, None] * cn[ends[:, 0]] + xi[:, None] * cn[ends[:, 1]]
+        m /= np.linalg.norm(m, axis=1)[:, None]
+        nu = np.where(found[:, None], -m, n)
+    t = pv.t
+    tau = t - np.einsum("ki,ki->k", t, nu)[:, None] * nu
+    tau /= np.linalg.norm(tau, axis=1)[:, None]
+    return n, nu, tau
+
+
 def none_if_nan(v: np.ndarray) -> list[float | None]:
     """The values as floats, None where not finite (JSON has no NaN)."""
     return [None if not np.isfinite(x) else float(x) for x in v]
@@ -59,7 +146,7 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     """pair_interface, computed (collective)."""
     pv = sol.pairs[k]
     rows = pv.rows
-    n, x, s = pv.n, pv.x, pv.s
+    x, s = pv.x, pv.s
     gn_a, _, sig_a = nodal_stress(sol, pv.pair.active)
     sa = sig_a[np.searchsorted(gn_a, pv.gblock)]
     sp = np.full_like(sa, np.nan)  # a rigid obstacle has no stress of its own
@@ -71,7 +158,7 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
         ends = surf_p.segments[seg]
         sp = (1 - xi)[:, None, None] * at_node[ends[:, 0]] + xi[:, None, None] * at_node[ends[:, 1]]
         sp[~found] = np.nan  # beyond the passive surface's end there is no value
-    nu, tau, _ = pv.frame
+    n, nu, tau = report_frame(pv)
     nn_a, nt_a = resolve(sa, n, nu, tau)
     nn_p, nt_p = resolve(sp, nu, nu, tau)
     order = np.argsort(s, kind="stable")

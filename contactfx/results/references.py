@@ -22,7 +22,7 @@ from mpi4py import MPI
 from ..errors import InputError
 from ..methods.solution import Solution
 from ..scenes import HertzReference, LameReference, Material, Model, Scene, UniformStress
-from .interface import pair_forces, pair_interface, resolve
+from .interface import pair_forces, pair_interface, report_frame, resolve
 from .records import HertzErrors, LameErrors, PatchErrors
 from .stress import body_vertex_stress
 
@@ -203,10 +203,10 @@ def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
     for k, pv in enumerate(sol.pairs):
         itf = pair_interface(sol, k)
         order = np.argsort(pv.s, kind="stable")
-        nu, tau, _ = (v[order] for v in pv.frame)
+        n, nu, tau = (v[order] for v in report_frame(pv))
         sig = np.broadcast_to(sigma, (len(nu), 2, 2))
         # The exact values of the columns: each side's traction in the contact frame.
-        nn_a, nt_a = resolve(sig, pv.n[order], nu, tau)
+        nn_a, nt_a = resolve(sig, n, nu, tau)
         nn_p, nt_p = resolve(sig, nu, nu, tau)
         exact = {"nn_active": nn_a, "nn_passive": nn_p, "nt_active": nt_a, "nt_passive": nt_p}
         sides = ("active",) if pv.obstacle is not None else ("active", "passive")

@@ -146,24 +146,63 @@ class Traction:
 Load = Pressure | Traction
 
 
+class HertzContact(StrEnum):
+    """Which of Hertz's contacts a reference is: a cylinder's line or a sphere's point."""
+
+    LINE = "line"
+    POINT = "point"
+
+
 @dataclass(frozen=True)
 class HertzReference:
     """Hertz contact on one pair: effective radius R, full load P.
 
-    The line contact of a cylinder (P per unit thickness) in plane strain and plane stress;
-    the point contact of a sphere (P the total force) in an axisymmetric scene.
+    `contact` None (the default) takes the model's: the line contact of a cylinder (P per
+    unit thickness) in plane strain and plane stress, the point contact of a sphere (P the
+    total force; its centre is on the axis) in an axisymmetric scene. `contact = "line"` in
+    an axisymmetric scene is a ring's line contact on a torus section (an O-ring between
+    plates): P the total force over the turn, the line load P / (2 pi r_c) at the contact
+    centre's radius r_c. A plane model has no point contact (InputError).
 
     `P` None (omitted): the load is the pair's computed contact force (twice it for a half
     model), which is what a displacement-controlled scene knows. `symmetric`: the model is a
     half model cut through the contact centre (which is then the end of the active surface
     nearest the symmetry line); otherwise (the default, in Python and in scene files alike)
     the centre is the first moment of the piecewise-linear pressure along the arc length.
+    The sphere of an axisymmetric scene is measured from the axis with or without it (the
+    axis is the symmetry line); a ring's line contact has no such cut (InputError).
     """
 
     pair: int
     R: float
     P: float | None = None
     symmetric: bool = False
+    contact: HertzContact | None = None
+
+    def __post_init__(self) -> None:
+        if self.contact is not None:
+            try:
+                object.__setattr__(self, "contact", HertzContact(self.contact))
+            except ValueError:
+                raise InputError(
+                    f"hertz reference: contact must be 'line' or 'point' (got {self.contact!r})"
+                ) from None
+
+    def contact_in(self, model: Model) -> HertzContact:
+        """The contact this reference is in `model` (InputError where it has none)."""
+        axi = model is Model.AXISYMMETRIC
+        kind = self.contact or (HertzContact.POINT if axi else HertzContact.LINE)
+        if kind is HertzContact.POINT and not axi:
+            raise InputError(
+                f"hertz reference (pair {self.pair}): contact = 'point' is a sphere's, which "
+                f"needs model = 'axisymmetric' ({model.value} is a cylinder's line contact)"
+            )
+        if kind is HertzContact.LINE and axi and self.symmetric:
+            raise InputError(
+                f"hertz reference (pair {self.pair}): a ring's line contact in an axisymmetric "
+                "scene has no half model (drop symmetric; the centre is read off the pressure)"
+            )
+        return kind
 
 
 @dataclass(frozen=True)
@@ -174,6 +213,61 @@ class UniformStress:
 
 
 Reference = HertzReference | UniformStress | LameReference
+
+
+class ProbeKind(StrEnum):
+    """What a probe reads off a pair (docs/scenes.md, "Probes")."""
+
+    PRESSURE = "pressure"  # the pressure at the surface point nearest `at`
+    MEAN_PRESSURE = "mean_pressure"  # the mean pressure between `start` and `end`
+    PEAK_SIGMA_NN = "peak_sigma_nn"  # the largest compression -sigma_nn of the FE stress
+
+
+@dataclass(frozen=True)
+class Probe:
+    """A value read off one pair's solution: printed on the terminal, written to the JSON.
+
+    `pressure`: the multipliers' pressure (piecewise linear along the active surface) at the
+    surface point nearest `at`. `mean_pressure`: its mean between the surface points nearest
+    `start` and `end` (over the revolved surface in an axisymmetric scene: weighted by r).
+    `peak_sigma_nn`: the largest -sigma_nn of `side`'s FE stress (`active` or `passive`) at
+    the pair's nodes, between `start` and `end` if given (the edge peak of a punch or a fit),
+    and where it is. Points are (x, y) of the undeformed mesh.
+    """
+
+    kind: ProbeKind
+    pair: int = 0
+    at: tuple[float, float] | None = None
+    start: tuple[float, float] | None = None
+    end: tuple[float, float] | None = None
+    side: str = "active"
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        try:
+            object.__setattr__(self, "kind", ProbeKind(self.kind))
+        except ValueError:
+            choices = ", ".join(k.value for k in ProbeKind)
+            raise InputError(f"probe: unknown type {self.kind!r} (choose {choices})") from None
+        where = f"probe '{self.label}'"
+        window = (self.start is None, self.end is None)
+        if self.kind is ProbeKind.PRESSURE and (self.at is None or window != (True, True)):
+            raise InputError(f"{where}: type 'pressure' takes `at` = [x, y] (and no start, end)")
+        if self.kind is ProbeKind.MEAN_PRESSURE and (self.at is not None or any(window)):
+            raise InputError(f"{where}: type 'mean_pressure' takes start and end (and no at)")
+        if self.kind is ProbeKind.PEAK_SIGMA_NN and (self.at is not None or len(set(window)) > 1):
+            raise InputError(f"{where}: type 'peak_sigma_nn' takes start and end, or neither")
+        if self.side not in ("active", "passive"):
+            raise InputError(f"{where}: side must be 'active' or 'passive' (got {self.side!r})")
+        for key in ("at", "start", "end"):
+            v = getattr(self, key)
+            if v is not None and not all(math.isfinite(float(c)) for c in v):
+                raise InputError(f"{where}: {key} must be finite")
+
+    @property
+    def label(self) -> str:
+        """The probe's name, or its kind and pair."""
+        return self.name or f"{self.kind.value} on pair {self.pair}"
 
 
 @dataclass(frozen=True)
@@ -278,6 +372,7 @@ class Scene:
     units: Units = field(default_factory=Units)
     # The lines of a structured mesh (its coarser grids: a geometric multigrid's levels).
     grid: GridLines | None = field(default=None, compare=False, repr=False)
+    probes: tuple[Probe, ...] = ()  # values read off the solution (results/probes.py)
 
     @property
     def comm(self) -> MPI.Comm:
