@@ -17,6 +17,7 @@ on the passive side). The records are assembled in results/summary.py.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -59,10 +60,7 @@ def curve_normals(surface: Surface) -> np.ndarray:
     """
     base = nodal_normals(surface)
     out = base.copy()
-    nbrs: list[list[int]] = [[] for _ in range(surface.n_nodes)]
-    for a, b in surface.segments:
-        nbrs[int(a)].append(int(b))
-        nbrs[int(b)].append(int(a))
+    nbrs = neighbours(surface)
     x = surface.x
     for i, near in enumerate(nbrs):
         if len(near) == 2:
@@ -75,7 +73,7 @@ def curve_normals(surface: Surface) -> np.ndarray:
             k = further[0]
         else:
             continue
-        centre = _circumcentre(x[i], x[j], x[k])
+        centre = circumcentre(x[i], x[j], x[k])
         if centre is None:
             continue
         n = x[i] - centre
@@ -84,7 +82,7 @@ def curve_normals(surface: Surface) -> np.ndarray:
     return out
 
 
-def _circumcentre(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> np.ndarray | None:
+def circumcentre(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> np.ndarray | None:
     """Centre of the circle through p, q, r; None if they are collinear or turn sharply.
 
     A turn of the two chords by more than 30 degrees is a corner of the polygon, not a
@@ -101,6 +99,31 @@ def _circumcentre(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> np.ndarray | N
         return None
     d = 2.0 * cross
     return p + np.array([v[1] * lu - u[1] * lv, u[0] * lv - v[0] * lu]) / d
+
+
+def neighbours(surface: Surface) -> list[list[int]]:
+    """The nodes each node shares a segment with."""
+    nbrs: list[list[int]] = [[] for _ in range(surface.n_nodes)]
+    for a, b in surface.segments:
+        nbrs[int(a)].append(int(b))
+        nbrs[int(b)].append(int(a))
+    return nbrs
+
+
+def curve_radius(surface: Surface, point: np.ndarray) -> float:
+    """The radius of the circle through the surface node nearest `point` and its neighbours.
+
+    inf where they are collinear (a straight surface) or the node has no two neighbours.
+    """
+    nbrs = neighbours(surface)
+    i = int(np.argmin(np.linalg.norm(surface.x - point, axis=1)))
+    near = nbrs[i]
+    if len(near) == 1:
+        near = near + [m for m in nbrs[near[0]] if m != i][:1]
+    if len(near) != 2:
+        return math.inf
+    centre = circumcentre(surface.x[i], surface.x[near[0]], surface.x[near[1]])
+    return math.inf if centre is None else float(np.linalg.norm(surface.x[i] - centre))
 
 
 def report_frame(pv: PairView) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -64,7 +64,12 @@ class ContactSummary:
 
 @dataclass(frozen=True, kw_only=True)
 class HertzErrors:
-    """One pair against plane-strain Hertz: fitted and bracketed half-width, p0, L2 error."""
+    """One pair against Hertz: fitted and bracketed half-width, p0, L2 error.
+
+    Hertz is never exact for a finite model (a half-space theory, a small against the
+    surfaces' radii and the bodies' size): `exact` is False and `a_over_radius` (a over the
+    smaller surface radius at the centre) says how far the scene is from the theory.
+    """
 
     pair: int
     s_centre: float  # arc length of the contact centre r is measured from
@@ -77,6 +82,15 @@ class HertzErrors:
     P: float
     P_source: str
     l2_error: float
+    description: str = "plane-strain Hertz line contact (Johnson 4.2)"
+    line_load: float | None = None  # a ring's (axisymmetric line contact): P / (2 pi r_c)
+    a_over_radius: float = 0.0
+    exact: bool = False
+
+    @property
+    def validity(self) -> str:
+        """Why the reference is approximate, in words."""
+        return f"approximate: half-space theory, a / R_min = {self.a_over_radius:.3g}"
 
     def to_json(self) -> dict[str, Any]:
         """The JSON's `hertz` block."""
@@ -92,6 +106,11 @@ class HertzErrors:
             "P": self.P,
             "P_source": self.P_source,
             "l2_error": self.l2_error,
+            "reference": self.description,
+            **({} if self.line_load is None else {"line_load": self.line_load}),
+            "exact": self.exact,
+            "validity": self.validity,
+            "a_over_radius": self.a_over_radius,
         }
 
 
@@ -108,6 +127,8 @@ class LameErrors:
     p_exact: float
     error: float  # |p_mean / p_exact - 1|
     active_fraction: float  # active rows / rows of the pair
+    exact: bool = True  # False: Lame's is approximate for the scene (validity says why)
+    validity: str = ""
 
     def to_json(self) -> dict[str, Any]:
         """One entry of the JSON's `lame` list."""
@@ -121,6 +142,8 @@ class LameErrors:
             "p_exact": self.p_exact,
             "error": self.error,
             "active_fraction": self.active_fraction,
+            "exact": self.exact,
+            "validity": self.validity,
         }
 
 

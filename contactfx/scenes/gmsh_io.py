@@ -30,6 +30,7 @@ from .model import (
     Material,
     Model,
     Obstacle,
+    Probe,
     Reference,
     Scene,
     SizeField,
@@ -245,6 +246,7 @@ class SceneParts:
     obstacles: tuple[Obstacle, ...] = ()
     model: Model = Model.PLANE_STRAIN
     units: Units = field(default_factory=Units)
+    probes: tuple[Probe, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -313,6 +315,7 @@ def scene_from_gmsh(
         obstacles=parts.obstacles,
         model=parts.model,
         units=parts.units,
+        probes=parts.probes,
     )
     return check_scene(scene)
 

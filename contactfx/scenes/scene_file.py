@@ -18,6 +18,7 @@ from .gmsh_io import SceneParts, scene_from_gmsh
 from .model import (
     ContactPair,
     Dirichlet,
+    HertzContact,
     HertzReference,
     LameReference,
     Load,
@@ -25,6 +26,8 @@ from .model import (
     Model,
     Obstacle,
     Pressure,
+    Probe,
+    ProbeKind,
     Reference,
     Scene,
     Traction,
@@ -144,7 +147,7 @@ def _material(body: str, table: Any) -> Material:
     return mat
 
 
-def _reference(k: int, entry: Any) -> Reference:
+def _reference(k: int, entry: Any, model: Model | None = None) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
     if kind not in ("hertz", "uniform_stress", "lame"):
         raise InputError(
@@ -169,7 +172,13 @@ def _reference(k: int, entry: Any) -> Reference:
         P = _number(f"{where}.P", e["P"]) if "P" in e else None
         if R <= 0 or (P is not None and P <= 0):
             raise InputError(f"{where}: R and P must be positive")
-        return HertzReference(pair, R, P, **flags)
+        contact = e.get("contact")
+        if contact is not None and contact not in tuple(HertzContact):
+            raise InputError(f'{where}: contact must be "line" or "point" (got {contact!r})')
+        ref = HertzReference(pair, R, P, **flags, contact=contact)
+        if model is not None:
+            ref.contact_in(model)  # a point contact needs the axisymmetric model
+        return ref
     e = _section(where, entry, "reference.uniform_stress")
     s = e["sigma"]
     if not (
@@ -180,6 +189,25 @@ def _reference(k: int, entry: Any) -> Reference:
     if sig[0][1] != sig[1][0]:
         raise InputError(f"{where}: sigma must be symmetric")
     return UniformStress(sig)  # type: ignore[arg-type]
+
+
+def _probe(k: int, entry: Any) -> Probe:
+    """A `[[probe]]` table: a value read off one pair (model.Probe)."""
+    kind = entry.get("type") if isinstance(entry, dict) else None
+    if kind not in tuple(ProbeKind):
+        choices = ", ".join(f"'{p.value}'" for p in ProbeKind)
+        raise InputError(f"probe {k}: type must be one of {choices} (got {kind!r})")
+    where = f"probe {k} ({kind})"
+    e = _section(where, entry, "probe")
+    pair = e.get("pair", 0)
+    if isinstance(pair, bool) or not isinstance(pair, int):
+        raise InputError(
+            f"{where}: pair: {TYPE_ERRORS['integer']} into [[contact]], then [[obstacle]]"
+        )
+    points = {key: _vector(f"{where}.{key}", e[key]) for key in ("at", "start", "end") if key in e}
+    name = _string(f"{where}.name", e["name"]) if "name" in e else ""
+    side = _string(f"{where}.side", e.get("side", "active"))
+    return Probe(ProbeKind(kind), pair, side=side, name=name, **points)
 
 
 def _units(table: Any) -> Units:
@@ -245,7 +273,8 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
                 (_number(f"traction {k}.t", t[0]), _number(f"traction {k}.t", t[1])),
             )
         )
-    refs = [_reference(k, e) for k, e in enumerate(_entries(doc, "reference"))]
+    refs = [_reference(k, e, model) for k, e in enumerate(_entries(doc, "reference"))]
+    probes = [_probe(k, e) for k, e in enumerate(_entries(doc, "probe"))]
     obstacles = [_obstacle(k, e) for k, e in enumerate(_entries(doc, "obstacle"))]
     parts = SceneParts(
         bodies,
@@ -257,6 +286,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         tuple(obstacles),
         model,
         units,
+        tuple(probes),
     )
     return mesh, parts
 
