@@ -38,11 +38,7 @@ def terminal_summary(run: RunSummary) -> list[str]:
         f"total {run.times['total']:.2f} s"
     ]
     for k, c in enumerate(run.contacts):
-        f = c.force
-        lines.append(
-            f"pair {k} ({c.active} on {c.passive}): force ({f[0]:.6g}, "
-            f"{f[1]:.6g}), balance {c.balance:.1e}, {c.active_nodes} active nodes"
-        )
+        lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}")
     if run.patch is not None:
         lines.append(
             f"patch test: max stress/pressure error {run.patch.max:.2e} "

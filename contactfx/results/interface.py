@@ -25,6 +25,7 @@ import numpy as np
 from ..contact.geometry import Surface, nodal_normals
 from ..contact.search import project
 from ..methods.solution import PairView, Solution
+from ..scenes import Model
 from .records import ContactSummary
 from .stress import nodal_stress, surface_stress
 
@@ -225,6 +226,8 @@ def contacts_summary(sol: Solution) -> tuple[ContactSummary, ...]:
                 interface=pair_interface(sol, k),
                 obstacle=pv.obstacle,
                 initial_overlap=pv.initial_overlap,
+                axisymmetric=sol.scene.model is Model.AXISYMMETRIC,
+                fit=bool(pv.pair.interference),
             )
         )
     return tuple(out)

@@ -7,6 +7,7 @@ study and the adaptive loop read its attributes. Its `to_json()` is the schema o
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -26,7 +27,15 @@ ESTIMATE_NORM = (
 
 @dataclass(frozen=True, kw_only=True)
 class ContactSummary:
-    """One contact pair's results: its names, forces, counts and interface columns."""
+    """One contact pair's results: its names, forces, counts and interface columns.
+
+    `force` is the sum of the pair's nodal forces. In an axisymmetric scene these are totals
+    over the turn, and the x sum is no force (the radial forces of a body of revolution
+    cancel): the records give the axial force (y, total over the turn) and the radial
+    pressure's resultant per radian, int p n_r r ds (twice it is the force that splits the
+    ring across a diametral plane: for a fit of radius b and length L, 2 p b L). The x
+    component of `force` is then written as null (docs/models.md, "Forces").
+    """
 
     active: str
     passive: str
@@ -41,22 +50,63 @@ class ContactSummary:
     interface: dict[str, list[Any]]
     obstacle: Obstacle | None = None
     initial_overlap: float = 0.0  # max over the pair's nodes of -gap before the solve
+    axisymmetric: bool = False
+    fit: bool = False  # the pair is an interference fit
+
+    @property
+    def axial_force(self) -> float:
+        """Axisymmetric: the force along the axis on the active body, total over the turn."""
+        return self.force[1]
+
+    @property
+    def radial_per_radian(self) -> float:
+        """Axisymmetric: the radial pressure's resultant per radian on the active body."""
+        return self.force[0] / (2.0 * math.pi)
+
+    @property
+    def magnitude(self) -> float:
+        """|force| in a plane model; |axial force| in an axisymmetric one."""
+        return abs(self.axial_force) if self.axisymmetric else float(np.hypot(*self.force))
+
+    def force_text(self) -> str:
+        """The pair's forces for the terminal (axisymmetric: the components that exist)."""
+        tail = f"balance {self.balance:.1e}, {self.active_nodes} active nodes"
+        if not self.axisymmetric:
+            return f"force ({self.force[0]:.6g}, {self.force[1]:.6g}), {tail}"
+        text = (
+            f"axial force {self.axial_force:.6g} (total over the turn), radial resultant "
+            f"{self.radial_per_radian:.6g} per radian"
+        )
+        if self.fit and self.force[0] != 0.0:
+            share = abs(self.axial_force / self.force[0])
+            text += (
+                f" (a fit's axial force is {100 * share:.2g} % of its radial load: none "
+                "on a frictionless cylinder, the rest is the discretization's)"
+            )
+        return f"{text}, {tail}"
 
     def to_json(self) -> dict[str, Any]:
         """The pair's entry of the JSON's `contacts` list."""
+        force: list[float | None] = list(self.force)
+        force_passive: list[float | None] = list(self.force_passive)
+        if self.axisymmetric:
+            force[0] = force_passive[0] = None  # no radial force: see the class docstring
         out: dict[str, Any] = {
             "active": self.active,
             "passive": self.passive,
             "active_body": self.active_body,
             "passive_body": self.passive_body,
-            "force": list(self.force),
-            "force_passive": list(self.force_passive),
+            "force": force,
+            "force_passive": force_passive,
             "balance": self.balance,
             "multipliers": self.multipliers,
             "active_nodes": self.active_nodes,
             "initial_overlap": self.initial_overlap,
             "interface": self.interface,
         }
+        if self.axisymmetric:
+            out["axial_force"] = self.axial_force
+            out["radial_force_per_radian"] = self.radial_per_radian
         if self.obstacle is not None:
             out["obstacle"] = obstacle_json(self.obstacle)
         return out
@@ -260,8 +310,8 @@ class RunSummary:
 
     @property
     def contact_force(self) -> float:
-        """Magnitude of the first pair's force: the paper's scenes have one pair."""
-        return float(np.linalg.norm(self.contacts[0].force))
+        """Magnitude of the first pair's force (axisymmetric: its axial force's)."""
+        return self.contacts[0].magnitude
 
     def with_estimate(self, estimate: EstimateSummary) -> RunSummary:
         """The same summary with the error estimate attached."""
