@@ -60,6 +60,7 @@ def terminal_summary(run: RunSummary) -> list[str]:
             f"Lame, pair {r.pair} ({r.model}): mean pressure {r.p_mean:.6g} (exact "
             f"{r.p_exact:.6g}, {100 * (r.p_mean / r.p_exact - 1):+.3f} %)"
         )
+    lines += [p.text() for p in run.probes]
     e = run.estimate
     if e is not None:
         lines.append(

@@ -198,6 +198,40 @@ class LameErrors:
 
 
 @dataclass(frozen=True, kw_only=True)
+class ProbeResult:
+    """One probe's value (results/probes.py) and where it was read."""
+
+    name: str
+    kind: str  # ProbeKind's value
+    pair: int
+    value: float
+    at: tuple[float, float] | None  # the surface point (None for a window's mean)
+    s: float | None  # its arc length along the active surface
+    window: tuple[float, float] | None  # the arc-length window, if the probe has one
+    meaning: str
+
+    def text(self) -> str:
+        """One terminal line."""
+        where = "" if self.at is None else f" at ({self.at[0]:.6g}, {self.at[1]:.6g})"
+        if self.window is not None:
+            where += f" in s [{self.window[0]:.6g}, {self.window[1]:.6g}]"
+        return f"probe '{self.name}' (pair {self.pair}, {self.kind}): {self.value:.6g}{where}"
+
+    def to_json(self) -> dict[str, Any]:
+        """One entry of the JSON's `probes` list."""
+        return {
+            "name": self.name,
+            "type": self.kind,
+            "pair": self.pair,
+            "value": self.value,
+            "at": None if self.at is None else list(self.at),
+            "s": self.s,
+            "window": None if self.window is None else list(self.window),
+            "meaning": self.meaning,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
 class PatchErrors:
     """The patch test: max errors relative to the largest exact stress component."""
 
@@ -307,6 +341,7 @@ class RunSummary:
     patch: PatchErrors | None = None
     estimate: EstimateSummary | None = None
     lame: tuple[LameErrors, ...] = ()  # one per Lame reference
+    probes: tuple[ProbeResult, ...] = ()  # one per probe of the scene
 
     @property
     def contact_force(self) -> float:
@@ -350,6 +385,8 @@ class RunSummary:
             out["patch"] = self.patch.to_json()
         if self.lame:
             out["lame"] = [r.to_json() for r in self.lame]
+        if self.probes:
+            out["probes"] = [p.to_json() for p in self.probes]
         out["solver"] = self.solver
         if self.solver_choice is not None:
             out["solver_choice"] = self.solver_choice

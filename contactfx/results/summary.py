@@ -11,6 +11,7 @@ from ..options import Method, SolverSpec
 from ..request import SolveRequest
 from ..scenes import HertzReference, LameReference, UniformStress
 from .interface import cartesian_interface, contacts_summary
+from .probes import probe_value
 from .records import (
     ContactSummary,
     EstimateSummary,
@@ -18,6 +19,7 @@ from .records import (
     LameErrors,
     MethodExtras,
     PatchErrors,
+    ProbeResult,
     RunSummary,
 )
 from .references import hertz_summary, lame_summary, uniform_stress_errors
@@ -29,6 +31,7 @@ __all__ = [
     "LameErrors",
     "MethodExtras",
     "PatchErrors",
+    "ProbeResult",
     "RunSummary",
     "method_extras",
     "solver_label",
@@ -113,4 +116,5 @@ def summary(
         # The last uniform stress wins, as one `patch` block holds one.
         patch=patch[-1] if patch else None,
         lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
+        probes=tuple(probe_value(sol, p) for p in scene.probes),
     )
