@@ -55,10 +55,12 @@ def terminal_summary(run: RunSummary) -> list[str]:
             f"{h.p0_exact:.4g}, {100 * (h.p0 / h.p0_exact - 1):+.2f} %), "
             f"L2 error {100 * h.l2_error:.2f} %"
         )
+        lines.append(f"  against {h.description}, {h.validity}")
     for r in run.lame:
         lines.append(
             f"Lame, pair {r.pair} ({r.model}): mean pressure {r.p_mean:.6g} (exact "
             f"{r.p_exact:.6g}, {100 * (r.p_mean / r.p_exact - 1):+.3f} %)"
+            + ("" if r.exact else f"; {r.validity}")
         )
     lines += [p.text() for p in run.probes]
     e = run.estimate

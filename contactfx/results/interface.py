@@ -65,16 +65,15 @@ def curve_normals(surface: Surface) -> np.ndarray:
     x = surface.x
     for i, near in enumerate(nbrs):
         if len(near) == 2:
-            j, k = near
+            ordered = (near[0], i, near[1])
         elif len(near) == 1:
-            j = near[0]
-            further = [m for m in nbrs[j] if m != i]
+            further = [m for m in nbrs[near[0]] if m != i]
             if not further:
                 continue
-            k = further[0]
+            ordered = (i, near[0], further[0])
         else:
             continue
-        centre = circumcentre(x[i], x[j], x[k])
+        centre = circumcentre(*(x[m] for m in ordered))
         if centre is None:
             continue
         n = x[i] - centre
@@ -84,10 +83,10 @@ def curve_normals(surface: Surface) -> np.ndarray:
 
 
 def circumcentre(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> np.ndarray | None:
-    """Centre of the circle through p, q, r; None if they are collinear or turn sharply.
+    """Centre of the circle through p, q, r (in order along a curve), or None.
 
-    A turn of the two chords by more than 30 degrees is a corner of the polygon, not a
-    sampled curve: the facets' mean normal is kept there.
+    None where they are collinear, or where the chords turn at q by more than 30 degrees (a
+    corner of the polygon, not a sampled curve: the facets' mean normal is kept there).
     """
     u, v = q - p, r - p
     cross = u[0] * v[1] - u[1] * v[0]
@@ -119,11 +118,13 @@ def curve_radius(surface: Surface, point: np.ndarray) -> float:
     nbrs = neighbours(surface)
     i = int(np.argmin(np.linalg.norm(surface.x - point, axis=1)))
     near = nbrs[i]
-    if len(near) == 1:
-        near = near + [m for m in nbrs[near[0]] if m != i][:1]
-    if len(near) != 2:
+    if len(near) == 2:
+        ordered = (near[0], i, near[1])
+    elif len(near) == 1 and [m for m in nbrs[near[0]] if m != i]:
+        ordered = (i, near[0], next(m for m in nbrs[near[0]] if m != i))
+    else:
         return math.inf
-    centre = circumcentre(surface.x[i], surface.x[near[0]], surface.x[near[1]])
+    centre = circumcentre(*(surface.x[m] for m in ordered))
     return math.inf if centre is None else float(np.linalg.norm(surface.x[i] - centre))
 
 

@@ -133,6 +133,7 @@ class HertzErrors:
     P_source: str
     l2_error: float
     description: str = "plane-strain Hertz line contact (Johnson 4.2)"
+    window: str = "[0, 1.5 a]"  # the interval of the L2 error
     line_load: float | None = None  # a ring's (axisymmetric line contact): P / (2 pi r_c)
     a_over_radius: float = 0.0
     exact: bool = False

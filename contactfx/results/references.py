@@ -238,9 +238,18 @@ def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> HertzErro
             radial=contact is HertzContact.POINT,
         ),
         description=hertz_description(contact, scene.model),
+        window=HERTZ_WINDOWS[centre_mode(ref, scene.model)],
         line_load=line_load,
         a_over_radius=exact["a"] / radius,
     )
+
+
+# The interval of the L2 error, by where the centre is (centre_mode).
+HERTZ_WINDOWS = {
+    "axis": "[0, 1.5 a] of the radius (the contact disc, weighted by r)",
+    "end": "[0, 1.5 a] (half model)",
+    "moment": "[-1.5 a, 1.5 a] (full model)",
+}
 
 
 def hertz_description(contact: HertzContact, model: Model) -> str:

@@ -173,6 +173,11 @@ def table_lines(study: Study) -> list[str]:
             else ""
         )
     )
+    if study.reference.get("exact") is False:
+        lines.append(
+            f"the reference is {study.reference['validity']}: the errors and rates above "
+            "include its model error (they level off at it on fine meshes)"
+        )
     if study.reference["kind"] == "self":
         lines.append(f"rates: {study.reference['rates']} (study.json: runs[].successive)")
     for m, rates in study.rates.items():
