@@ -166,3 +166,25 @@ def test_window_mean_is_exact_for_piecewise_linear_data() -> None:
     num = (2.5**2 / 2 + 2.5**3 / 3) - (0.5**2 / 2 + 0.5**3 / 3)
     den = (2.5 + 2.5**2 / 2) - (0.5 + 0.5**2 / 2)
     assert window_mean(s, s, 1 + s, 0.5, 2.5) == pytest.approx(num / den, rel=1e-14)
+
+
+@pytest.mark.serial
+def test_study_names_the_sphere_and_says_hertz_is_approximate() -> None:
+    """`study` on the axisymmetric sphere labelled its reference "plane-strain Hertz line
+    contact" with no word that Hertz is only approximate for the scene. Now the block, its
+    JSON and the table say what it is, over which window, and that it is approximate."""
+    from mpi4py import MPI
+
+    from contactfx.study.core import run_study
+    from contactfx.study.levels import scene_file_levels
+    from contactfx.study.report import table_lines
+
+    levels = scene_file_levels(SCENES / "axi_sphere.toml", [4.0, 2.0], MPI.COMM_SELF)
+    study = run_study(levels, ["mortar"], comm=MPI.COMM_SELF, say=lambda line: None)
+    ref = study.to_json()["reference"]
+    assert ref["description"].startswith("Hertz point contact of a sphere")
+    assert "weighted by r" in ref["description"] and "line contact" not in ref["description"]
+    assert ref["exact"] is False and ref["validity"].startswith("approximate: half-space")
+    text = "\n".join(table_lines(study))
+    assert "reference: Hertz point contact of a sphere" in text
+    assert "the reference is approximate: half-space theory, a / R_min = 0.058" in text
