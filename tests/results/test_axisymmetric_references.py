@@ -135,6 +135,10 @@ def test_axisymmetric_forces_are_axial_and_per_radian() -> None:
     gives the axial force and the radial pressure's resultant per radian, which on the
     hub's cylindrical interface (r = b = 1, length 6) is -p_mean b L on the shaft. The
     terminal names them (before: `force (-474.0 * 2 pi, 0)`, a radial total over the turn)."""
+    _, sphere = run_scene(load_scene_file(SCENES / "axi_sphere.toml", size_factor=4.0), "mortar")
+    c = sphere.to_json()["contacts"][0]
+    assert c["force"][0] is None and c["axial_force"] == pytest.approx(100.0, rel=1e-9)
+    assert sphere.contact_force == pytest.approx(100.0, rel=1e-9)
     _, run = run_scene(load_scene_file(SCENES / "long_hub_axi.toml"), "mortar")
     c = run.to_json()["contacts"][0]
     assert c["force"][0] is None and c["force_passive"][0] is None
