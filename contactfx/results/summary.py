@@ -11,6 +11,7 @@ from ..options import Method, SolverSpec
 from ..request import SolveRequest
 from ..scenes import HertzReference, LameReference, UniformStress
 from .interface import cartesian_interface, contacts_summary
+from .lame import lame_summary
 from .probes import probe_value
 from .records import (
     ContactSummary,
@@ -22,7 +23,7 @@ from .records import (
     ProbeResult,
     RunSummary,
 )
-from .references import hertz_summary, lame_summary, uniform_stress_errors
+from .references import hertz_summary, uniform_stress_errors
 
 __all__ = [
     "ContactSummary",

@@ -26,8 +26,6 @@ from .model import (
     Model,
     Obstacle,
     Pressure,
-    Probe,
-    ProbeKind,
     Recipe,
     Reference,
     Scene,
@@ -36,6 +34,7 @@ from .model import (
     UniformStress,
     Units,
 )
+from .probe import Probe, ProbeKind
 from .scene_file import load_scene_file, parse_scene_file
 
 __all__ = [

@@ -30,13 +30,13 @@ from .model import (
     Material,
     Model,
     Obstacle,
-    Probe,
     Reference,
     Scene,
     SizeField,
     Units,
 )
 from .partition import body_strips, cell_arrays
+from .probe import Probe
 
 
 def _gmsh_node_coordinates() -> np.ndarray:

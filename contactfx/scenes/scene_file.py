@@ -26,8 +26,6 @@ from .model import (
     Model,
     Obstacle,
     Pressure,
-    Probe,
-    ProbeKind,
     Reference,
     Scene,
     Traction,
@@ -35,6 +33,7 @@ from .model import (
     Units,
 )
 from .obstacle import OBSTACLE_SHAPES
+from .probe import Probe, ProbeKind
 from .schema import SECTIONS, TYPE_ERRORS, allowed, required
 
 # The allowed keys of each section, from the one table the reference page is generated from.
