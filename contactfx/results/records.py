@@ -68,6 +68,16 @@ class ContactSummary:
         """|force| in a plane model; |axial force| in an axisymmetric one."""
         return abs(self.axial_force) if self.axisymmetric else float(np.hypot(*self.force))
 
+    @property
+    def components(self) -> tuple[float, float]:
+        """The two force components that exist, named by `component_names`."""
+        return (self.radial_per_radian, self.axial_force) if self.axisymmetric else self.force
+
+    @property
+    def component_names(self) -> tuple[str, str]:
+        """Plane: (x, y); axisymmetric: the radial resultant per radian and the axial force."""
+        return ("radial_per_radian", "axial") if self.axisymmetric else ("x", "y")
+
     def force_text(self) -> str:
         """The pair's forces for the terminal (axisymmetric: the components that exist)."""
         tail = f"balance {self.balance:.1e}, {self.active_nodes} active nodes"

@@ -76,7 +76,7 @@ def solve_one(
     times["total"] += mesh_time
     run.dofs, run.elements, run.iterations = record.dofs, record.elements, record.iterations
     run.times, run.summary, run.h = times, record, contact_size(record)
-    run.forces = [list(c.force) for c in record.contacts]
+    run.forces = [list(c.components) for c in record.contacts]
     if kind == "self":
         run.profiles = profiles(sol, record)
     else:

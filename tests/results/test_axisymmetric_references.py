@@ -173,15 +173,18 @@ def test_window_mean_is_exact_for_piecewise_linear_data() -> None:
 
 
 @pytest.mark.serial
-def test_study_names_the_sphere_and_says_hertz_is_approximate() -> None:
+def test_study_names_the_sphere_and_says_hertz_is_approximate(tmp_path: Path) -> None:
     """`study` on the axisymmetric sphere labelled its reference "plane-strain Hertz line
     contact" with no word that Hertz is only approximate for the scene. Now the block, its
-    JSON and the table say what it is, over which window, and that it is approximate."""
+    JSON and the table say what it is, over which window, and that it is approximate; the
+    CSV's force columns are the axial force and the radial resultant per radian."""
+    import csv
+
     from mpi4py import MPI
 
     from contactfx.study.core import run_study
     from contactfx.study.levels import scene_file_levels
-    from contactfx.study.report import table_lines
+    from contactfx.study.report import table_lines, write_study_csv
 
     levels = scene_file_levels(SCENES / "axi_sphere.toml", [4.0, 2.0], MPI.COMM_SELF)
     study = run_study(levels, ["mortar"], comm=MPI.COMM_SELF, say=lambda line: None)
@@ -192,3 +195,9 @@ def test_study_names_the_sphere_and_says_hertz_is_approximate() -> None:
     text = "\n".join(table_lines(study))
     assert "reference: Hertz point contact of a sphere" in text
     assert "the reference is approximate: half-space theory, a / R_min = 0.058" in text
+    with write_study_csv(study, tmp_path / "study.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert "force0_x" not in rows[0]
+    for row in rows:
+        assert float(row["force0_axial"]) == pytest.approx(100.0, rel=1e-9)
+        assert math.isfinite(float(row["force0_radial_per_radian"]))
