@@ -349,6 +349,7 @@ def from_gmsh(
     name: str | None = None,
     obstacles: list[Obstacle] | None = None,
     model: Model | str = Model.PLANE_STRAIN,
+    probes: list[Probe] | None = None,
 ) -> Scene:
     """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path.
 
@@ -366,6 +367,7 @@ def from_gmsh(
         name: The scene's label (default: the file's stem, or "gmsh-model").
         obstacles: Rigid obstacles (Obstacle), each against one curve group of a body.
         model: plane_strain (default), plane_stress or axisymmetric (x = r >= 0, y the axis).
+        probes: Values read off the solution (Probe), printed and in the JSON.
 
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
@@ -388,5 +390,6 @@ def from_gmsh(
         label,
         tuple(obstacles or ()),
         Model.parse(model),
+        probes=tuple(probes or ()),
     )
     return scene_from_gmsh(model_or_path, parts, comm)

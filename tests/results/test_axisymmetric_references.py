@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from contactfx import load_scene_file, run_scene
+from contactfx import ContactPair, load_scene_file, run_scene
 from contactfx.cli.solve import terminal_summary
 from contactfx.errors import InputError
+from contactfx.scenes import Dirichlet
 
 SCENES = ROOT / "tests" / "scenes"
 
@@ -201,3 +202,23 @@ def test_study_names_the_sphere_and_says_hertz_is_approximate(tmp_path: Path) ->
     for row in rows:
         assert float(row["force0_axial"]) == pytest.approx(100.0, rel=1e-9)
         assert math.isfinite(float(row["force0_radial_per_radian"]))
+
+
+@pytest.mark.serial
+def test_python_scene_takes_probes() -> None:
+    """contactfx.Probe in `scene_from_gmsh(..., probes=...)`: the same values as the file's."""
+    from contactfx import Probe, scene_from_gmsh
+
+    probe = Probe("mean_pressure", start=(1.0, 0.0), end=(1.0, 3.0), name="middle")
+    scene = scene_from_gmsh(
+        SCENES / "long_hub_axi.geo",
+        bodies={"shaft": {"E": 210000.0, "nu": 0.3}, "hub": {"E": 210000.0, "nu": 0.3}},
+        contacts=[ContactPair("shaft_contact", "hub_contact", 0.001)],
+        dirichlet=[Dirichlet("mid_plane", uy=0.0)],
+        model="axisymmetric",
+        probes=[probe],
+    )
+    (value,) = run_scene(scene, "mortar")[1].probes
+    assert value.value == pytest.approx(79.0059, rel=1e-3)
+    with pytest.raises(InputError, match="type 'pressure' takes `at`"):
+        Probe("pressure")
