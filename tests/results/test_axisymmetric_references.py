@@ -56,7 +56,7 @@ def test_sphere_is_measured_from_the_axis_with_or_without_symmetric(tmp_path: Pa
 
 @pytest.mark.serial
 def test_point_contact_needs_the_axisymmetric_model(tmp_path: Path) -> None:
-    """A plane model has no sphere: one line naming the model."""
+    """A plane model has no sphere, a ring's line contact no half model: one line each."""
     text = (
         (SCENES / "two_cylinders.toml")
         .read_text()
@@ -64,6 +64,9 @@ def test_point_contact_needs_the_axisymmetric_model(tmp_path: Path) -> None:
     )
     with pytest.raises(InputError, match="needs model = 'axisymmetric'"):
         load_scene_file(copy_scene(tmp_path, "two_cylinders", text))
+    ring = (SCENES / "oring_axi.toml").read_text().replace("R = 1.0", "R = 1.0\nsymmetric = true")
+    with pytest.raises(InputError, match="has no half model"):
+        load_scene_file(copy_scene(tmp_path, "oring_axi", ring))
 
 
 @pytest.mark.serial
