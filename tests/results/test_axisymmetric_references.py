@@ -56,7 +56,8 @@ def test_sphere_is_measured_from_the_axis_with_or_without_symmetric(tmp_path: Pa
 
 @pytest.mark.serial
 def test_point_contact_needs_the_axisymmetric_model(tmp_path: Path) -> None:
-    """A plane model has no sphere, a ring's line contact no half model: one line each."""
+    """A plane model has no sphere, a ring's line contact no half model, and a sphere's
+    surface reaches the axis: one line each."""
     text = (
         (SCENES / "two_cylinders.toml")
         .read_text()
@@ -67,6 +68,9 @@ def test_point_contact_needs_the_axisymmetric_model(tmp_path: Path) -> None:
     ring = (SCENES / "oring_axi.toml").read_text().replace("R = 1.0", "R = 1.0\nsymmetric = true")
     with pytest.raises(InputError, match="has no half model"):
         load_scene_file(copy_scene(tmp_path, "oring_axi", ring))
+    sphere = (SCENES / "oring_axi.toml").read_text().replace('contact = "line"\n', "")
+    with pytest.raises(InputError, match=r"stops at r = 9.5 \(a ring's contact: give contact"):
+        run_scene(load_scene_file(copy_scene(tmp_path, "oring_axi", sphere)), "mortar")
 
 
 @pytest.mark.serial
