@@ -54,6 +54,7 @@ class HertzErrors:
             "P": self.P,
             "P_source": self.P_source,
             "l2_error": self.l2_error,
+            "l2_window": self.window,
             "reference": self.description,
             **({} if self.line_load is None else {"line_load": self.line_load}),
             "exact": self.exact,

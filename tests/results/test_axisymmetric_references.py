@@ -51,6 +51,7 @@ def test_sphere_is_measured_from_the_axis_with_or_without_symmetric(tmp_path: Pa
         assert hz.l2_error == pytest.approx(0.051584, rel=1e-3)
         assert hz.s_centre == 0.0 and not hz.exact
         assert "point contact of a sphere" in hz.description
+        assert hz.to_json()["l2_window"].startswith("[0, 1.5 a] of the radius")
     assert runs[0].to_json() == runs[1].to_json()
 
 
