@@ -38,11 +38,7 @@ def terminal_summary(run: RunSummary) -> list[str]:
         f"total {run.times['total']:.2f} s"
     ]
     for k, c in enumerate(run.contacts):
-        f = c.force
-        lines.append(
-            f"pair {k} ({c.active} on {c.passive}): force ({f[0]:.6g}, "
-            f"{f[1]:.6g}), balance {c.balance:.1e}, {c.active_nodes} active nodes"
-        )
+        lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}")
     if run.patch is not None:
         lines.append(
             f"patch test: max stress/pressure error {run.patch.max:.2e} "
@@ -59,11 +55,14 @@ def terminal_summary(run: RunSummary) -> list[str]:
             f"{h.p0_exact:.4g}, {100 * (h.p0 / h.p0_exact - 1):+.2f} %), "
             f"L2 error {100 * h.l2_error:.2f} %"
         )
+        lines.append(f"  against {h.description}, {h.validity}")
     for r in run.lame:
         lines.append(
             f"Lame, pair {r.pair} ({r.model}): mean pressure {r.p_mean:.6g} (exact "
             f"{r.p_exact:.6g}, {100 * (r.p_mean / r.p_exact - 1):+.3f} %)"
+            + ("" if r.exact else f"; {r.validity}")
         )
+    lines += [p.text() for p in run.probes]
     e = run.estimate
     if e is not None:
         lines.append(

@@ -2,22 +2,30 @@
 
 Stresses are each body's own FE stress, averaged at the surface nodes over the adjacent
 cells. Each body's traction sigma.m (m its outward normal, the passive one's turned to point
-out of the active body) is resolved on the contact frame of PairView.frame: nu, the normal
-the multipliers act along (the passive surface's), and tau perpendicular to it (the
-direction of increasing arc length s along the active surface). On a frictionless contact
-sigma_nt then tends to 0 and sigma_nn to -p at the discretization's order also on curved
-pairs, where the active surface's own normal differs from nu by the slope (docs/hertz.md).
-The records are assembled in results/summary.py.
+out of the active body) is resolved on the contact frame of `report_frame`: nu, the passive
+surface's normal at the node's projection, and tau perpendicular to it (the direction of
+increasing arc length s along the active surface). On a frictionless contact sigma_nt then
+tends to 0 and sigma_nn to -p at the discretization's order also on curved pairs, where the
+active surface's own normal differs from nu by the slope (docs/hertz.md).
+
+The normals are those of the curve the polygon samples, not of its facets (`curve_normals`:
+the circle through a node and its neighbours): a facet's normal is off the curve's by up to
+half the facet's turn, and the shear read in it is the hoop stress difference times that
+angle (p dtheta / 2 on the active side of a frictionless ring fit, (sigma_tt + p) dtheta / 2
+on the passive side). The records are assembled in results/summary.py.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
+from ..contact.geometry import Surface, nodal_normals
 from ..contact.search import project
-from ..methods.solution import Solution
+from ..methods.solution import PairView, Solution
+from ..scenes import Model
 from .records import ContactSummary
 from .stress import nodal_stress, surface_stress
 
@@ -43,6 +51,110 @@ def resolve(
     return np.einsum("ki,ki->k", nu, tr), np.einsum("ki,ki->k", tau, tr)
 
 
+def curve_normals(surface: Surface) -> np.ndarray:
+    """Unit outward normal at each node of the curve through the surface's nodes, (n, 2).
+
+    The normal of the circle through the node and its two neighbours (at an end of a chain:
+    the next two nodes along it), oriented like the facets' mean normal, which it replaces
+    where the three points are collinear (a straight line, or a kink). On a circle it is the
+    radius at every node, ends included; on a line, the line's normal.
+    """
+    base = nodal_normals(surface)
+    out = base.copy()
+    nbrs = neighbours(surface)
+    x = surface.x
+    for i, near in enumerate(nbrs):
+        if len(near) == 2:
+            ordered = (near[0], i, near[1])
+        elif len(near) == 1:
+            further = [m for m in nbrs[near[0]] if m != i]
+            if not further:
+                continue
+            ordered = (i, near[0], further[0])
+        else:
+            continue
+        centre = circumcentre(*(x[m] for m in ordered))
+        if centre is None:
+            continue
+        n = x[i] - centre
+        n /= np.linalg.norm(n)
+        out[i] = n if n @ base[i] >= 0 else -n
+    return out
+
+
+def circumcentre(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> np.ndarray | None:
+    """Centre of the circle through p, q, r (in order along a curve), or None.
+
+    None where they are collinear, or where the chords turn at q by more than 30 degrees (a
+    corner of the polygon, not a sampled curve: the facets' mean normal is kept there).
+    """
+    u, v = q - p, r - p
+    cross = u[0] * v[1] - u[1] * v[0]
+    lu, lv = float(u @ u), float(v @ v)
+    if abs(cross) <= 1e-9 * lu**0.5 * lv**0.5:
+        return None
+    w, z = q - p, r - q
+    cos_turn = float(w @ z) / (np.linalg.norm(w) * np.linalg.norm(z))
+    if cos_turn < np.cos(np.pi / 6):
+        return None
+    d = 2.0 * cross
+    return p + np.array([v[1] * lu - u[1] * lv, u[0] * lv - v[0] * lu]) / d
+
+
+def neighbours(surface: Surface) -> list[list[int]]:
+    """The nodes each node shares a segment with."""
+    nbrs: list[list[int]] = [[] for _ in range(surface.n_nodes)]
+    for a, b in surface.segments:
+        nbrs[int(a)].append(int(b))
+        nbrs[int(b)].append(int(a))
+    return nbrs
+
+
+def curve_radius(surface: Surface, point: np.ndarray) -> float:
+    """The radius of the circle through the surface node nearest `point` and its neighbours.
+
+    inf where they are collinear (a straight surface) or the node has no two neighbours.
+    """
+    nbrs = neighbours(surface)
+    i = int(np.argmin(np.linalg.norm(surface.x - point, axis=1)))
+    near = nbrs[i]
+    if len(near) == 2:
+        ordered = (near[0], i, near[1])
+    elif len(near) == 1 and [m for m in nbrs[near[0]] if m != i]:
+        ordered = (i, near[0], next(m for m in nbrs[near[0]] if m != i))
+    else:
+        return math.inf
+    centre = circumcentre(*(surface.x[m] for m in ordered))
+    return math.inf if centre is None else float(np.linalg.norm(surface.x[i] - centre))
+
+
+def report_frame(pv: PairView) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(n, nu, tau): the active curve's normal at each row's node and the contact frame.
+
+    nu is the passive curve's normal at the node's projection (`curve_normals` interpolated
+    along the facet and normalized), turned to point out of the active body; against a rigid
+    obstacle its exact normal; beyond the passive surface's end the active curve's normal.
+    tau is perpendicular to nu, along increasing s. On a straight passive surface nu is
+    PairView.frame's (the direction the multipliers act along).
+    """
+    n = curve_normals(pv.active.surface)[pv.nodes]
+    facet_nu, _, found = pv.frame
+    if pv.passive is None:
+        nu = facet_nu
+    else:
+        surf = pv.passive.surface
+        seg, xi, _ = project(pv.x, surf)
+        ends = surf.segments[seg]
+        cn = curve_normals(surf)
+        m = (1 - xi)[:, None] * cn[ends[:, 0]] + xi[:, None] * cn[ends[:, 1]]
+        m /= np.linalg.norm(m, axis=1)[:, None]
+        nu = np.where(found[:, None], -m, n)
+    t = pv.t
+    tau = t - np.einsum("ki,ki->k", t, nu)[:, None] * nu
+    tau /= np.linalg.norm(tau, axis=1)[:, None]
+    return n, nu, tau
+
+
 def none_if_nan(v: np.ndarray) -> list[float | None]:
     """The values as floats, None where not finite (JSON has no NaN)."""
     return [None if not np.isfinite(x) else float(x) for x in v]
@@ -59,7 +171,7 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     """pair_interface, computed (collective)."""
     pv = sol.pairs[k]
     rows = pv.rows
-    n, x, s = pv.n, pv.x, pv.s
+    x, s = pv.x, pv.s
     gn_a, _, sig_a = nodal_stress(sol, pv.pair.active)
     sa = sig_a[np.searchsorted(gn_a, pv.gblock)]
     sp = np.full_like(sa, np.nan)  # a rigid obstacle has no stress of its own
@@ -71,7 +183,7 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
         ends = surf_p.segments[seg]
         sp = (1 - xi)[:, None, None] * at_node[ends[:, 0]] + xi[:, None, None] * at_node[ends[:, 1]]
         sp[~found] = np.nan  # beyond the passive surface's end there is no value
-    nu, tau, _ = pv.frame
+    n, nu, tau = report_frame(pv)
     nn_a, nt_a = resolve(sa, n, nu, tau)
     nn_p, nt_p = resolve(sp, nu, nu, tau)
     order = np.argsort(s, kind="stable")
@@ -115,6 +227,8 @@ def contacts_summary(sol: Solution) -> tuple[ContactSummary, ...]:
                 interface=pair_interface(sol, k),
                 obstacle=pv.obstacle,
                 initial_overlap=pv.initial_overlap,
+                axisymmetric=sol.scene.model is Model.AXISYMMETRIC,
+                fit=bool(pv.pair.interference),
             )
         )
     return tuple(out)

@@ -7,6 +7,7 @@ study and the adaptive loop read its attributes. Its `to_json()` is the schema o
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -15,6 +16,10 @@ import numpy as np
 from ..options import Discretization, Enforcement, Method
 from ..scenes import Obstacle, Units
 from .obstacles import obstacle_json
+from .reference_records import HertzErrors as HertzErrors
+from .reference_records import LameErrors as LameErrors
+from .reference_records import PatchErrors as PatchErrors
+from .reference_records import ProbeResult as ProbeResult
 
 # The JSON's `estimate.norm`: what the relative values are relative to.
 ESTIMATE_NORM = (
@@ -26,7 +31,15 @@ ESTIMATE_NORM = (
 
 @dataclass(frozen=True, kw_only=True)
 class ContactSummary:
-    """One contact pair's results: its names, forces, counts and interface columns."""
+    """One contact pair's results: its names, forces, counts and interface columns.
+
+    `force` is the sum of the pair's nodal forces. In an axisymmetric scene these are totals
+    over the turn, and the x sum is no force (the radial forces of a body of revolution
+    cancel): the records give the axial force (y, total over the turn) and the radial
+    pressure's resultant per radian, int p n_r r ds (twice it is the force that splits the
+    ring across a diametral plane: for a fit of radius b and length L, 2 p b L). The x
+    component of `force` is then written as null (docs/models.md, "Forces").
+    """
 
     active: str
     passive: str
@@ -41,106 +54,76 @@ class ContactSummary:
     interface: dict[str, list[Any]]
     obstacle: Obstacle | None = None
     initial_overlap: float = 0.0  # max over the pair's nodes of -gap before the solve
+    axisymmetric: bool = False
+    fit: bool = False  # the pair is an interference fit
+
+    @property
+    def axial_force(self) -> float:
+        """Axisymmetric: the force along the axis on the active body, total over the turn."""
+        return self.force[1]
+
+    @property
+    def radial_per_radian(self) -> float:
+        """Axisymmetric: the radial pressure's resultant per radian on the active body."""
+        return self.force[0] / (2.0 * math.pi)
+
+    @property
+    def magnitude(self) -> float:
+        """|force| in a plane model; |axial force| in an axisymmetric one."""
+        return abs(self.axial_force) if self.axisymmetric else float(np.hypot(*self.force))
+
+    @property
+    def components(self) -> tuple[float, float]:
+        """The two force components that exist, named by `component_names`."""
+        return (self.radial_per_radian, self.axial_force) if self.axisymmetric else self.force
+
+    @property
+    def component_names(self) -> tuple[str, str]:
+        """Plane: (x, y); axisymmetric: the radial resultant per radian and the axial force."""
+        return ("radial_per_radian", "axial") if self.axisymmetric else ("x", "y")
+
+    def force_text(self) -> str:
+        """The pair's forces for the terminal (axisymmetric: the components that exist)."""
+        tail = f"balance {self.balance:.1e}, {self.active_nodes} active nodes"
+        if not self.axisymmetric:
+            return f"force ({self.force[0]:.6g}, {self.force[1]:.6g}), {tail}"
+        text = (
+            f"axial force {self.axial_force:.6g} (total over the turn), radial resultant "
+            f"{self.radial_per_radian:.6g} per radian"
+        )
+        if self.fit and self.force[0] != 0.0:
+            share = abs(self.axial_force / self.force[0])
+            text += (
+                f" (a fit's axial force is {100 * share:.2g} % of its radial load: none "
+                "on a frictionless cylinder, the rest is the discretization's)"
+            )
+        return f"{text}, {tail}"
 
     def to_json(self) -> dict[str, Any]:
         """The pair's entry of the JSON's `contacts` list."""
+        force: list[float | None] = list(self.force)
+        force_passive: list[float | None] = list(self.force_passive)
+        if self.axisymmetric:
+            force[0] = force_passive[0] = None  # no radial force: see the class docstring
         out: dict[str, Any] = {
             "active": self.active,
             "passive": self.passive,
             "active_body": self.active_body,
             "passive_body": self.passive_body,
-            "force": list(self.force),
-            "force_passive": list(self.force_passive),
+            "force": force,
+            "force_passive": force_passive,
             "balance": self.balance,
             "multipliers": self.multipliers,
             "active_nodes": self.active_nodes,
             "initial_overlap": self.initial_overlap,
             "interface": self.interface,
         }
+        if self.axisymmetric:
+            out["axial_force"] = self.axial_force
+            out["radial_force_per_radian"] = self.radial_per_radian
         if self.obstacle is not None:
             out["obstacle"] = obstacle_json(self.obstacle)
         return out
-
-
-@dataclass(frozen=True, kw_only=True)
-class HertzErrors:
-    """One pair against plane-strain Hertz: fitted and bracketed half-width, p0, L2 error."""
-
-    pair: int
-    s_centre: float  # arc length of the contact centre r is measured from
-    a: float | None  # fitted half-width (None if the fit fails)
-    a_bracket: tuple[float, float | None]  # last active and first inactive |r|
-    a_exact: float
-    p0: float
-    p0_exact: float
-    E_star: float
-    P: float
-    P_source: str
-    l2_error: float
-
-    def to_json(self) -> dict[str, Any]:
-        """The JSON's `hertz` block."""
-        return {
-            "pair": self.pair,
-            "s_centre": self.s_centre,
-            "a": self.a,
-            "a_bracket": list(self.a_bracket),
-            "a_exact": self.a_exact,
-            "p0": self.p0,
-            "p0_exact": self.p0_exact,
-            "E_star": self.E_star,
-            "P": self.P,
-            "P_source": self.P_source,
-            "l2_error": self.l2_error,
-        }
-
-
-@dataclass(frozen=True, kw_only=True)
-class LameErrors:
-    """One pair against Lame's shrink-fit pressure (docs/models.md, "Lame")."""
-
-    pair: int
-    model: str
-    inner: str  # the inner ring's body
-    outer: str
-    delta: float
-    p_mean: float  # the pair's mean contact pressure: sum p_j w_j / sum w_j
-    p_exact: float
-    error: float  # |p_mean / p_exact - 1|
-    active_fraction: float  # active rows / rows of the pair
-
-    def to_json(self) -> dict[str, Any]:
-        """One entry of the JSON's `lame` list."""
-        return {
-            "pair": self.pair,
-            "model": self.model,
-            "inner": self.inner,
-            "outer": self.outer,
-            "delta": self.delta,
-            "p_mean": self.p_mean,
-            "p_exact": self.p_exact,
-            "error": self.error,
-            "active_fraction": self.active_fraction,
-        }
-
-
-@dataclass(frozen=True, kw_only=True)
-class PatchErrors:
-    """The patch test: max errors relative to the largest exact stress component."""
-
-    sigma: tuple[tuple[float, float], tuple[float, float]]  # the exact uniform stress
-    bodies: dict[str, float]
-    pairs: tuple[dict[str, float], ...]  # pressure and sigma_* columns per pair
-    max: float
-
-    def to_json(self) -> dict[str, Any]:
-        """The JSON's `patch` block."""
-        return {
-            "sigma": [list(row) for row in self.sigma],
-            "bodies": self.bodies,
-            "pairs": list(self.pairs),
-            "max": self.max,
-        }
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -234,11 +217,12 @@ class RunSummary:
     patch: PatchErrors | None = None
     estimate: EstimateSummary | None = None
     lame: tuple[LameErrors, ...] = ()  # one per Lame reference
+    probes: tuple[ProbeResult, ...] = ()  # one per probe of the scene
 
     @property
     def contact_force(self) -> float:
-        """Magnitude of the first pair's force: the paper's scenes have one pair."""
-        return float(np.linalg.norm(self.contacts[0].force))
+        """Magnitude of the first pair's force (axisymmetric: its axial force's)."""
+        return self.contacts[0].magnitude
 
     def with_estimate(self, estimate: EstimateSummary) -> RunSummary:
         """The same summary with the error estimate attached."""
@@ -277,6 +261,8 @@ class RunSummary:
             out["patch"] = self.patch.to_json()
         if self.lame:
             out["lame"] = [r.to_json() for r in self.lame]
+        if self.probes:
+            out["probes"] = [p.to_json() for p in self.probes]
         out["solver"] = self.solver
         if self.solver_choice is not None:
             out["solver_choice"] = self.solver_choice

@@ -2,14 +2,20 @@
 
 Hertz is the plane line contact (a cylinder, force per unit thickness) in plane strain and
 plane stress (E* from the model's effective moduli: E/(1 - nu^2) in plane strain, E in plane
-stress), and the point contact of a sphere (3D, total force) in an axisymmetric model, whose
-L2 error weights the pressure by r (the integral over the contact disc).
+stress), and in an axisymmetric model the point contact of a sphere (3D, total force), whose
+L2 error weights the pressure by r (the integral over the contact disc), or a ring's line
+contact (`contact = "line"`: the line load is the total force over 2 pi r_c).
 
 Hertz, for one pair: half-width, peak and the L2 error of the pressure. The distance r from
 the contact centre is measured along the active surface's tangent at the centre (the
-tangent-plane coordinate of Hertz's theory). For a half model (`symmetric`) the centre is the
-end of the active surface nearest the pressure peak; otherwise the pressure's own centre along
-the arc length: the first moment of the piecewise-linear pressure (`pressure_centre`).
+tangent-plane coordinate of Hertz's theory). A sphere's centre is on the axis (r is the
+radius); for a half model (`symmetric`) the centre is the end of the active surface nearest
+the pressure peak; otherwise the pressure's own centre along the arc length: the first
+moment of the piecewise-linear pressure (`pressure_centre`).
+
+Each record says whether its reference is exact for the scene (the patch test's uniform
+stress; Lame's rings in a plane model, results/lame.py) or approximate (Hertz's half-space
+theory).
 """
 
 from __future__ import annotations
@@ -19,11 +25,20 @@ import math
 import numpy as np
 from mpi4py import MPI
 
+from ..contact.geometry import Surface
 from ..errors import InputError
 from ..methods.solution import Solution
-from ..scenes import HertzReference, LameReference, Material, Model, Scene, UniformStress
-from .interface import pair_forces, pair_interface, resolve
-from .records import HertzErrors, LameErrors, PatchErrors
+from ..scenes import (
+    HertzContact,
+    HertzReference,
+    Material,
+    Model,
+    Scene,
+    UniformStress,
+)
+from .interface import curve_radius, pair_forces, pair_interface, report_frame, resolve
+from .lame import lame_pressure as lame_pressure  # where tests and scripts found it
+from .records import HertzErrors, PatchErrors
 from .stress import body_vertex_stress
 
 
@@ -81,13 +96,18 @@ def effective_modulus(mats: list[Material], model: Model) -> float:
     return 1.0 / sum((1 - m.nu**2) / m.E for m in mats)
 
 
-def hertz_values(e_star: float, R: float, P: float, model: Model) -> dict[str, float]:
+def hertz_values(
+    e_star: float, R: float, P: float, contact: HertzContact | Model
+) -> dict[str, float]:
     """E*, a and p0 of Hertz's contact under the load P.
 
-    Cylinder (plane models, P per unit thickness): a = sqrt(4 P R/(pi E*)), p0 = 2 P/(pi a).
-    Sphere (axisymmetric, P the total force): a = (3 P R/(4 E*))^(1/3), p0 = 3 P/(2 pi a^2).
+    Line (a cylinder, P per unit length): a = sqrt(4 P R/(pi E*)), p0 = 2 P/(pi a).
+    Point (a sphere, P the total force): a = (3 P R/(4 E*))^(1/3), p0 = 3 P/(2 pi a^2).
+    A model stands for its default contact (axisymmetric: the point).
     """
-    if model is Model.AXISYMMETRIC:
+    if isinstance(contact, Model):
+        contact = HertzContact.POINT if contact is Model.AXISYMMETRIC else HertzContact.LINE
+    if contact is HertzContact.POINT:
         a = (3 * P * R / (4 * e_star)) ** (1.0 / 3.0)
         return {"E_star": e_star, "a": a, "p0": 3 * P / (2 * math.pi * a * a)}
     a = math.sqrt(4 * P * R / (math.pi * e_star))
@@ -104,7 +124,14 @@ def reference_values(scene: Scene, ref: HertzReference, P: float) -> dict[str, f
     else:
         groups = [scene.contacts[ref.pair].active, scene.contacts[ref.pair].passive]
     mats = [scene.body_of_curve(g).material for g in groups]
-    return hertz_values(effective_modulus(mats, scene.model), ref.R, P, scene.model)
+    return hertz_values(effective_modulus(mats, scene.model), ref.R, P, ref.contact_in(scene.model))
+
+
+def centre_mode(ref: HertzReference, model: Model) -> str:
+    """Where the contact centre is: "axis" (a sphere), "end" (a half model) or "moment"."""
+    if ref.contact_in(model) is HertzContact.POINT:
+        return "axis"
+    return "end" if ref.symmetric else "moment"
 
 
 def computed_load(sol: Solution, ref: HertzReference, tangent: np.ndarray) -> float:
@@ -115,8 +142,25 @@ def computed_load(sol: Solution, ref: HertzReference, tangent: np.ndarray) -> fl
     """
     force = pair_forces(sol, ref.pair)[0]
     normal = np.array([-tangent[1], tangent[0]])
-    halved = ref.symmetric and sol.scene.model is not Model.AXISYMMETRIC
+    halved = centre_mode(ref, sol.scene.model) == "end"
     return float(abs(force @ normal) * (2.0 if halved else 1.0))
+
+
+def axis_node(surf: Surface, s_all: np.ndarray, pair: int) -> int:
+    """The active surface's node on the axis (x = 0): a sphere's contact centre.
+
+    InputError if the surface does not reach the axis (a ring's contact is a line).
+    """
+    ok = np.isfinite(s_all)
+    extent = float(np.ptp(surf.x[ok], axis=0).max()) if ok.any() else 0.0
+    node = int(np.argmin(np.where(ok, np.abs(surf.x[:, 0]), np.inf)))
+    if abs(surf.x[node, 0]) > 1e-6 * max(extent, 1e-300):
+        raise InputError(
+            f"hertz reference (pair {pair}): a sphere's contact centre is on the axis, but "
+            f"the pair's active surface stops at r = {surf.x[node, 0]:.4g} (a ring's "
+            'contact: give contact = "line")'
+        )
+    return node
 
 
 def centre_distance(
@@ -124,7 +168,8 @@ def centre_distance(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
     """(r, pressure, active, tc, sc) of the pair's multipliers, r signed along the centre's tangent.
 
-    tc is that tangent (unit), sc the centre's arc length s along the active surface.
+    tc is that tangent (unit), sc the centre's arc length s along the active surface. A
+    sphere (axisymmetric): r is the radius x, tc the radial direction (1, 0).
     """
     pv = sol.pairs[ref.pair]
     rows = pv.rows
@@ -134,7 +179,11 @@ def centre_distance(
     s, p = s_all[node], sol.pressure[rows]
     order = np.argsort(s, kind="stable")
     s, p, node, act = s[order], p[order], node[order], sol.active[rows][order]
-    if ref.symmetric:
+    mode = centre_mode(ref, sol.scene.model)
+    if mode == "axis":
+        centre_node = axis_node(surf, s_all, ref.pair)
+        return surf.x[node, 0].copy(), p, act, np.array([1.0, 0.0]), float(s_all[centre_node])
+    if mode == "end":
         peak = s[int(np.argmax(p))]
         ends = np.array([np.nanmin(s_all), np.nanmax(s_all)])
         centre_node = int(np.nanargmin(np.abs(s_all - ends[np.argmin(np.abs(ends - peak))])))
@@ -145,7 +194,7 @@ def centre_distance(
         tc = np.array([np.interp(sc, s, t_all[node, d]) for d in (0, 1)])
         tc /= np.linalg.norm(tc)
     r = (surf.x[node] - xc) @ tc
-    if ref.symmetric and np.any(p > 0) and np.median(r[p > 0]) < 0:
+    if mode == "end" and np.any(p > 0) and np.median(r[p > 0]) < 0:
         r = -r  # the centre is the end of largest s: measure into the surface
     return r, p, act, tc, sc
 
@@ -154,9 +203,16 @@ def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> HertzErro
     """The pair's errors against Hertz: fitted and bracketed half-width, p0 and the L2 error."""
     if ref is None:
         ref = next(r for r in sol.scene.references if isinstance(r, HertzReference))
+    scene = sol.scene
+    contact = ref.contact_in(scene.model)
     r, p, act, tc, sc = centre_distance(sol, ref)
     load = ref.P if ref.P is not None else computed_load(sol, ref, tc)
-    exact = reference_values(sol.scene, ref, load)
+    xc = centre_point(sol, ref, sc)
+    line_load = None
+    if contact is HertzContact.LINE and scene.model is Model.AXISYMMETRIC:
+        line_load = load / (2.0 * math.pi * xc[0])  # the total over the turn, per length
+    exact = reference_values(scene, ref, load if line_load is None else line_load)
+    radius = surface_radius(sol, ref, xc)
     order = np.argsort(r, kind="stable")
     r, p, act = r[order], p[order], act[order]
     ra = np.abs(r[act])
@@ -178,10 +234,59 @@ def hertz_summary(sol: Solution, ref: HertzReference | None = None) -> HertzErro
             p,
             exact["a"],
             exact["p0"],
-            both_sides=not ref.symmetric,
-            radial=sol.scene.model is Model.AXISYMMETRIC,
+            both_sides=centre_mode(ref, scene.model) == "moment",
+            radial=contact is HertzContact.POINT,
         ),
+        description=hertz_description(contact, scene.model),
+        window=HERTZ_WINDOWS[centre_mode(ref, scene.model)],
+        line_load=line_load,
+        a_over_radius=exact["a"] / radius,
     )
+
+
+# The interval of the L2 error, by where the centre is (centre_mode).
+HERTZ_WINDOWS = {
+    "axis": "[0, 1.5 a] of the radius (the contact disc, weighted by r)",
+    "end": "[0, 1.5 a] (half model)",
+    "moment": "[-1.5 a, 1.5 a] (full model)",
+}
+
+
+def hertz_description(contact: HertzContact, model: Model) -> str:
+    """What the Hertz reference is in this model, in words (terminal, JSON, study)."""
+    if contact is HertzContact.POINT:
+        return "Hertz point contact of a sphere (Johnson 3.4; axisymmetric, P the total force)"
+    if model is Model.AXISYMMETRIC:
+        return (
+            "Hertz line contact of a ring (Johnson 4.2 on a torus section; axisymmetric, "
+            "the line load P / (2 pi r_c))"
+        )
+    return f"{model.value.replace('_', '-')} Hertz line contact (Johnson 4.2)"
+
+
+def centre_point(sol: Solution, ref: HertzReference, sc: float) -> np.ndarray:
+    """The contact centre's point: on the active surface at arc length sc."""
+    pv = sol.pairs[ref.pair]
+    s_all = pv.arc[0]
+    ok = np.flatnonzero(np.isfinite(s_all))
+    order = ok[np.argsort(s_all[ok], kind="stable")]
+    x = pv.active.surface.x
+    return np.array([np.interp(sc, s_all[order], x[order, d]) for d in (0, 1)])
+
+
+def surface_radius(sol: Solution, ref: HertzReference, xc: np.ndarray) -> float:
+    """The smaller radius of the two surfaces at the contact centre (inf if both are flat).
+
+    Hertz's theory holds for a small against it (and against the bodies' size): a / R_min
+    is the record's measure of how approximate the reference is.
+    """
+    pv = sol.pairs[ref.pair]
+    radii = [curve_radius(pv.active.surface, xc)]
+    if pv.passive is not None:
+        radii.append(curve_radius(pv.passive.surface, xc))
+    elif pv.obstacle is not None and pv.obstacle.radius is not None:
+        radii.append(float(pv.obstacle.radius))
+    return min(radii)
 
 
 def _max_error(values: list[float | None], exact: np.ndarray, scale: float) -> float:
@@ -203,10 +308,10 @@ def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
     for k, pv in enumerate(sol.pairs):
         itf = pair_interface(sol, k)
         order = np.argsort(pv.s, kind="stable")
-        nu, tau, _ = (v[order] for v in pv.frame)
+        n, nu, tau = (v[order] for v in report_frame(pv))
         sig = np.broadcast_to(sigma, (len(nu), 2, 2))
         # The exact values of the columns: each side's traction in the contact frame.
-        nn_a, nt_a = resolve(sig, pv.n[order], nu, tau)
+        nn_a, nt_a = resolve(sig, n, nu, tau)
         nn_p, nt_p = resolve(sig, nu, nu, tau)
         exact = {"nn_active": nn_a, "nn_passive": nn_p, "nt_active": nt_a, "nt_passive": nt_p}
         sides = ("active",) if pv.obstacle is not None else ("active", "passive")
@@ -227,76 +332,4 @@ def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
         bodies=bodies,
         pairs=tuple(pairs),
         max=max([*bodies.values(), *(v for p in pairs for v in p.values())]),
-    )
-
-
-def lame_pressure(
-    a: float,
-    b: float,
-    c: float,
-    delta: float,
-    inner: tuple[float, float],
-    outer: tuple[float, float],
-    model: Model,
-) -> float:
-    """Lame's shrink-fit contact pressure of rings a..b (inner) and b..c (outer).
-
-    Plane stress (Shigley's Mechanical Engineering Design, sec. 3-16, "Press and Shrink
-    Fits"; Lame's thick cylinder, Timoshenko & Goodier, ch. 4):
-    p = delta / (b [(1/E_o)((c^2 + b^2)/(c^2 - b^2) + nu_o)
-                    + (1/E_i)((b^2 + a^2)/(b^2 - a^2) - nu_i)]),
-    `inner` and `outer` the (E, nu) of the rings; plane strain by E -> E/(1 - nu^2),
-    nu -> nu/(1 - nu).
-    """
-    if model is Model.AXISYMMETRIC:
-        raise InputError("lame reference: the shrink fit of rings is plane strain or plane stress")
-
-    def plane(E: float, nu: float) -> tuple[float, float]:
-        return (E / (1 - nu**2), nu / (1 - nu)) if model is Model.PLANE_STRAIN else (E, nu)
-
-    (Ei, nui), (Eo, nuo) = plane(*inner), plane(*outer)
-    compliance = ((c**2 + b**2) / (c**2 - b**2) + nuo) / Eo
-    compliance += ((b**2 + a**2) / (b**2 - a**2) - nui) / Ei
-    return delta / (b * compliance)
-
-
-def lame_summary(sol: Solution, ref: LameReference) -> LameErrors:
-    """The pair's mean contact pressure against Lame's (InputError if the pair is no fit)."""
-    scene = sol.scene
-    if ref.pair >= len(scene.contacts):
-        raise InputError(f"lame reference: pair {ref.pair} is not a [[contact]] pair")
-    pair = scene.contacts[ref.pair]
-    delta = ref.delta if ref.delta is not None else pair.prescribed_overlap
-    if not delta > 0:
-        raise InputError(
-            f"lame reference: give delta (pair {ref.pair} has no interference = D to take it from)"
-        )
-    pv = sol.pairs[ref.pair]
-    # The active surface's outward normal points away from the centre on the inner ring.
-    radial = float(np.mean(np.einsum("kd,kd->k", pv.n, pv.x - np.asarray(ref.center))))
-    assert pv.passive_body is not None  # a [[contact]] pair joins two bodies
-    inner, outer = (
-        (pv.active_body, pv.passive_body) if radial > 0 else (pv.passive_body, pv.active_body)
-    )
-    w = sol.layout.weights[pv.rows]
-    p_mean = float(np.sum(sol.pressure[pv.rows] * w) / np.sum(w))
-    exact = lame_pressure(
-        ref.a,
-        ref.b,
-        ref.c,
-        delta,
-        (inner.material.E, inner.material.nu),
-        (outer.material.E, outer.material.nu),
-        scene.model,
-    )
-    return LameErrors(
-        pair=ref.pair,
-        model=scene.model.value,
-        inner=inner.name,
-        outer=outer.name,
-        delta=delta,
-        p_mean=p_mean,
-        p_exact=exact,
-        error=abs(p_mean / exact - 1.0),
-        active_fraction=float(np.mean(sol.active[pv.rows])) if len(pv.rows) else 0.0,
     )

@@ -11,6 +11,8 @@ from ..options import Method, SolverSpec
 from ..request import SolveRequest
 from ..scenes import HertzReference, LameReference, UniformStress
 from .interface import cartesian_interface, contacts_summary
+from .lame import lame_summary
+from .probes import probe_value
 from .records import (
     ContactSummary,
     EstimateSummary,
@@ -18,9 +20,10 @@ from .records import (
     LameErrors,
     MethodExtras,
     PatchErrors,
+    ProbeResult,
     RunSummary,
 )
-from .references import hertz_summary, lame_summary, uniform_stress_errors
+from .references import hertz_summary, uniform_stress_errors
 
 __all__ = [
     "ContactSummary",
@@ -29,6 +32,7 @@ __all__ = [
     "LameErrors",
     "MethodExtras",
     "PatchErrors",
+    "ProbeResult",
     "RunSummary",
     "method_extras",
     "solver_label",
@@ -113,4 +117,5 @@ def summary(
         # The last uniform stress wins, as one `patch` block holds one.
         patch=patch[-1] if patch else None,
         lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
+        probes=tuple(probe_value(sol, p) for p in scene.probes),
     )

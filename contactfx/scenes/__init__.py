@@ -18,6 +18,7 @@ from .model import (
     ContactPair,
     Dirichlet,
     Groups,
+    HertzContact,
     HertzReference,
     LameReference,
     Load,
@@ -33,6 +34,7 @@ from .model import (
     UniformStress,
     Units,
 )
+from .probe import Probe, ProbeKind
 from .scene_file import load_scene_file, parse_scene_file
 
 __all__ = [
@@ -45,6 +47,7 @@ __all__ = [
     "Dirichlet",
     "GeoRecipe",
     "Groups",
+    "HertzContact",
     "HertzParams",
     "HertzReference",
     "LameReference",
@@ -53,6 +56,8 @@ __all__ = [
     "Model",
     "Obstacle",
     "Pressure",
+    "Probe",
+    "ProbeKind",
     "Recipe",
     "Reference",
     "Scene",

@@ -12,7 +12,7 @@ import numpy as np
 from mpi4py import MPI
 
 from ..errors import InputError, MeshError
-from .model import Body, LameReference, Model, Scene
+from .model import Body, HertzReference, LameReference, Model, Scene
 
 
 def _global_count(scene: Scene, local: int) -> int:
@@ -117,8 +117,6 @@ def _check_lame(scene: Scene, ref: LameReference) -> None:
         raise InputError(
             f"lame reference: give delta (pair {ref.pair} has no interference = D to take it from)"
         )
-    if scene.model is Model.AXISYMMETRIC:
-        raise InputError("lame reference: the shrink fit of rings is plane strain or plane stress")
 
 
 def _check_conditions(scene: Scene) -> None:
@@ -138,13 +136,16 @@ def _check_conditions(scene: Scene) -> None:
         values = [load.p] if hasattr(load, "p") else list(load.t)
         if not all(math.isfinite(float(v)) for v in values):
             raise InputError(f"load on '{load.group}': values must be finite")
-    for ref in scene.references:
+    for ref in [*scene.references, *scene.probes]:
         pair = getattr(ref, "pair", 0)
         if isinstance(ref, LameReference):
             _check_lame(scene, ref)
+        if isinstance(ref, HertzReference):
+            ref.contact_in(scene.model)
         if not 0 <= pair < len(scene.contacts) + len(scene.obstacles):
+            what = "probe" if ref in scene.probes else "reference"
             raise InputError(
-                f"reference: pair {pair} does not exist (the scene has "
+                f"{what}: pair {pair} does not exist (the scene has "
                 f"{len(scene.contacts)} contact pairs and {len(scene.obstacles)} obstacles)"
             )
 

@@ -57,7 +57,7 @@ def check_interference(value: bool | float, where: str) -> bool | float:
 
 @dataclass(frozen=True)
 class LameReference:
-    """Lame's shrink fit of two concentric rings on one pair (plane strain or plane stress).
+    """Lame's shrink fit of two concentric rings on one pair (any model; axisymmetric: open ends).
 
     The inner ring a..b, the outer ring b..c, both centred at `center`; `delta` the radial
     interference (None: the pair's `interference = D`). Which body is the inner ring is read

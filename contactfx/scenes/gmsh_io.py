@@ -36,6 +36,7 @@ from .model import (
     SizeField,
     Units,
 )
+from .probe import Probe
 
 
 def _gmsh_node_coordinates() -> np.ndarray:
@@ -276,6 +277,7 @@ class SceneParts:
     obstacles: tuple[Obstacle, ...] = ()
     model: Model = Model.PLANE_STRAIN
     units: Units = field(default_factory=Units)
+    probes: tuple[Probe, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -347,6 +349,7 @@ def scene_from_parts(
         obstacles=parts.obstacles,
         model=parts.model,
         units=parts.units,
+        probes=parts.probes,
     )
     return check_scene(scene)
 
@@ -380,6 +383,7 @@ def scene_from_gmsh(
     name: str | None = None,
     obstacles: list[Obstacle] | None = None,
     model: Model | str = Model.PLANE_STRAIN,
+    probes: list[Probe] | None = None,
 ) -> Scene:
     """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path.
 
@@ -397,6 +401,7 @@ def scene_from_gmsh(
         name: The scene's label (default: the file's stem, or "gmsh-model").
         obstacles: Rigid obstacles (Obstacle), each against one curve group of a body.
         model: plane_strain (default), plane_stress or axisymmetric (x = r >= 0, y the axis).
+        probes: Values read off the solution (Probe), printed and in the JSON.
 
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
@@ -419,5 +424,6 @@ def scene_from_gmsh(
         label,
         tuple(obstacles or ()),
         Model.parse(model),
+        probes=tuple(probes or ()),
     )
     return scene_from_parts(model_or_path, parts, comm)

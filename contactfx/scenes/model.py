@@ -21,6 +21,7 @@ from ..errors import InputError, MeshError
 from ..meshes import GridLines
 from .fits import LameReference, check_interference, check_thermal
 from .obstacle import Obstacle
+from .probe import Probe
 
 
 class Model(StrEnum):
@@ -151,24 +152,63 @@ class Traction:
 Load = Pressure | Traction
 
 
+class HertzContact(StrEnum):
+    """Which of Hertz's contacts a reference is: a cylinder's line or a sphere's point."""
+
+    LINE = "line"
+    POINT = "point"
+
+
 @dataclass(frozen=True)
 class HertzReference:
     """Hertz contact on one pair: effective radius R, full load P.
 
-    The line contact of a cylinder (P per unit thickness) in plane strain and plane stress;
-    the point contact of a sphere (P the total force) in an axisymmetric scene.
+    `contact` None (the default) takes the model's: the line contact of a cylinder (P per
+    unit thickness) in plane strain and plane stress, the point contact of a sphere (P the
+    total force; its centre is on the axis) in an axisymmetric scene. `contact = "line"` in
+    an axisymmetric scene is a ring's line contact on a torus section (an O-ring between
+    plates): P the total force over the turn, the line load P / (2 pi r_c) at the contact
+    centre's radius r_c. A plane model has no point contact (InputError).
 
     `P` None (omitted): the load is the pair's computed contact force (twice it for a half
     model), which is what a displacement-controlled scene knows. `symmetric`: the model is a
     half model cut through the contact centre (which is then the end of the active surface
     nearest the symmetry line); otherwise (the default, in Python and in scene files alike)
     the centre is the first moment of the piecewise-linear pressure along the arc length.
+    The sphere of an axisymmetric scene is measured from the axis with or without it (the
+    axis is the symmetry line); a ring's line contact has no such cut (InputError).
     """
 
     pair: int
     R: float
     P: float | None = None
     symmetric: bool = False
+    contact: HertzContact | None = None
+
+    def __post_init__(self) -> None:
+        if self.contact is not None:
+            try:
+                object.__setattr__(self, "contact", HertzContact(self.contact))
+            except ValueError:
+                raise InputError(
+                    f"hertz reference: contact must be 'line' or 'point' (got {self.contact!r})"
+                ) from None
+
+    def contact_in(self, model: Model) -> HertzContact:
+        """The contact this reference is in `model` (InputError where it has none)."""
+        axi = model is Model.AXISYMMETRIC
+        kind = self.contact or (HertzContact.POINT if axi else HertzContact.LINE)
+        if kind is HertzContact.POINT and not axi:
+            raise InputError(
+                f"hertz reference (pair {self.pair}): contact = 'point' is a sphere's, which "
+                f"needs model = 'axisymmetric' ({model.value} is a cylinder's line contact)"
+            )
+        if kind is HertzContact.LINE and axi and self.symmetric:
+            raise InputError(
+                f"hertz reference (pair {self.pair}): a ring's line contact in an axisymmetric "
+                "scene has no half model (drop symmetric; the centre is read off the pressure)"
+            )
+        return kind
 
 
 @dataclass(frozen=True)
@@ -283,6 +323,7 @@ class Scene:
     units: Units = field(default_factory=Units)
     # The lines of a structured mesh (its coarser grids: a geometric multigrid's levels).
     grid: GridLines | None = field(default=None, compare=False, repr=False)
+    probes: tuple[Probe, ...] = ()  # values read off the solution (results/probes.py)
 
     @property
     def comm(self) -> MPI.Comm:

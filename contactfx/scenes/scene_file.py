@@ -19,6 +19,7 @@ from .gmsh_io import SceneParts, scene_from_parts
 from .model import (
     ContactPair,
     Dirichlet,
+    HertzContact,
     HertzReference,
     LameReference,
     Load,
@@ -33,6 +34,7 @@ from .model import (
     Units,
 )
 from .obstacle import OBSTACLE_SHAPES, Shape
+from .probe import Probe, ProbeKind
 from .schema import SECTIONS, TYPE_ERRORS, allowed, required
 
 # The allowed keys of each section, from the one table the reference page is generated from.
@@ -146,7 +148,7 @@ def _material(body: str, table: Any) -> Material:
     return mat
 
 
-def _reference(k: int, entry: Any) -> Reference:
+def _reference(k: int, entry: Any, model: Model | None = None) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
     if kind not in ("hertz", "uniform_stress", "lame"):
         raise InputError(
@@ -171,7 +173,13 @@ def _reference(k: int, entry: Any) -> Reference:
         P = _number(f"{where}.P", e["P"]) if "P" in e else None
         if R <= 0 or (P is not None and P <= 0):
             raise InputError(f"{where}: R and P must be positive")
-        return HertzReference(pair, R, P, **flags)
+        contact = e.get("contact")
+        if contact is not None and contact not in tuple(HertzContact):
+            raise InputError(f'{where}: contact must be "line" or "point" (got {contact!r})')
+        ref = HertzReference(pair, R, P, **flags, contact=contact)
+        if model is not None:
+            ref.contact_in(model)  # a point contact needs the axisymmetric model
+        return ref
     e = _section(where, entry, "reference.uniform_stress")
     s = e["sigma"]
     if not (
@@ -182,6 +190,25 @@ def _reference(k: int, entry: Any) -> Reference:
     if sig[0][1] != sig[1][0]:
         raise InputError(f"{where}: sigma must be symmetric")
     return UniformStress(sig)  # type: ignore[arg-type]
+
+
+def _probe(k: int, entry: Any) -> Probe:
+    """A `[[probe]]` table: a value read off one pair (model.Probe)."""
+    kind = entry.get("type") if isinstance(entry, dict) else None
+    if kind not in tuple(ProbeKind):
+        choices = ", ".join(f"'{p.value}'" for p in ProbeKind)
+        raise InputError(f"probe {k}: type must be one of {choices} (got {kind!r})")
+    where = f"probe {k} ({kind})"
+    e = _section(where, entry, "probe")
+    pair = e.get("pair", 0)
+    if isinstance(pair, bool) or not isinstance(pair, int):
+        raise InputError(
+            f"{where}: pair: {TYPE_ERRORS['integer']} into [[contact]], then [[obstacle]]"
+        )
+    points = {key: _vector(f"{where}.{key}", e[key]) for key in ("at", "start", "end") if key in e}
+    name = _string(f"{where}.name", e["name"]) if "name" in e else ""
+    side = _string(f"{where}.side", e.get("side", "active"))
+    return Probe(ProbeKind(kind), pair, side=side, name=name, **points)
 
 
 def _units(table: Any) -> Units:
@@ -248,7 +275,8 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
                 (_number(f"traction {k}.t", t[0]), _number(f"traction {k}.t", t[1])),
             )
         )
-    refs = [_reference(k, e) for k, e in enumerate(_entries(doc, "reference"))]
+    refs = [_reference(k, e, model) for k, e in enumerate(_entries(doc, "reference"))]
+    probes = [_probe(k, e) for k, e in enumerate(_entries(doc, "probe"))]
     obstacles = [_obstacle(k, e) for k, e in enumerate(_entries(doc, "obstacle"))]
     parts = SceneParts(
         bodies,
@@ -260,6 +288,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         tuple(obstacles),
         model,
         units,
+        tuple(probes),
     )
     return mesh, parts
 

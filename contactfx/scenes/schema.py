@@ -69,6 +69,7 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("pressure", "tables", "none", "normal pressures on curve groups"),
         Key("traction", "tables", "none", "traction vectors on curve groups"),
         Key("reference", "tables", "none", "analytic references the run is checked against"),
+        Key("probe", "tables", "none", "values read off a pair: printed and in the JSON"),
     ),
     "bodies": (
         Key("E", "number", None, "Young's modulus", "E <= 0"),
@@ -101,11 +102,30 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("t", "vector", None, "traction vector [tx, ty], force per unit length"),
     ),
     "reference.hertz": (
-        Key("type", "string", None, '"hertz": plane-strain Hertz line contact on one pair'),
+        Key(
+            "type",
+            "string",
+            None,
+            '"hertz": Hertz on one pair (a line contact in a plane model, a sphere in an '
+            "axisymmetric one)",
+        ),
         Key("pair", "integer", "0", "index into [[contact]], then the [[obstacle]]s"),
         Key("R", "number", None, "effective radius, 1/R = 1/R1 + 1/R2", "R <= 0"),
         Key("P", "number", "the pair's force", "line load of the full contact", "P <= 0"),
-        Key("symmetric", "bool", "false", "a half model cut through the contact centre"),
+        Key(
+            "symmetric",
+            "bool",
+            "false",
+            "a half model cut through the contact centre (a sphere's is the axis: either)",
+            "with a ring's line contact",
+        ),
+        Key(
+            "contact",
+            "string",
+            "the model's",
+            '"line" (a cylinder; axisymmetric: a ring, P over 2 pi r_c) or "point" (a sphere)',
+            '"point" in a plane model',
+        ),
     ),
     "reference.lame": (
         Key("type", "string", None, '"lame": a shrink fit of two concentric rings'),
@@ -115,6 +135,15 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("c", "number", None, "outer radius of the outer ring"),
         Key("delta", "number", "the pair's interference D", "radial interference"),
         Key("center", "vector", "[0, 0]", "the rings' centre"),
+    ),
+    "probe": (
+        Key("type", "string", None, '"pressure", "mean_pressure" or "peak_sigma_nn"'),
+        Key("pair", "integer", "0", "index into [[contact]], then the [[obstacle]]s"),
+        Key("name", "string", "its type and pair", "label in the terminal and the JSON"),
+        Key("at", "vector", "none", "pressure: the surface point nearest [x, y]", "elsewhere"),
+        Key("start", "vector", "none", "mean_pressure, peak_sigma_nn: the window's first end"),
+        Key("end", "vector", "none", "mean_pressure, peak_sigma_nn: the window's other end"),
+        Key("side", "string", '"active"', "peak_sigma_nn: whose FE stress", "not active/passive"),
     ),
     "reference.uniform_stress": (
         Key("type", "string", None, '"uniform_stress": a patch test'),

@@ -28,7 +28,7 @@ def write_study_csv(study: Study, path: Path) -> Path:
     """Write study.csv: one row per run, sizes, times and every error as columns."""
     size_keys = list(dict.fromkeys(k for lv in study.levels for k in lv.sizes))
     pairs = max((len(r.forces) for r in study.runs if r.forces), default=0)
-    force_keys = [f"force{k}_{c}" for k in range(pairs) for c in "xy"]
+    force_keys = [f"force{k}_{c}" for k in range(pairs) for c in force_names(study)]
     succ = study.reference["kind"] == "self"
     head = [
         "method",
@@ -72,6 +72,14 @@ def write_study_csv(study: Study, path: Path) -> Path:
                 ]
             )
     return path
+
+
+def force_names(study: Study) -> tuple[str, str]:
+    """The names of the force columns: x, y; axisymmetric: radial_per_radian, axial."""
+    for r in study.runs:
+        if r.summary is not None and r.summary.contacts:
+            return r.summary.contacts[0].component_names
+    return ("x", "y")
 
 
 def _forces(run: Run, pairs: int) -> list[float | None]:
@@ -173,6 +181,11 @@ def table_lines(study: Study) -> list[str]:
             else ""
         )
     )
+    if study.reference.get("exact") is False:
+        lines.append(
+            f"the reference is {study.reference['validity']}: the errors and rates above "
+            "include its model error (they level off at it on fine meshes)"
+        )
     if study.reference["kind"] == "self":
         lines.append(f"rates: {study.reference['rates']} (study.json: runs[].successive)")
     for m, rates in study.rates.items():

@@ -30,7 +30,8 @@ class Run:
     errors: dict[str, float | None] = field(default_factory=dict)
     # Self-convergence: the differences from the same method's next finer level.
     successive: dict[str, float | None] = field(default_factory=dict)
-    forces: list[list[float]] | None = None  # the contact force [fx, fy] of every pair
+    # Every pair's [fx, fy]; axisymmetric: [radial resultant per radian, axial force].
+    forces: list[list[float]] | None = None
     summary: RunSummary | None = field(default=None, repr=False)
     profiles: Profiles | None = field(default=None, repr=False)
 

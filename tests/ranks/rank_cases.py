@@ -199,7 +199,7 @@ def axisymmetric_sphere() -> tuple[Solution, Arrays]:
         **u_split(sol),
         "x": np.asarray(c["interface"]["x"]),
         "p": np.asarray(c["interface"]["pressure"]),
-        "f": np.asarray(c["force"]),
+        "f": np.asarray([c["axial_force"], c["radial_force_per_radian"]]),
         "a": np.asarray(data["hertz"]["a"]),
     }
 

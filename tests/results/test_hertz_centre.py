@@ -19,6 +19,7 @@ import pytest
 from conftest import ROOT
 
 from contactfx import load_scene_file, run_scene
+from contactfx.contact.geometry import Surface
 from contactfx.options import Method
 from contactfx.results.references import exact_pressure, hertz_summary
 from contactfx.scenes import HertzReference, Model, Units
@@ -41,13 +42,22 @@ def brute_l2(x: np.ndarray, p: np.ndarray, a: float, p0: float) -> float:
 
 def straight_pair(s: np.ndarray, p: np.ndarray, E: float, nu: float) -> SimpleNamespace:
     """A stand-in Solution: one pair whose active surface is the x axis, nodes at x = s."""
-    surface = SimpleNamespace(x=np.column_stack([s, np.zeros_like(s)]))
-    tangent = np.tile([1.0, 0.0], (len(s), 1))
+    n = len(s)
+    seg = np.column_stack([np.arange(n - 1), np.arange(1, n)])
+    surface = Surface(
+        np.column_stack([s, np.zeros_like(s)]),
+        seg,
+        np.tile([0.0, -1.0], (n - 1, 1)),
+        np.zeros((n, 2), dtype=np.int64),
+    )
+    tangent = np.tile([1.0, 0.0], (n, 1))
     pair = SimpleNamespace(
-        rows=np.arange(len(s)),
-        nodes=np.arange(len(s)),
+        rows=np.arange(n),
+        nodes=np.arange(n),
         arc=(s.copy(), tangent),
         active=SimpleNamespace(surface=surface),
+        passive=None,
+        obstacle=None,
     )
     body = SimpleNamespace(material=SimpleNamespace(E=E, nu=nu))
     scene = SimpleNamespace(

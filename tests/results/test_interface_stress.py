@@ -21,6 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from conftest import ROOT
 from matplotlib.figure import Figure
 from mpi4py import MPI
 
@@ -124,3 +125,44 @@ def test_pair_chart_zooms_on_the_contact_zone_without_a_reference(
         length = zone[1] - zone[0]
         assert zone[0] - 0.6 * length <= lo <= zone[0] and zone[1] <= hi <= zone[1] + 0.6 * length
         assert hi - lo < 0.25 * (coord.max() - coord.min()), (lo, hi)
+
+
+def test_curve_normals_are_the_circle_radii_ends_included() -> None:
+    """On a graded polygon inscribed in a circle, every node's normal is the radius (the
+    facets' mean normal is off it by up to half a facet's turn, at the ends by exactly it);
+    on a straight line, the line's normal."""
+    from contactfx.contact.geometry import Surface
+    from contactfx.results.interface import curve_normals
+
+    theta = np.pi / 2 * np.linspace(0.0, 1.0, 13) ** 1.3
+    x = 2.0 * np.column_stack([np.cos(theta), np.sin(theta)])
+    seg = np.column_stack([np.arange(12), np.arange(1, 13)])
+    d = x[seg[:, 1]] - x[seg[:, 0]]
+    normals = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
+    surf = Surface(x, seg, normals, np.zeros((13, 2), dtype=np.int64))
+    np.testing.assert_allclose(curve_normals(surf), x / 2.0, atol=1e-12)
+    line = Surface(
+        np.column_stack([np.linspace(0, 1, 5), np.zeros(5)]),
+        seg[:4],
+        np.tile([0.0, -1.0], (4, 1)),
+        np.zeros((5, 2), dtype=np.int64),
+    )
+    np.testing.assert_allclose(curve_normals(line), np.tile([0.0, -1.0], (5, 1)), atol=0)
+
+
+@pytest.mark.serial
+def test_frictionless_ring_fit_reports_no_shear() -> None:
+    """The shaft-hub fit (48 cells on both quarter arcs, frictionless): sigma_nt within
+    0.5 % of the mean pressure at every node of both sides. Read in the facets' frame it was
+    exactly p dtheta / 2 = 1.62 % on the active side and (sigma_tt + p) dtheta / 2 = 4.19 %
+    on the passive (the hub's hoop stress 1.67 p); in the curve's frame, measured 0.11 %
+    (the active side's end nodes) and 4e-7."""
+    from contactfx import load_scene_file, run_scene
+
+    _, run = run_scene(load_scene_file(ROOT / "demos" / "scenes" / "shaft_hub.toml"), "mortar")
+    itf = run.contacts[0].interface
+    p = column(itf, "pressure").mean()
+    for side in ("active", "passive"):
+        nt = column(itf, f"sigma_nt_{side}")
+        assert np.isfinite(nt).sum() >= 47, side  # of 49 nodes; an end projects off the hub
+        assert np.nanmax(np.abs(nt)) < 0.005 * p, (side, np.nanmax(np.abs(nt)) / p)

@@ -63,17 +63,20 @@ def test_time_axis_includes_meshing() -> None:
 
 def test_missing_half_width_says_why() -> None:
     from contactfx.cli.solve import terminal_summary
+    from contactfx.results.records import ContactSummary, HertzErrors
 
     h = SimpleNamespace(
-        pair=0, a=None, a_exact=0.7585, p0=10.0, p0_exact=10.5, l2_error=0.1, a_bracket=(0.5, 1)
-    )
-    contact = SimpleNamespace(
-        force=(0.0, 1.0), active="a", passive="b", balance=0.0, active_nodes=3
-    )
+        pair=0, a=None, a_exact=0.7585, p0=10.0, p0_exact=10.5, l2_error=0.1, a_bracket=(0.5, 1),
+        description=HertzErrors.description, validity="approximate",
+    )  # fmt: skip
+    contact = ContactSummary(
+        active="a", passive="b", active_body="A", passive_body="B", force=(0.0, 1.0),
+        force_passive=(0.0, -1.0), balance=0.0, multipliers=3, active_nodes=3, interface={},
+    )  # fmt: skip
     run: Any = SimpleNamespace(
         scene="hertz", method=SimpleNamespace(value="mortar"), dofs=10, multipliers=3,
         iterations=2, times={"total": 1.0}, contacts=[contact], patch=None, hertz=[h],
-        estimate=None, lame=(),
+        estimate=None, lame=(), probes=(),
     )  # fmt: skip
     line = next(ln for ln in terminal_summary(run) if ln.startswith("Hertz"))
     assert "nan" not in line and "a: n/a (3 active nodes" in line, line

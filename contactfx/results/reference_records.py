@@ -1,0 +1,149 @@
+"""The records of a run's checks: Hertz, Lame, the patch test, and the probes' values.
+
+Each writes its JSON with `to_json()`; RunSummary (records.py) holds them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+
+@dataclass(frozen=True, kw_only=True)
+class HertzErrors:
+    """One pair against Hertz: fitted and bracketed half-width, p0, L2 error.
+
+    Hertz is never exact for a finite model (a half-space theory, a small against the
+    surfaces' radii and the bodies' size): `exact` is False and `a_over_radius` (a over the
+    smaller surface radius at the centre) says how far the scene is from the theory.
+    """
+
+    pair: int
+    s_centre: float  # arc length of the contact centre r is measured from
+    a: float | None  # fitted half-width (None if the fit fails)
+    a_bracket: tuple[float, float | None]  # last active and first inactive |r|
+    a_exact: float
+    p0: float
+    p0_exact: float
+    E_star: float
+    P: float
+    P_source: str
+    l2_error: float
+    description: str = "plane-strain Hertz line contact (Johnson 4.2)"
+    window: str = "[0, 1.5 a]"  # the interval of the L2 error
+    line_load: float | None = None  # a ring's (axisymmetric line contact): P / (2 pi r_c)
+    a_over_radius: float = 0.0
+    exact: bool = False
+
+    @property
+    def validity(self) -> str:
+        """Why the reference is approximate, in words."""
+        return f"approximate: half-space theory, a / R_min = {self.a_over_radius:.3g}"
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON's `hertz` block."""
+        return {
+            "pair": self.pair,
+            "s_centre": self.s_centre,
+            "a": self.a,
+            "a_bracket": list(self.a_bracket),
+            "a_exact": self.a_exact,
+            "p0": self.p0,
+            "p0_exact": self.p0_exact,
+            "E_star": self.E_star,
+            "P": self.P,
+            "P_source": self.P_source,
+            "l2_error": self.l2_error,
+            "l2_window": self.window,
+            "reference": self.description,
+            **({} if self.line_load is None else {"line_load": self.line_load}),
+            "exact": self.exact,
+            "validity": self.validity,
+            "a_over_radius": self.a_over_radius,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class LameErrors:
+    """One pair against Lame's shrink-fit pressure (docs/models.md, "Lame")."""
+
+    pair: int
+    model: str
+    inner: str  # the inner ring's body
+    outer: str
+    delta: float
+    p_mean: float  # the pair's mean contact pressure: sum p_j w_j / sum w_j
+    p_exact: float
+    error: float  # |p_mean / p_exact - 1|
+    active_fraction: float  # active rows / rows of the pair
+    exact: bool = True  # False: Lame's is approximate for the scene (validity says why)
+    validity: str = ""
+
+    def to_json(self) -> dict[str, Any]:
+        """One entry of the JSON's `lame` list."""
+        return {
+            "pair": self.pair,
+            "model": self.model,
+            "inner": self.inner,
+            "outer": self.outer,
+            "delta": self.delta,
+            "p_mean": self.p_mean,
+            "p_exact": self.p_exact,
+            "error": self.error,
+            "active_fraction": self.active_fraction,
+            "exact": self.exact,
+            "validity": self.validity,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class ProbeResult:
+    """One probe's value (results/probes.py) and where it was read."""
+
+    name: str
+    kind: str  # ProbeKind's value
+    pair: int
+    value: float
+    at: tuple[float, float] | None  # the surface point (None for a window's mean)
+    s: float | None  # its arc length along the active surface
+    window: tuple[float, float] | None  # the arc-length window, if the probe has one
+    meaning: str
+
+    def text(self) -> str:
+        """One terminal line."""
+        where = "" if self.at is None else f" at ({self.at[0]:.6g}, {self.at[1]:.6g})"
+        if self.window is not None:
+            where += f" in s [{self.window[0]:.6g}, {self.window[1]:.6g}]"
+        return f"probe '{self.name}' (pair {self.pair}, {self.kind}): {self.value:.6g}{where}"
+
+    def to_json(self) -> dict[str, Any]:
+        """One entry of the JSON's `probes` list."""
+        return {
+            "name": self.name,
+            "type": self.kind,
+            "pair": self.pair,
+            "value": self.value,
+            "at": None if self.at is None else list(self.at),
+            "s": self.s,
+            "window": None if self.window is None else list(self.window),
+            "meaning": self.meaning,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class PatchErrors:
+    """The patch test: max errors relative to the largest exact stress component."""
+
+    sigma: tuple[tuple[float, float], tuple[float, float]]  # the exact uniform stress
+    bodies: dict[str, float]
+    pairs: tuple[dict[str, float], ...]  # pressure and sigma_* columns per pair
+    max: float
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON's `patch` block."""
+        return {
+            "sigma": [list(row) for row in self.sigma],
+            "bodies": self.bodies,
+            "pairs": list(self.pairs),
+            "max": self.max,
+        }
