@@ -269,19 +269,21 @@ def _adapt_parser(sub: Any) -> None:
     a = s.add_argument_group("adaptivity")
     a.add_argument(
         "--goal",
-        default="pressure",
+        default=None,
         choices=[*GOALS, "residual"],
         help="the quantity --tol bounds: pressure (relative L2 error of the contact "
-        "pressure, default), energy (energy-norm error), force (each pair's contact force); "
-        "each level's estimate is a second solve on a refined mesh (docs/adapt.md). "
-        "residual: the residual estimate's loop (uncalibrated; the expert flags' loop)",
+        "pressure), energy (energy-norm error), force (each pair's contact force); each "
+        "level's estimate is a second solve on a refined mesh (docs/adapt.md). residual: the "
+        "residual estimate (uncalibrated, no second solve). Default: pressure, or energy "
+        "where the scene's pressure is singular (its peak grows like a singular edge's over "
+        "two refinements: a flat punch, a press fit's hub edges); the log and adapt.json "
+        "say which",
     )
     a.add_argument(
         "--tol",
         type=float,
         default=None,
-        help="relative error of the goal to reach (default 0.01; with --goal residual the "
-        "relative residual estimate, default 0.05)",
+        help="relative error of the goal to reach (default 0.01; 0.05 for --goal residual)",
     )
     a.add_argument(
         "--max-dofs",
@@ -295,7 +297,7 @@ def _adapt_parser(sub: Any) -> None:
         type=float,
         default=None,
         help="expert: most cells of a level relative to the previous one, > 1 (default: planned "
-        "from the goal estimate's observed rate and the budget left; 4 with --goal residual)",
+        "from the goal estimate's observed rate and the budget left; 4 for --goal residual)",
     )
     a.add_argument(
         "--weight-contact",
@@ -303,7 +305,7 @@ def _adapt_parser(sub: Any) -> None:
         default=None,
         metavar="W",
         help="expert: size the next mesh with each cell's contact terms times W (the "
-        "estimate itself is unweighted; default 1; with --goal residual 10, or 1 with "
+        "estimate itself is unweighted; default 1; for --goal residual 10, or 1 with "
         "--pressure-tol, whose sizing does that better)",
     )
     a.add_argument(
@@ -311,9 +313,9 @@ def _adapt_parser(sub: Any) -> None:
         type=float,
         default=None,
         metavar="P",
-        help="expert, --goal residual: also size the cells along the contact surfaces for "
-        "a relative L2 pressure indicator of P, and stop only when it is met too "
-        "(docs/adapt.md; the goal loop aims it at half the error it plans for)",
+        help="expert, --goal residual only: also size the cells along the contact surfaces "
+        "for a relative L2 pressure indicator of P, and stop only when it is met too "
+        "(docs/adapt.md; the pressure goal aims it at half the error it plans for)",
     )
     a.add_argument(
         "--compare-uniform",

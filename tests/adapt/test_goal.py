@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import contactfx
+from contactfx.adapt.curves import peak_exponent, singular_growth, two_node_peak
 from contactfx.adapt.goal import (
     Goal,
     GoalUnbounded,
@@ -108,7 +109,7 @@ def test_singular_pressure_is_refused() -> None:
     """A rigid flat punch: the peak grows like 1/sqrt, the L2 goal does not exist."""
     scene = contactfx.load_scene_file("demos/scenes/rigid_punch.toml")
     sol = contactfx.solve(scene, "nts")
-    with pytest.raises(GoalUnbounded, match="--goal force or --goal energy"):
+    with pytest.raises(GoalUnbounded, match="--goal energy or --goal force"):
         goal_estimate(sol, Goal.PRESSURE, options={})
 
 
@@ -120,3 +121,43 @@ def test_hertz_energy_effectivity() -> None:
     assert true is not None
     g = goal_estimate(sol, Goal.ENERGY)
     assert 1.0 <= g.relative / true["relative"] <= 3.0, (g.relative, true)
+
+
+def _sampled(profile, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """A pressure profile on [0, 1] sampled every h (the edge at s = 1)."""
+    s = np.arange(0.0, 1.0 + h / 2, h)
+    return s, profile(s)
+
+
+def test_one_spiking_node_is_not_a_peak() -> None:
+    """Hertz-like sqrt(1 - s^2) with one node x 1000 (a node beside the end of a passive
+    surface): the peak two neighbours carry is the smooth one, and stays bounded on three
+    meshes though the spike grows on one refinement only."""
+    peaks = []
+    for k, h in enumerate([0.1, 0.05, 0.025]):
+        s, p = _sampled(lambda s: np.sqrt(np.maximum(1.0 - s * s, 0.0)), h)
+        if k == 1:
+            p[len(p) // 2] *= 1000.0
+        peak, _ = two_node_peak(s, p)
+        assert peak <= 1.0
+        peaks.append((float(np.max(p)), h))  # the one-node peak would say singular ...
+    assert peak_exponent(peaks[0], peaks[1]) > 5 and singular_growth(peaks) is None
+    assert (
+        singular_growth([two_node_peak(*_sampled(np.cos, h)) for h in (0.1, 0.05, 0.025)]) is None
+    )
+
+
+def test_growth_over_two_refinements_is_singular() -> None:
+    """A flat punch's 1/sqrt edge: the peak grows like h^-1/2 on both refinements."""
+    edge = lambda s: 1.0 / np.sqrt(np.maximum(1.0 - s, 0.0) + 1e-300)  # noqa: E731
+    peaks = []
+    for h in (0.1, 0.05, 0.025):
+        s, p = _sampled(edge, h)
+        p[-1] = 1e3 / h  # the corner node itself: whatever the method makes of it
+        peaks.append(two_node_peak(s, p))
+    exponents = singular_growth(peaks)
+    assert exponents is not None and exponents == pytest.approx([0.5, 0.5], abs=0.05)
+    # One refinement is not enough to judge.
+    assert singular_growth(peaks[:2]) is None
+    # Growth on one refinement, none on the next: bounded.
+    assert singular_growth([peaks[0], peaks[1], (peaks[1][0], peaks[2][1])]) is None

@@ -125,12 +125,14 @@ def test_obstacles_and_three_bodies(scene: str, goal: str, tmp_path: Path) -> No
     assert len(levels) == 2 and 0 < levels[1]["estimate"] < levels[0]["estimate"]
 
 
-def test_unbounded_pressure_says_what_to_use(tmp_path: Path) -> None:
-    """The flat punch's 1/sqrt corner: one line naming the goals that exist, exit 2."""
+def test_unbounded_pressure_asked_for_says_what_to_use(tmp_path: Path) -> None:
+    """The flat punch's 1/sqrt corner with --goal pressure (asked for, not the default): one
+    line naming the goals that exist, exit 2; `solve --estimate` likewise."""
     punch = str(SCENES / "rigid_punch.toml")
-    proc = cli("adapt", punch, "--out", str(tmp_path / "o"))
+    proc = cli("adapt", punch, "--goal", "pressure", "--out", str(tmp_path / "o"))
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
     assert "--goal energy" in proc.stderr and "Traceback" not in proc.stderr
+    assert "over two refinements" in proc.stderr
     assert not (tmp_path / "o").exists()
     proc = cli("solve", punch, "--estimate", "--json", str(tmp_path / "r.json"))
     assert proc.returncode == 2 and "--goal energy" in proc.stderr
