@@ -2,7 +2,7 @@
 
 The pressure goal (adapt/goal.py) compares two solutions' pressures in L2
 (`pressure_difference`, exact for piecewise-linear curves) and judges whether the pressure
-is singular from its peak over successive refinements (`singular_growth`).
+is singular from its peak (`window_peak`) over successive refinements (`singular_growth`).
 """
 
 from __future__ import annotations
@@ -19,8 +19,10 @@ from ..methods.solution import PairView
 # peak (Hertz) tends to 0. One refinement is not enough to judge: a node that falls beside
 # the end of a passive surface can jump by orders of magnitude on one mesh and not the next.
 SINGULAR_EXPONENT = 0.15
-# The smallest refinement of the peak's segment that gives an exponent (h ratio).
+# The smallest refinement of the peak's segments that gives an exponent (h ratio).
 MIN_REFINEMENT = 1.2
+# The peak is the mean pressure over this many segments (`window_peak`).
+WINDOW = 4
 
 
 def pressure_curve(pv: PairView, pressure: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -68,24 +70,29 @@ def pressure_difference(
 
 
 def pair_peak(pv: PairView, pressure: np.ndarray) -> tuple[float, float]:
-    """(peak, h) of the pair's pressure along its surface (`two_node_peak`)."""
+    """(peak, h) of the pair's pressure along its surface (`window_peak`)."""
     s, p, _ = pressure_curve(pv, pressure)
-    return two_node_peak(s, p)
+    return window_peak(s, p)
 
 
-def two_node_peak(s: np.ndarray, p: np.ndarray) -> tuple[float, float]:
-    """(peak, h): the largest pressure two neighbouring nodes both carry, and their distance.
+def window_peak(s: np.ndarray, p: np.ndarray, m: int = WINDOW) -> tuple[float, float]:
+    """(peak, h): the largest mean pressure over m consecutive segments, and their mean length.
 
-    `s` sorted arc lengths, `p` the nodal pressures. The smaller of two neighbours,
-    maximized along the surface: a single node's spike (a node beside the end of a passive
-    surface) is not a peak; a singular edge's is, since the node next to the corner grows
-    like the corner's field at one cell's distance.
+    `s` sorted arc lengths, `p` the nodal pressures (piecewise linear between them). The
+    load over a few cells, not a node's value: a node that takes its neighbour's load (the
+    on/off pattern beside the end of a passive surface or at a corner) moves load inside the
+    window, and a single spike counts 1/m. A singular edge's mean over m cells grows like
+    its field at m cells' distance, h^-lambda; a bounded one tends to a constant.
     """
-    if len(s) < 2:
+    n = len(s) - 1
+    if n < 1:
         return 0.0, 0.0
-    both = np.minimum(p[:-1], p[1:])
-    i = int(np.argmax(both))
-    return float(both[i]), float(s[i + 1] - s[i])
+    m = min(m, n)
+    load = np.concatenate([[0.0], np.cumsum(np.diff(s) * 0.5 * (p[:-1] + p[1:]))])
+    length = s[m:] - s[:-m]
+    mean = (load[m:] - load[:-m]) / np.maximum(length, 1e-300)
+    i = int(np.argmax(mean))
+    return float(mean[i]), float(length[i] / m)
 
 
 def peak_exponent(coarse: tuple[float, float], fine: tuple[float, float]) -> float:

@@ -28,8 +28,8 @@ the ratio of the residual estimates of the two meshes (the observed rate; the es
 constant cancels). The force is an energy-squared quantity: rate 2. docs/adapt.md has the
 measured effectivities, the cost and where it fails. A pressure singular like 1/sqrt (a
 rigid flat punch's corner) has no finite L2 norm, and one whose peak grows like h^-lambda at
-a sharp corner breaks the rate the estimate assumes: where the peak (the largest value two
-neighbouring nodes both carry) grows like that over two refinements of the contact cells, the
+a sharp corner breaks the rate the estimate assumes: where the peak (the largest mean
+pressure over a few segments) grows like that over two refinements of the contact cells, the
 estimate refuses the scene (GoalUnbounded) and names the goals that exist; `adapt` with its
 default goal stops on the energy instead.
 """

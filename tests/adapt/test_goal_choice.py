@@ -25,19 +25,19 @@ def _adapt(tmp: Path, scene: Path, *args: str) -> tuple[dict, str]:
 def test_flat_punch_stops_on_the_energy(tmp_path: Path) -> None:
     """Defaults and --tol only: the punch's pressure is singular, the energy goal is chosen,
     said in the log and the JSON, and the loop stops on its estimate."""
-    data, stdout = _adapt(tmp_path, PUNCH, "--tol", "0.2")
+    data, stdout = _adapt(tmp_path, PUNCH, "--tol", "0.1")
     assert data["settings"]["goal"] == "pressure" and data["goal"] == "energy"
     assert "pressure goal is unbounded" in data["goal_note"]
     assert "over two refinements" in data["goal_note"]
     assert "goal: energy (" in stdout
-    assert data["stop"].startswith("energy estimate") and "<= tol 20 %" in data["stop"]
+    assert data["stop"].startswith("energy estimate") and "<= tol 10 %" in data["stop"]
     assert all(lv["goal"] == "energy" for lv in data["levels"])
 
 
 def test_chamfered_press_fit_stops_on_its_estimate(tmp_path: Path) -> None:
     """An axisymmetric shaft-hub press fit, the hub's edge chamfered: defaults and --tol only
     run and stop on the chosen goal's estimate (not on the budget or the levels)."""
-    data, stdout = _adapt(tmp_path, PRESS_FIT, "--tol", "0.2")
-    assert "<= tol 20 %" in data["stop"], data["stop"]
+    data, stdout = _adapt(tmp_path, PRESS_FIT, "--tol", "0.1")
+    assert "<= tol 10 %" in data["stop"], data["stop"]
     assert data["stop"].startswith(data["goal"] + " estimate")
     assert f"goal: {data['goal']}" in stdout

@@ -13,8 +13,8 @@ DefineConstant[
   Lh = {1, Name "Parameters/Lh half length of the hub"},
   Ls = {2.5, Name "Parameters/Ls half length of the shaft"},
   c = {0.1, Name "Parameters/c chamfer leg"},
-  h = {0.2, Name "Parameters/h size"},
-  hc = {0.1, Name "Parameters/hc size near the chamfer's corner"},
+  h = {0.1, Name "Parameters/h size"},
+  hc = {0.025, Name "Parameters/hc size near the chamfer's corner"},
   r_fine = {0.3, Name "Parameters/r_fine radius of the finer zone"}
 ];
 
