@@ -244,10 +244,14 @@ def _adapt_parser(sub: Any) -> None:
         help="adaptive meshing: solve, estimate, remesh with gmsh until --tol is met",
         description="Adapt the mesh of one scene until the relative error of --goal is "
         "estimated to be at most --tol (docs/adapt.md). Each level solves, estimates the error "
-        "(residual estimator, docs/adapt.md), sizes the next mesh from the indicators and "
+        "(the goal's two-level estimate and the residual indicators), sizes the next mesh and "
         "remeshes the geometry with gmsh. Stops at --tol, --max-levels, or when the next "
         "mesh would exceed --max-dofs. Writes adapt.json, mesh.msh, fields.pvtu (with the "
-        "indicators eta) and the charts adapt_dofs.png, adapt_time.png to --out.",
+        "indicators eta) and the charts adapt_dofs.png, adapt_time.png to --out. Example: "
+        "`contactfx adapt hertz --refine 1 --h-far 10 --refine-edge 0 --max-dofs 60000 "
+        "--out out/adapt` adapts an ungraded start (1,052 DOFs) over four levels to a "
+        "pressure estimate of 0.69 % at 7,332 DOFs (`adapt hertz` alone starts from the "
+        "graded default mesh, already within --tol 0.01 at level 0).",
     )
     s.add_argument("scene", help="blocks, hertz or a scene .toml file whose mesh is a .geo")
     _builtin_scene_options(s)
