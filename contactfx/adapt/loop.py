@@ -24,7 +24,7 @@ from ..scenes import Scene
 from ..timers import Timers
 from .estimate import estimate
 from .goal import Goal
-from .records import RESIDUAL_GROWTH, AdaptLevel, AdaptOptions, AdaptResult
+from .records import AdaptLevel, AdaptOptions, AdaptResult
 from .sizing import Plan, plan_mesh
 
 Say = Callable[[str], None]
@@ -101,7 +101,9 @@ class ResidualPlan:
     def __init__(self, opts: AdaptOptions, size: Callable[..., Plan] = plan_mesh) -> None:
         self.opts = opts
         self.size = size
-        self.growth = RESIDUAL_GROWTH if opts.growth is None else opts.growth
+        growth = opts.level_growth
+        assert growth is not None, "the residual goal's growth is never planned"
+        self.growth = growth
         self.budget = 0.0
         self.sizes: Plan | None = None
 

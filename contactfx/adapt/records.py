@@ -98,6 +98,16 @@ class AdaptOptions:
         return 1.0
 
     @property
+    def level_growth(self) -> float | None:
+        """The most cells of a level over the previous one: `growth`, or the goal's default.
+
+        RESIDUAL_GROWTH for the residual goal; None for the goal estimates, which plan it.
+        """
+        if self.growth is None and self.goal is Goal.RESIDUAL:
+            return RESIDUAL_GROWTH
+        return self.growth
+
+    @property
     def rule(self) -> SizingRule:
         """How the next mesh is sized (the growth is the loop's: `growth`)."""
         return SizingRule(contact_weight=self.weight)
@@ -144,7 +154,7 @@ class AdaptOptions:
             "max_dofs": self.max_dofs,
             "max_levels": self.max_levels,
             "rate": rule.rate,
-            "growth": self.growth,
+            "growth": self.level_growth,
             "weight_contact": rule.contact_weight,
             "pressure_tol": self.pressure_tol,
             "goal": self.goal.value,

@@ -11,6 +11,7 @@ import pytest
 from contactfx.adapt.goal import GOAL_MEANING, Goal
 from contactfx.adapt.planned import BUDGET_FILL, MIN_LEVELS, plan_growth
 from contactfx.adapt.records import (
+    RESIDUAL_GROWTH,
     RESIDUAL_WEIGHT,
     AdaptOptions,
     AdaptResult,
@@ -74,3 +75,12 @@ def test_adapt_json_names_the_request_and_the_goal_stopped_on() -> None:
     assert data["settings"]["goal"] == "pressure" and data["settings"]["fallback"] == "energy"
     assert data["goal"] == "energy" and data["goal_meaning"] == GOAL_MEANING[Goal.ENERGY]
     assert data["goal_note"] == "the pressure goal is unbounded"
+
+
+def test_one_home_for_the_growth() -> None:
+    """`growth` on the options: given, x 4 for the residual goal, planned (None) otherwise;
+    adapt.json records the one the loop uses."""
+    assert AdaptOptions(Goal.RESIDUAL, 0.05).level_growth == RESIDUAL_GROWTH
+    assert AdaptOptions(Goal.RESIDUAL, 0.05, growth=2.0).level_growth == 2.0
+    assert AdaptOptions(Goal.PRESSURE).level_growth is None
+    assert AdaptOptions(Goal.ENERGY, growth=3.0).settings()["growth"] == 3.0
