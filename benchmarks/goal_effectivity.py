@@ -20,11 +20,12 @@ from typing import Any
 
 from contactfx.adapt.estimate import estimate
 from contactfx.adapt.goal import Goal, goal_estimate, refined_field
-from contactfx.adapt.loop import AdaptOptions, adapt
-from contactfx.adapt.sizing import SizingRule
+from contactfx.adapt.loop import adapt
+from contactfx.adapt.records import AdaptOptions
 from contactfx.adapt.true_error import energy_error
 from contactfx.api import solve
 from contactfx.methods.solution import Solution
+from contactfx.request import SolveRequest
 from contactfx.results.references import hertz_summary
 from contactfx.scenes import HertzParams, hertz, load_scene_file
 
@@ -146,14 +147,17 @@ def main() -> None:
         params = HertzParams(
             refine=args.adapt_from, h_far=args.adapt_h_far, refine_edge=0.0, slope=args.slope
         )
+        # The residual goal's loop with the pressure sizing (its levels are the meshes).
         opts = AdaptOptions(
+            Goal.RESIDUAL,
             tol=0.001,
             max_dofs=args.max_dofs,
             max_levels=args.adapt_levels,
-            rule=SizingRule(growth=1.5, contact_weight=1.0),
+            growth=1.5,
+            contact_weight=1.0,
             pressure_tol=args.pressure_tol,
         )
-        res = adapt(hertz(params), "mortar", opts, say=lambda line: None)
+        res = adapt(hertz(params), SolveRequest.parse("mortar"), opts, say=lambda line: None)
         for lv in res.levels:
             seconds = lv.time
             rows.append(

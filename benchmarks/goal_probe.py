@@ -68,7 +68,7 @@ def exact(sol):
 
 
 def curves(sol):
-    return [G._pressure_curve(pv, sol.pressure) for pv in sol.pairs]
+    return [G.pressure_curve(pv, sol.pressure) for pv in sol.pairs]
 
 
 def segs(sol):
@@ -88,12 +88,12 @@ def variant(sol, mode, solver):
     field = G.refined_field(sol, far=far, near=near, reach=G.REACH)
     ref = G._refined(sol, field, solver, {})
     q = 2.0 ** (-1.5 * k)
-    G._check_bounded(sol, ref)
+    G._check_bounded(sol, ref, solver, {})
     parts = {}
     for pv, pr in zip(sol.pairs, ref.pairs, strict=True):
         d, n = G.pressure_difference(
-            G._pressure_curve(pv, sol.pressure),
-            G._pressure_curve(pr, ref.pressure),
+            G.pressure_curve(pv, sol.pressure),
+            G.pressure_curve(pr, ref.pressure),
             radial=sol.scene.model is Model.AXISYMMETRIC,
         )
         parts[pv.label] = d / n / (1.0 - q) if n > 0 else 0.0

@@ -26,8 +26,9 @@ import dolfinx_solver  # noqa: F401
 import numpy as np
 
 from contactfx import load_scene_file, run_scene
-from contactfx.adapt.loop import AdaptOptions, adapt, uniform_levels
-from contactfx.adapt.sizing import SizingRule
+from contactfx.adapt.goal import Goal
+from contactfx.adapt.loop import adapt, uniform_levels
+from contactfx.adapt.records import AdaptOptions
 from contactfx.request import SolveRequest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -80,7 +81,8 @@ def measures(data: dict, ref: dict | None) -> dict:
 def reference(tmp: Path, slope: float, hmin: float) -> dict:
     """A mesh graded towards the punch edge: h = max(hmin, slope r), at most 2."""
     f = f"Min(2, Max({hmin}, {slope} * Sqrt((x - 1)^2 + y^2)))"
-    _, data = run_scene(load_scene_file(scene_with(tmp, f"ref{slope}", f)), "nts")
+    scene = load_scene_file(scene_with(tmp, f"ref{slope}", f))
+    _, data = run_scene(scene, SolveRequest.parse("nts"))
     data = data.to_json()
     return measures(data, None)
 
@@ -118,11 +120,14 @@ def main() -> None:
     result = adapt(
         start,
         nts,
+        # The residual goal, no tolerance: the budget decides.
         AdaptOptions(
-            1e-9,
+            Goal.RESIDUAL,
+            None,
             args.max_dofs,
             12,
-            SizingRule(growth=args.growth, contact_weight=args.weight_contact),
+            growth=args.growth,
+            contact_weight=args.weight_contact,
         ),
         say=print,
     )

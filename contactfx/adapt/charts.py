@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullFormatter
 
-from .loop import AdaptLevel
+from .records import AdaptLevel
 
 
 def tick_values(lo: float, hi: float) -> list[float]:

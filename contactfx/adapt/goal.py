@@ -27,8 +27,11 @@ In the energy norm the two errors are nearly orthogonal (Galerkin): d / sqrt(1 -
 the ratio of the residual estimates of the two meshes (the observed rate; the estimator's
 constant cancels). The force is an energy-squared quantity: rate 2. docs/adapt.md has the
 measured effectivities, the cost and where it fails. A pressure singular like 1/sqrt (a
-rigid flat punch's corner) has no finite L2 norm: the estimate refuses it (GoalUnbounded)
-and names the goals that exist.
+rigid flat punch's corner) has no finite L2 norm, and one whose peak grows like h^-lambda at
+a sharp corner breaks the rate the estimate assumes: where the peak (the largest mean
+pressure over a few segments) grows like that over two refinements of the contact cells, the
+estimate refuses the scene (GoalUnbounded) and names the goals that exist; `adapt` with its
+default goal stops on the energy instead.
 """
 
 from __future__ import annotations
@@ -43,11 +46,19 @@ from scipy.spatial import cKDTree
 
 from ..api import solve, solve_request
 from ..errors import InputError
-from ..methods.solution import PairView, Solution
+from ..methods.solution import Solution
 from ..options import SolverSpec
 from ..request import SolveRequest
 from ..results.interface import pair_forces
 from ..scenes import Model, SizeField
+from .curves import (
+    SINGULAR_EXPONENT,
+    pair_peak,
+    peak_exponent,
+    pressure_curve,
+    pressure_difference,
+    singular_growth,
+)
 from .estimate import estimate
 from .sizing import cell_sizes, owned_cells, vertex_sizes
 from .true_error import energy_error
@@ -59,6 +70,7 @@ class Goal(StrEnum):
     PRESSURE = "pressure"  # relative L2 error of the contact pressure, worst pair
     ENERGY = "energy"  # relative energy-norm error of the displacement
     FORCE = "force"  # relative error of each pair's contact force, worst pair
+    RESIDUAL = "residual"  # the residual estimate (adapt/estimate.py): uncalibrated, no solve
 
 
 # Convergence rates in h of each goal's error: P1 multipliers against a square-root edge
@@ -91,13 +103,16 @@ MAX_HALVINGS = 3
 EDGE_CELLS = 2.0
 EDGE_HALVINGS = 2
 
-# A peak pressure that grows by more than this factor when the contact cells are halved is
-# singular: a 1/sqrt peak grows by sqrt(2) = 1.41 per halving, a bounded one tends to 1.
-SINGULAR_GROWTH = 2**0.25
-
 
 class GoalUnbounded(InputError):
-    """The goal has no finite value on this scene (e.g. a pressure singular like 1/sqrt)."""
+    """The goal has no finite value on this scene (e.g. a pressure singular like 1/sqrt).
+
+    `reason`: what was observed, without the advice the message adds.
+    """
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(f"{reason}: use --goal energy or --goal force")
+        self.reason = reason
 
 
 @dataclass(frozen=True)
@@ -124,6 +139,7 @@ GOAL_MEANING = {
     Goal.PRESSURE: "the relative L2 error of the contact pressure (worst pair)",
     Goal.ENERGY: "the relative energy-norm error of the displacement",
     Goal.FORCE: "the relative error of each pair's contact force (worst pair)",
+    Goal.RESIDUAL: "the relative residual estimate of the energy-norm error (uncalibrated)",
 }
 
 
@@ -239,62 +255,33 @@ def _surface_points(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(mids), np.concatenate(lengths)
 
 
-def _pressure_curve(
-    pv: PairView, pressure: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(s, p, x): the pair's multipliers along its surface's arc length, sorted, and x.
+def _check_bounded(
+    sol: Solution,
+    ref: Solution,
+    solver: SolverSpec | str | SolveRequest,
+    options: dict[str, Any],
+) -> None:
+    """GoalUnbounded if a pair's peak pressure grows like a singularity's over two refinements.
 
-    x is each node's x coordinate: the radius of an axisymmetric model.
+    `ref` (the goal's refined solve) is the first refinement; only where a pair's peak grew
+    on it is the second solved: the refined mesh's contact cells halved again.
     """
-    s_all = pv.arc[0]
-    p = pv.nodal(pressure)
-    keep = np.isfinite(s_all)
-    order = np.argsort(s_all[keep], kind="stable")
-    x = pv.active.surface.x[:, 0]
-    return s_all[keep][order], p[keep][order], x[keep][order]
-
-
-def _l2_pl(s: np.ndarray, v: np.ndarray, r: np.ndarray | None = None) -> float:
-    """L2 norm of the piecewise-linear v at sorted abscissae s, exactly.
-
-    With r (piecewise linear too: an axisymmetric surface's radius) weighted by r.
-    """
-    h = np.diff(s)
-    a, b = v[:-1], v[1:]
-    if r is None:
-        return float(np.sqrt(np.sum(h * (a * a + a * b + b * b) / 3.0)))
-    ra, rb = r[:-1], r[1:]
-    w = a * a * (3 * ra + rb) / 12 + a * b * (ra + rb) / 6 + b * b * (ra + 3 * rb) / 12
-    return float(np.sqrt(np.sum(h * w)))
-
-
-def pressure_difference(
-    coarse: tuple[np.ndarray, ...], fine: tuple[np.ndarray, ...], radial: bool = False
-) -> tuple[float, float]:
-    """(||p_c - p_f||_L2, ||p_f||_L2) of two piecewise-linear pressures along arc length.
-
-    Both are evaluated on the union of their nodes, where the difference is again piecewise
-    linear, so the integral is exact. `radial` (an axisymmetric model, curves (s, p, x)):
-    the L2 norm over the revolved surface, weighted by the radius x, as the Hertz
-    reference's error is.
-    """
-    s = np.union1d(coarse[0], fine[0])
-    pc = np.interp(s, coarse[0], coarse[1], left=0.0, right=0.0)
-    pf = np.interp(s, fine[0], fine[1], left=0.0, right=0.0)
-    r = np.interp(s, fine[0], fine[2]) if radial else None
-    return _l2_pl(s, pc - pf, r), _l2_pl(s, pf, r)
-
-
-def _check_bounded(sol: Solution, ref: Solution) -> None:
-    """GoalUnbounded if a pair's peak pressure grows like a 1/sqrt singularity's."""
-    for pv, pr in zip(sol.pairs, ref.pairs, strict=True):
-        peak = float(np.max(sol.pressure[pv.rows], initial=0.0))
-        fine = float(np.max(ref.pressure[pr.rows], initial=0.0))
-        if peak > 0 and fine > SINGULAR_GROWTH * peak:
+    first = [
+        (pair_peak(a, sol.pressure), pair_peak(b, ref.pressure))
+        for a, b in zip(sol.pairs, ref.pairs, strict=True)
+    ]
+    if all(peak_exponent(*f) < SINGULAR_EXPONENT for f in first):
+        return
+    again = _refined(ref, refined_field(ref, far=1.0, near=0.5, reach=0.0), solver, options)
+    for pv, (p0, p1), pw in zip(sol.pairs, first, again.pairs, strict=True):
+        p2 = pair_peak(pw, again.pressure)
+        exponents = singular_growth([p0, p1, p2])
+        if exponents is not None:
+            grew = ", ".join(f"h^-{e:.2f}" for e in exponents)
             raise GoalUnbounded(
-                f"{pv.label}: the peak pressure grew x {fine / peak:.2f} on the refined "
-                "contact zone (a 1/sqrt singularity has no L2 pressure error to bound): use "
-                "--goal force or --goal energy"
+                f"{pv.label}: the peak pressure grows like {grew} over two refinements of the "
+                f"contact cells ({p0[0]:.4g}, {p1[0]:.4g}, {p2[0]:.4g}): a singular edge, "
+                "whose pressure has no L2 error to bound"
             )
 
 
@@ -340,6 +327,8 @@ def goal_estimate(
         GoalUnbounded: The pressure of a pair is singular (its L2 norm is infinite).
     """
     goal = Goal(goal)
+    if goal is Goal.RESIDUAL:
+        raise ValueError("the residual goal is the residual estimate itself (adapt/estimate.py)")
     r = RATES[goal] if rate is None else rate
     t0 = time.perf_counter()
     # Energy and force halve every cell once; the pressure its contact cells k times.
@@ -360,11 +349,11 @@ def goal_estimate(
         parts["ratio"] = q
         relative = e["relative"] / np.sqrt(1.0 - q * q)
     elif goal is Goal.PRESSURE:
-        _check_bounded(sol, ref)
+        _check_bounded(sol, ref, solver, options or {})
         for pv, pr in zip(sol.pairs, ref.pairs, strict=True):
             d, n = pressure_difference(
-                _pressure_curve(pv, sol.pressure),
-                _pressure_curve(pr, ref.pressure),
+                pressure_curve(pv, sol.pressure),
+                pressure_curve(pr, ref.pressure),
                 radial=sol.scene.model is Model.AXISYMMETRIC,
             )
             parts[pv.label] = d / n / (1.0 - q) if n > 0 else 0.0

@@ -2,172 +2,32 @@
 
 DOLFINx cannot refine quadrilaterals, so every level remeshes the scene's geometry (a
 built-in scene's gmsh model or a .geo) from a background size field built from the
-indicators (adapt/sizing.py). The loop stops when the relative estimate is at most `tol`,
-after `max_levels` levels, or when the next mesh would exceed `max_dofs`. `uniform_levels`
-refines the same starting scene uniformly, for the comparison charts.
+indicators (adapt/sizing.py). One loop for every goal; what differs is a Strategy's: how a
+level is assessed (the goal estimates' refined solve, adapt/planned.py; nothing more for the
+residual estimate, `ResidualPlan` below), when the loop stops (`stop`: the estimate at most
+`tol`) and how the next mesh is planned (`plan`, and `replan` when gmsh overshoots). The loop
+also stops after `max_levels` levels, or when the next mesh would exceed `max_dofs`.
+`uniform_levels` refines the same starting scene uniformly, for the comparison charts.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
+from typing import Protocol
 
 from ..api import run_scene
-from ..errors import InputError
 from ..methods.predictor import scene_dofs
 from ..methods.solution import Solution
 from ..request import SolveRequest
-from ..results.records import RunSummary
 from ..scenes import Scene
 from ..timers import Timers
-from .estimate import Estimate, estimate
-from .goal import Goal, GoalRecord
-from .sizing import Plan, SizingRule, plan_mesh
+from .estimate import estimate
+from .goal import Goal
+from .records import AdaptLevel, AdaptOptions, AdaptResult
+from .sizing import Plan, plan_mesh
 
-# On a full budget, the pressure sizing goes on while its estimate falls below this fraction
-# of the previous level's.
-PRESSURE_PROGRESS = 0.8
-
-
-@dataclass(frozen=True)
-class AdaptOptions:
-    """When the loop stops and how it sizes meshes."""
-
-    tol: float = 0.05  # relative estimate to reach
-    max_dofs: int = 200_000
-    max_levels: int = 8
-    rule: SizingRule = field(default_factory=SizingRule)
-    pressure_tol: float | None = None  # relative L2 pressure estimate to reach too
-    # The quantity `tol` bounds (adapt/planned.py: the goal loop); None: the residual
-    # estimate's loop below (the expert flags' loop, `--goal residual`).
-    goal: Goal | None = None
-
-    def pressure_met(self, est: Estimate) -> bool:
-        """Whether the pressure estimate needs nothing more (always, without pressure_tol)."""
-        if self.pressure_tol is None or est.pressure is None:
-            return True
-        return est.pressure.relative <= self.pressure_tol
-
-    def pressure_settled(self, est: Estimate, before: Estimate | None) -> bool:
-        """Whether the pressure sizing has nothing left to gain on a full budget.
-
-        Met, or fallen by less than PRESSURE_PROGRESS on the last level: past that the
-        pressure error is the bulk's (a three-body scene's discrete half-width settles
-        0.09 % short of Hertz's while the estimate creeps down, docs/adapt.md).
-        """
-        if self.pressure_met(est):
-            return True
-        if before is None or before.pressure is None or est.pressure is None:
-            return False
-        return est.pressure.relative > PRESSURE_PROGRESS * before.pressure.relative
-
-    def met(self, est: Estimate) -> str | None:
-        """Why the loop may stop at this estimate, or None."""
-        if est.relative > self.tol:
-            return None
-        if not self.pressure_met(est):
-            return None
-        # Percent, as the level lines print the estimates.
-        reached = f"estimate {100 * est.relative:.2g} % <= tol {100 * self.tol:g} %"
-        if self.pressure_tol is None or est.pressure is None:
-            return reached
-        return (
-            f"{reached}, pressure estimate {100 * est.pressure.relative:.2g} % "
-            f"<= {100 * self.pressure_tol:g} %"
-        )
-
-    def check(self) -> None:
-        """InputError for a value out of range."""
-        if not (self.tol > 0):
-            raise InputError(f"--tol must be > 0 (got {self.tol})")
-        if not (self.rule.growth > 1.0):
-            raise InputError(
-                f"--growth must be > 1: the most cells of a level relative to the previous "
-                f"one (got {self.rule.growth:g})"
-            )
-        if self.max_dofs < 10:
-            raise InputError(f"--max-dofs must be at least 10 (got {self.max_dofs})")
-        if not (self.rule.contact_weight >= 1.0):
-            raise InputError(f"--weight-contact must be >= 1 (got {self.rule.contact_weight})")
-        if self.max_levels < 1:
-            raise InputError(f"--max-levels must be at least 1 (got {self.max_levels})")
-        if self.pressure_tol is not None and not (self.pressure_tol > 0):
-            raise InputError(f"--pressure-tol must be > 0 (got {self.pressure_tol})")
-
-
-@dataclass(frozen=True)
-class AdaptLevel:
-    """One solved level: its summary (with the estimate), the solution and the estimate."""
-
-    index: int
-    summary: RunSummary
-    solution: Solution
-    est: Estimate
-    time: float  # seconds: meshing (remesh) + solve + estimate (+ the goal's refined solve)
-    goal: GoalRecord | None = None  # the goal estimate (the goal loop, adapt/planned.py)
-
-    @property
-    def dofs(self) -> int:
-        """Displacement DOFs of the level."""
-        return self.summary.dofs
-
-    def to_json(self) -> dict[str, Any]:
-        """The level's entry of adapt.json: the run's JSON, `estimate` the relative total."""
-        out = self.summary.to_json()
-        out["estimate"] = self.est.relative
-        out["estimate_parts"] = self.est.summary().to_json()
-        out["level"] = self.index
-        out["time"] = self.time
-        if self.goal is not None:
-            out.update(self.goal.to_json())
-            out["estimate"] = self.goal.relative
-            exact = self.exact_error
-            if exact is not None:
-                out["exact_error"] = exact
-                out["effectivity"] = self.goal.relative / exact if exact > 0 else None
-        return out
-
-    @property
-    def exact_error(self) -> float | None:
-        """The goal's exact relative error where the scene has one (pressure on Hertz)."""
-        if self.goal is None or self.goal.goal is not Goal.PRESSURE or not self.summary.hertz:
-            return None
-        return max(h.l2_error for h in self.summary.hertz)
-
-
-@dataclass
-class AdaptResult:
-    """The levels, why the loop stopped, and the uniform levels if asked for."""
-
-    levels: list[AdaptLevel]
-    stop: str
-    uniform: list[AdaptLevel] = field(default_factory=list)
-
-    def to_json(self, scene: str, method: str, opts: AdaptOptions, solver: str) -> dict[str, Any]:
-        """adapt.json: the settings, every level (estimate a number), why the loop stopped.
-
-        `scene`, `method` and `solver` as the user named them.
-        """
-        return {
-            "scene": scene,
-            "method": method,
-            "settings": {
-                "tol": opts.tol,
-                "max_dofs": opts.max_dofs,
-                "max_levels": opts.max_levels,
-                "rate": opts.rule.rate,
-                "growth": opts.rule.growth,
-                "weight_contact": opts.rule.contact_weight,
-                "pressure_tol": opts.pressure_tol,
-                "goal": opts.goal.value if opts.goal is not None else "residual",
-                "solver": solver,
-            },
-            "stop": self.stop,
-            "levels": [lv.to_json() for lv in self.levels],
-            **({"uniform": [lv.to_json() for lv in self.uniform]} if self.uniform else {}),
-        }
+Say = Callable[[str], None]
 
 
 def solve_level(
@@ -194,8 +54,119 @@ def solve_level(
     return AdaptLevel(index, run, sol, est, elapsed)
 
 
-# Remeshings with a smaller budget when gmsh's mesh exceeds --max-dofs.
+# Remeshings with another plan when gmsh's mesh exceeds what was planned or --max-dofs.
 REPLANS = 2
+
+
+class Strategy(Protocol):
+    """What a goal decides in the loop: the level's estimate, the stop, the next mesh."""
+
+    goal: Goal  # the goal the loop is stopping on now
+    note: str  # why the goal is not the one asked for ("" if it is)
+
+    def assess(self, level: AdaptLevel, say: Say) -> AdaptLevel:
+        """The level with its goal estimate (collective)."""
+        ...
+
+    def stop(self, level: AdaptLevel) -> str | None:
+        """Why the loop stops at this level (the estimate reached tol), or None."""
+        ...
+
+    def reached(self, level: AdaptLevel) -> str:
+        """What the level's estimate reached, for a stop on the budget or the levels ("")."""
+        ...
+
+    def plan(self, level: AdaptLevel, history: list[AdaptLevel]) -> Plan | str:
+        """The next mesh's plan, or why there is none (the budget is full). Collective."""
+        ...
+
+    def replan(self, level: AdaptLevel, dofs: int) -> Plan | None:
+        """Another plan when gmsh made `dofs` of the last one, or None to keep it."""
+        ...
+
+    def remeshed(self, level: AdaptLevel, dofs: int) -> str:
+        """The progress line's account of the remeshed level's DOFs."""
+        ...
+
+
+class ResidualPlan:
+    """The residual goal: the residual estimate at most tol; sizes for tol within the growth.
+
+    `size` is `plan_mesh` (tests pass their own to steer the loop).
+    """
+
+    goal = Goal.RESIDUAL
+    note = ""
+
+    def __init__(self, opts: AdaptOptions, size: Callable[..., Plan] = plan_mesh) -> None:
+        self.opts = opts
+        self.size = size
+        growth = opts.level_growth
+        assert growth is not None, "the residual goal's growth is never planned"
+        self.growth = growth
+        self.budget = 0.0
+        self.sizes: Plan | None = None
+
+    def assess(self, level: AdaptLevel, say: Say) -> AdaptLevel:
+        """The level as it is: its residual estimate is the goal's."""
+        return level
+
+    def stop(self, level: AdaptLevel) -> str | None:
+        """The estimate (and the pressure estimate, with pressure_tol) reached."""
+        return self.opts.met(level.est)
+
+    def reached(self, level: AdaptLevel) -> str:
+        """Nothing to add: the level lines print the estimates."""
+        return ""
+
+    def _sized(self, level: AdaptLevel) -> Plan:
+        opts = self.opts
+        cells = min(self.growth * level.summary.elements, self.budget)
+        self.sizes = self.size(
+            level.solution, level.est, opts.tol, cells, opts.rule, opts.pressure_tol
+        )
+        return self.sizes
+
+    def plan(self, level: AdaptLevel, history: list[AdaptLevel]) -> Plan | str:
+        """Sized for tol within the growth and 90 % of --max-dofs; a full budget stops."""
+        opts = self.opts
+        ratio = level.dofs / max(level.summary.elements, 1)
+        # 10 % margin: gmsh meets a size field only approximately.
+        self.budget = 0.9 * opts.max_dofs / ratio
+        sizes = self._sized(level)
+        before = history[-2].est if len(history) > 1 else None
+        if (
+            (opts.tol is None or sizes.predicted > opts.tol)
+            and sizes.cells < 1.1 * level.summary.elements
+            and opts.pressure_settled(level.est, before)
+        ):
+            return f"the next mesh would exceed --max-dofs {opts.max_dofs}"
+        return sizes
+
+    def replan(self, level: AdaptLevel, dofs: int) -> Plan | None:
+        """Over --max-dofs: a smaller budget.
+
+        Rather than stop a level early: on Hertz the last level is the one the pressure
+        target needs.
+        """
+        if dofs <= self.opts.max_dofs:
+            return None
+        self.budget *= 0.95 * self.opts.max_dofs / dofs
+        return self._sized(level)
+
+    def remeshed(self, level: AdaptLevel, dofs: int) -> str:
+        """The DOFs and the estimate they were planned for."""
+        predicted = self.sizes.predicted if self.sizes is not None else float("nan")
+        return f"{dofs} DOFs planned for an estimate of {100 * predicted:.3g} %"
+
+
+def strategy_for(opts: AdaptOptions, request: SolveRequest) -> Strategy:
+    """The options' goal's strategy: the residual estimate's, or a goal estimate's."""
+    if opts.goal is Goal.RESIDUAL:
+        return ResidualPlan(opts)
+    from .planned import GoalPlan  # the goal estimates' refined solves
+
+    return GoalPlan(opts, request)
 
 
 def adapt(
@@ -204,67 +175,61 @@ def adapt(
     opts: AdaptOptions,
     *,
     paper_interface: bool = False,
-    say: Callable[[str], None] | None = None,
+    say: Say | None = None,
     mesh_time: float = 0.0,
     count_dofs: Callable[[Scene], int] = scene_dofs,
-    plan: Callable[..., Plan] = plan_mesh,
+    strategy: Strategy | None = None,
 ) -> AdaptResult:
-    """Run the adaptive loop from `scene` (collective); `say` prints progress (rank 0).
+    """Run the adaptive loop from `scene` until opts.goal's estimate is at most opts.tol.
 
-    `count_dofs` counts a remeshed scene's DOFs against the budget and `plan` sizes the next
-    mesh (`plan_mesh`'s arguments); tests pass their own to steer the loop.
+    Collective; `say` prints progress (rank 0). `count_dofs` counts a remeshed scene's DOFs
+    against the budget; `strategy` (default: the goal's) decides the estimate, the stop and
+    the plans.
+
+    Raises:
+        GoalUnbounded: The goal has no finite value on this scene and opts.fallback is None.
     """
-    opts.check()
     scene.require_recipe()
     comm = scene.comm
     say = say or (lambda line: print(line, flush=True) if comm.rank == 0 else None)
+    strategy = strategy or strategy_for(opts, request)
     levels: list[AdaptLevel] = []
     stop = f"max levels ({opts.max_levels})"
     for k in range(opts.max_levels):
         previous = levels[-1].solution if levels else None
         level = solve_level(scene, k, mesh_time, request, paper_interface, previous)
+        level = strategy.assess(level, say)
         levels.append(level)
         say(level_line(level))
-        reached = opts.met(level.est)
+        reached = strategy.stop(level)
         if reached is not None:
             stop = reached
             break
+        suffix = strategy.reached(level)
         if k + 1 == opts.max_levels:
+            stop += suffix
             break
-        ratio = level.dofs / max(level.summary.elements, 1)
-        # 10 % margin: gmsh meets a size field only approximately.
-        budget = 0.9 * opts.max_dofs / ratio
-        sizes = plan(level.solution, level.est, opts.tol, budget, opts.rule, opts.pressure_tol)
-        if (
-            sizes.predicted > opts.tol
-            and sizes.cells < 1.1 * level.summary.elements
-            and opts.pressure_settled(level.est, levels[-2].est if k else None)
-        ):
-            stop = f"the next mesh would exceed --max-dofs {opts.max_dofs}"
+        sizes = strategy.plan(level, levels)
+        if isinstance(sizes, str):
+            stop = sizes + suffix
             break
         t0 = time.perf_counter()
         nxt = scene.remeshed_to(sizes.field)
         dofs = count_dofs(nxt)
         for _ in range(REPLANS):
-            if dofs <= opts.max_dofs:
+            again = strategy.replan(level, dofs)
+            if again is None:
                 break
-            # gmsh overshot the budget: plan again for what fits, rather than stop a level
-            # early (on Hertz the last level is the one the pressure target needs).
-            budget *= 0.95 * opts.max_dofs / dofs
-            sizes = plan(level.solution, level.est, opts.tol, budget, opts.rule, opts.pressure_tol)
-            nxt = scene.remeshed_to(sizes.field)
+            nxt = scene.remeshed_to(again.field)
             dofs = count_dofs(nxt)
         mesh_time = time.perf_counter() - t0
         if dofs > opts.max_dofs:
-            stop = f"the next mesh would have {dofs} DOFs > --max-dofs {opts.max_dofs}"
+            stop = f"the next mesh would have {dofs} DOFs > --max-dofs {opts.max_dofs}{suffix}"
             break
-        say(
-            f"  remeshed: {dofs} DOFs planned for an estimate of "
-            f"{100 * sizes.predicted:.3g} % ({mesh_time:.2f} s)"
-        )
+        say(f"  remeshed: {strategy.remeshed(level, dofs)} ({mesh_time:.2f} s)")
         scene = nxt
     say(f"stopped: {stop}")
-    return AdaptResult(levels, stop)
+    return AdaptResult(levels, stop, strategy.goal, strategy.note)
 
 
 def uniform_levels(

@@ -1,4 +1,4 @@
-"""The goal loop: `--tol` is the relative error of a chosen quantity, each level planned.
+"""The goal estimates' strategy of the loop: `tol` the goal's relative error, each level planned.
 
 After each level's solve the goal's two-level estimate (adapt/goal.py) is computed; the
 loop stops when it is at most `tol`, or when the budget has no room for another level.
@@ -21,27 +21,29 @@ residual indicators. The budget decides the cell count (the residual tolerance i
 used). The energy goal's refined solve halves every cell (4-5.5 x the DOFs): past a
 quarter of the budget its estimate is the residual estimate times the ratio measured on
 the last level that had a refined solve (labelled in the parts as `calibration`).
+Where the pressure has no finite value on the scene (a singular edge, adapt/goal.py) and
+the options name a fallback goal, the loop stops on that one instead (the log and adapt.json
+say so): the energy, whose error bounds the field everywhere and the force's with it (the
+force converges like the energy error squared, so a force tolerance is met while the edge's
+field is still coarse).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import time
 from collections.abc import Callable
 
 import numpy as np
 from mpi4py import MPI
 
-from ..methods.predictor import scene_dofs
 from ..methods.solution import Solution
 from ..request import SolveRequest
-from ..scenes import Scene
-from .goal import GOAL_MEANING, Goal, GoalRecord, goal_estimate
-from .loop import REPLANS, AdaptLevel, AdaptOptions, AdaptResult, adapt, level_line, solve_level
+from .goal import GOAL_MEANING, Goal, GoalRecord, GoalUnbounded, goal_estimate
 from .pressure_estimate import PressureEstimate
 from .pressure_sizing import pressure_cell_sizes
-from .sizing import Plan, SizingRule, cell_sizes, owned_cells, plan_mesh
+from .records import AdaptLevel, AdaptOptions
+from .sizing import Plan, cell_sizes, owned_cells, plan_mesh
 
 # Error ~ N^s on level 0 (no observed rate yet): P1 pressure h^1.5 on a mesh refined along
 # a line (N ~ h^-2 overall: s = -0.75); Q1 energy h^1 (s = -0.5); the force h^2 (s = -1).
@@ -56,7 +58,6 @@ PRESSURE_AIM = 0.5  # the pressure indicator sized for half the error wanted (do
 ENERGY_REFINED = 4.0  # the energy goal's refined solve has ~4-5.5 x the level's DOFs
 AIM_FLOOR = 0.1  # but not below this fraction of the level's own estimate
 OVERSHOOT = 1.15  # a remeshed level with more DOFs than this x planned is planned again
-NO_TOL = 1e-12  # the residual sizing's own tolerance: the planned budget decides
 
 
 def observed_slope(history: list[tuple[int, float]], goal: Goal) -> float:
@@ -71,7 +72,7 @@ def observed_slope(history: list[tuple[int, float]], goal: Goal) -> float:
 
 def plan_growth(
     history: list[tuple[int, float]],
-    tol: float,
+    tol: float | None,
     max_dofs: int,
     goal: Goal,
     cap: float | None = None,
@@ -80,7 +81,8 @@ def plan_growth(
 ) -> float | None:
     """The next level's DOFs / this level's, or None when the budget has no room left.
 
-    `history`: (DOFs, goal estimate) of the levels so far. `cap`: an expert's --growth.
+    `history`: (DOFs, goal estimate) of the levels so far; `tol` None: the budget decides.
+    `cap`: an expert's --growth.
     `owed`: the levels the contact cells still need (contact_levels); `allowed`: the
     levels --max-levels leaves after this one (the budget is spread over at most these).
     """
@@ -89,7 +91,10 @@ def plan_growth(
     if room < G_MIN:
         return None
     s = observed_slope(history, goal)
-    need = (tol / e) ** (1.0 / s) if e > tol else 1.0
+    if tol is None:
+        need = math.inf
+    else:
+        need = (tol / e) ** (1.0 / s) if e > tol else 1.0
     left = max(MIN_LEVELS - len(history), owed, 1)
     if allowed is not None:
         left = max(min(left, allowed), 1)
@@ -116,140 +121,123 @@ def contact_levels(sol: Solution, pe: PressureEstimate | None, aim: float, fines
     return math.ceil(math.log(ratio) / math.log(finest) - 1e-9)
 
 
-def _goal_record(
-    level: AdaptLevel,
-    goal: Goal,
-    request: SolveRequest,
-    max_dofs: int,
-    calibration: float | None,
-) -> tuple[GoalRecord, float | None]:
-    """The level's goal estimate, and the energy goal's calibration of the residual one."""
-    residual = level.est.relative
-    if goal is Goal.ENERGY and calibration is not None and level.dofs * ENERGY_REFINED > max_dofs:
-        parts = {"residual": residual, "calibration": calibration}
-        return GoalRecord(goal, calibration * residual, parts, 0, 0.0), calibration
-    ge = goal_estimate(level.solution, goal, solver=request)
-    if goal is Goal.ENERGY and residual > 0:
-        calibration = ge.relative / residual
-    return ge.record(), calibration
+class GoalPlan:
+    """The goal estimates' strategy: a refined solve per level, the growth planned from the rate.
 
-
-def _plan(
-    level: AdaptLevel, goal: Goal, rule: SizingRule, cells: float, pressure_aim: float
-) -> Plan:
-    """The next mesh for `cells` cells: pressure sizing (pressure goal) + residual sizing."""
-    rule = dataclasses.replace(rule, growth=cells / max(level.summary.elements, 1))
-    aim = pressure_aim if goal is Goal.PRESSURE else None
-    return plan_mesh(level.solution, level.est, NO_TOL, cells, rule, aim)
-
-
-def adapt_to_goal(
-    scene: Scene,
-    request: SolveRequest,
-    opts: AdaptOptions,
-    *,
-    paper_interface: bool = False,
-    say: Callable[[str], None] | None = None,
-    mesh_time: float = 0.0,
-    count_dofs: Callable[[Scene], int] = scene_dofs,
-    growth_cap: float | None = None,
-) -> AdaptResult:
-    """Adapt until the goal's estimate is at most opts.tol or the budget is full (collective).
-
-    Raises:
-        GoalUnbounded: The goal has no finite value on this scene (before any output).
+    The pressure goal falls back to `opts.fallback` where the scene's pressure is singular.
     """
-    assert opts.goal is not None
-    goal = opts.goal
-    opts.check()
-    scene.require_recipe()
-    comm = scene.comm
-    say = say or (lambda line: print(line, flush=True) if comm.rank == 0 else None)
-    levels: list[AdaptLevel] = []
-    history: list[tuple[int, float]] = []
-    calibration: float | None = None
-    stop = f"max levels ({opts.max_levels})"
-    for k in range(opts.max_levels):
-        previous = levels[-1].solution if levels else None
-        level = solve_level(scene, k, mesh_time, request, paper_interface, previous)
-        rec, calibration = _goal_record(level, goal, request, opts.max_dofs, calibration)
-        level = dataclasses.replace(level, goal=rec, time=level.time + rec.seconds)
-        if k == 0:
-            say(f"goal: {goal.value}; --tol {opts.tol:g} bounds {GOAL_MEANING[goal]}")
-        levels.append(level)
-        history.append((level.dofs, rec.relative))
-        say(level_line(level))
-        est, tol = f"{100 * rec.relative:.3g} %", f"{100 * opts.tol:g} %"
-        reached = f"the {goal.value} estimate reached {est} (tol {tol})"
-        if rec.relative <= opts.tol:
-            stop = f"{goal.value} estimate {est} <= tol {tol}"
-            stop += f": it bounds {GOAL_MEANING[goal]}"
-            break
-        if k + 1 == opts.max_levels:
-            stop = f"max levels ({opts.max_levels}); {reached}"
-            break
-        owed = 0
-        if goal is Goal.PRESSURE:
-            pe, aim_tol = level.est.pressure, PRESSURE_AIM * opts.tol
-            owed = contact_levels(level.solution, pe, aim_tol, opts.rule.finest)
+
+    def __init__(self, opts: AdaptOptions, request: SolveRequest) -> None:
+        self.opts = opts
+        self.request = request
+        self.goal = opts.goal
+        self.note = ""
+        self.calibration: float | None = None
+        self.history: list[tuple[int, float]] = []  # (DOFs, estimate) of the current goal
+        self.cells = self.aim = self.target = self.g = self.s = 0.0
+        self.owed = 0
+
+    def _record(self, level: AdaptLevel) -> GoalRecord:
+        """The level's goal estimate (the energy goal's calibrated past a quarter budget)."""
+        residual = level.est.relative
+        big = level.dofs * ENERGY_REFINED > self.opts.max_dofs
+        if self.goal is Goal.ENERGY and self.calibration is not None and big:
+            parts = {"residual": residual, "calibration": self.calibration}
+            return GoalRecord(self.goal, self.calibration * residual, parts, 0, 0.0)
+        ge = goal_estimate(level.solution, self.goal, solver=self.request)
+        if self.goal is Goal.ENERGY and residual > 0:
+            self.calibration = ge.relative / residual
+        return ge.record()
+
+    def _tol(self) -> str:
+        tol = self.opts.tol
+        return "no tol: the budget decides" if tol is None else f"--tol {tol:g} bounds"
+
+    def assess(self, level: AdaptLevel, say: Callable[[str], None]) -> AdaptLevel:
+        """The level with its goal estimate; the fallback goal's where the pressure is singular."""
+        if level.index == 0:
+            say(f"goal: {self.goal.value}; {self._tol()} {GOAL_MEANING[self.goal]}")
+        try:
+            rec = self._record(level)
+        except GoalUnbounded as err:
+            fallback = self.opts.fallback
+            if fallback is None or self.goal is not Goal.PRESSURE:
+                raise
+            self.note = (
+                f"the pressure goal is unbounded on this scene ({err.reason}); "
+                f"stopped on the {fallback.value} goal instead"
+            )
+            self.goal, self.history = fallback, []
+            say(f"goal: {fallback.value} ({err.reason}); {self._tol()} {GOAL_MEANING[fallback]}")
+            rec = self._record(level)
+        self.history.append((level.dofs, rec.relative))
+        return dataclasses.replace(level, goal=rec, time=level.time + rec.seconds)
+
+    def _reached(self, level: AdaptLevel) -> tuple[str, str]:
+        assert level.goal is not None
+        est = f"{100 * level.goal.relative:.3g} %"
+        return est, "no tol" if self.opts.tol is None else f"{100 * self.opts.tol:g} %"
+
+    def stop(self, level: AdaptLevel) -> str | None:
+        """The goal's estimate at most tol."""
+        assert level.goal is not None
+        if self.opts.tol is None or level.goal.relative > self.opts.tol:
+            return None
+        est, tol = self._reached(level)
+        return f"{self.goal.value} estimate {est} <= tol {tol}: it bounds {GOAL_MEANING[self.goal]}"
+
+    def reached(self, level: AdaptLevel) -> str:
+        """The stop's suffix: "; the <goal> estimate reached <e> (tol <t>)"."""
+        est, tol = self._reached(level)
+        return f"; the {self.goal.value} estimate reached {est} (tol {tol})"
+
+    def _sized(self, level: AdaptLevel) -> Plan:
+        """The next mesh for `cells` cells: pressure sizing (pressure goal) + residual sizing."""
+        aim = self.aim if self.goal is Goal.PRESSURE else None
+        return plan_mesh(level.solution, level.est, None, self.cells, self.opts.rule, aim)
+
+    def plan(self, level: AdaptLevel, history: list[AdaptLevel]) -> Plan | str:
+        """The growth from the observed rate and the budget left; a full budget stops."""
+        opts, tol = self.opts, self.opts.tol
+        assert level.goal is not None
         allowed = opts.max_levels - len(history)
-        g = plan_growth(history, opts.tol, opts.max_dofs, goal, growth_cap, owed, allowed)
+        self.owed = 0
+        if self.goal is Goal.PRESSURE:
+            # Without a tolerance the contact cells could always use more: every level allowed.
+            self.owed = (
+                allowed
+                if tol is None
+                else contact_levels(
+                    level.solution, level.est.pressure, PRESSURE_AIM * tol, opts.rule.finest
+                )
+            )
+        g = plan_growth(
+            self.history, tol, opts.max_dofs, self.goal, opts.growth, self.owed, allowed
+        )
         if g is None:
-            stop = f"the budget (--max-dofs {opts.max_dofs}) is full; {reached}"
-            break
-        s = observed_slope(history, goal)
-        aim = PRESSURE_AIM * max(opts.tol, rec.relative * AIM_FLOOR)
-        cells = g * level.summary.elements
-        t0 = time.perf_counter()
-        nxt = scene.remeshed_to(_plan(level, goal, opts.rule, cells, aim).field)
-        dofs = count_dofs(nxt)
-        target = min(g * level.dofs, BUDGET_FILL * opts.max_dofs)
-        for _ in range(REPLANS):
-            if dofs <= opts.max_dofs and dofs <= OVERSHOOT * target:
-                break
-            # gmsh made more than planned (vertex sizes are the smallest of the cells
-            # around, which overshoots most on coarse levels) or than the budget: plan again for the
-            # growth planned, rather than stop or take a level off the plan.
-            cells *= target / dofs
-            if dofs > opts.max_dofs:
-                aim *= dofs / target
-            nxt = scene.remeshed_to(_plan(level, goal, opts.rule, cells, aim).field)
-            dofs = count_dofs(nxt)
-        mesh_time = time.perf_counter() - t0
-        if dofs > opts.max_dofs:
-            stop = f"the next mesh would have {dofs} DOFs > --max-dofs {opts.max_dofs}; {reached}"
-            break
-        say(
-            f"  remeshed: {dofs} DOFs (x {dofs / level.dofs:.2f}; planned x {g:.2f} from the "
-            f"observed rate N^{s:.2f}; the contact cells need {owed} more levels; "
-            f"{mesh_time:.2f} s)"
-        )
-        scene = nxt
-    say(f"stopped: {stop}")
-    return AdaptResult(levels, stop)
+            return f"the budget (--max-dofs {opts.max_dofs}) is full"
+        self.g, self.s = g, observed_slope(self.history, self.goal)
+        self.aim = PRESSURE_AIM * max(tol or 0.0, level.goal.relative * AIM_FLOOR)
+        self.cells = g * level.summary.elements
+        self.target = min(g * level.dofs, BUDGET_FILL * opts.max_dofs)
+        return self._sized(level)
 
+    def replan(self, level: AdaptLevel, dofs: int) -> Plan | None:
+        """Plan again for the growth planned where gmsh made more DOFs than planned or budgeted.
 
-def run_loop(
-    scene: Scene,
-    request: SolveRequest,
-    opts: AdaptOptions,
-    *,
-    paper_interface: bool = False,
-    say: Callable[[str], None] | None = None,
-    mesh_time: float = 0.0,
-    growth_cap: float | None = None,
-) -> AdaptResult:
-    """The goal loop (opts.goal set) or the residual estimate's loop (opts.goal None)."""
-    if opts.goal is None:
-        return adapt(
-            scene, request, opts, paper_interface=paper_interface, say=say, mesh_time=mesh_time
+        Vertex sizes are the smallest of the cells around, which overshoots most on coarse
+        levels; a new plan rather than a stop or a level taken off the plan.
+        """
+        if dofs <= self.opts.max_dofs and dofs <= OVERSHOOT * self.target:
+            return None
+        self.cells *= self.target / dofs
+        if dofs > self.opts.max_dofs:
+            self.aim *= dofs / self.target
+        return self._sized(level)
+
+    def remeshed(self, level: AdaptLevel, dofs: int) -> str:
+        """The growth made and planned, and the contact cells' levels owed."""
+        return (
+            f"{dofs} DOFs (x {dofs / level.dofs:.2f}; planned x {self.g:.2f} from the "
+            f"observed rate N^{self.s:.2f}; the contact cells need {self.owed} more levels)"
         )
-    return adapt_to_goal(
-        scene,
-        request,
-        opts,
-        paper_interface=paper_interface,
-        say=say,
-        mesh_time=mesh_time,
-        growth_cap=growth_cap,
-    )

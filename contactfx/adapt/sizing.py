@@ -24,26 +24,17 @@ from .pressure_sizing import pressure_cell_sizes
 
 @dataclass(frozen=True)
 class SizingRule:
-    """How the next mesh is sized: the rate, the budget and the clipping of each step."""
+    """How the next mesh is sized: the rate, the clipping of each step, the contact weight.
+
+    The cells a level may have are the loop's (`plan_mesh`'s max_cells).
+    """
 
     rate: float = 1.0  # p: energy-norm convergence rate of the element (Q1: 1)
-    growth: float = 4.0  # at most this many times the cells per level
     finest: float = 0.25  # a cell's size shrinks at most to this fraction per level
     coarsest: float = 2.0  # and grows at most by this factor
-    # Sizing (not the estimate) takes each cell's contact terms times this weight: the
-    # energy estimate is bulk-dominated, a pressure needs the contact zone resolved.
-    # 10 from measurements (docs/adapt.md): Hertz L2 0.118 % at 56k DOFs against 0.503 %
-    # unweighted; 30 and 100 did worse; the flat punch's energy error is unchanged.
-    contact_weight: float = 10.0
-
-
-def default_contact_weight(pressure_tol: float | None) -> float:
-    """The contact weight's default: 10, or 1 when the pressure sizing is on.
-
-    Measured on Hertz (docs/adapt.md): with the pressure sizing the weight only takes cells
-    from the bulk (last-level L2 0.059 % with W = 1 against 0.099 % with W = 10).
-    """
-    return 10.0 if pressure_tol is None else 1.0
+    # Sizing (not the estimate) takes each cell's contact terms times this weight (its
+    # default per goal: AdaptOptions.weight, adapt/records.py).
+    contact_weight: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -153,14 +144,15 @@ def _factor(
 def plan_mesh(
     sol: Solution,
     est: Estimate,
-    tol: float,
+    tol: float | None,
     max_cells: float,
     rule: SizingRule = SizingRule(),
     pressure_tol: float | None = None,
 ) -> Plan:
     """The size field of the next level (collective; the field's arrays on rank 0).
 
-    With `pressure_tol`, the cells along the contact surfaces are also sized for the
+    At most `max_cells` cells; fewer where they reach the relative estimate `tol` (None: the
+    cells decide). With `pressure_tol`, the cells along the contact surfaces are also sized for the
     pressure estimate (results/pressure_sizing.py) and the energy sizing gets the budget
     that leaves.
     """
@@ -175,10 +167,8 @@ def plan_mesh(
     q = rule.rate + 1.0
     eta = np.maximum(eta, 1e-300)
     S = comm.allreduce(float(np.sum(eta ** (2 / q))))
-    ncells = msh.topology.index_map(2).size_global
-    budget = min(rule.growth * ncells, max_cells)
-    target = tol * est.energy
-    eta_tol = (target**2 / S) ** (1 / (2 - 2 / q))
+    budget = max_cells
+    eta_tol = 0.0 if tol is None else ((tol * est.energy) ** 2 / S) ** (1 / (2 - 2 / q))
     h_p = np.full(len(h), np.inf)
     if pressure_tol is not None and est.pressure is not None:
         h_p = pressure_cell_sizes(est.pressure, pressure_tol, quads, h, rule.finest)

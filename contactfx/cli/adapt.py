@@ -10,20 +10,14 @@ from pathlib import Path
 from mpi4py import MPI
 
 from ..adapt.goal import Goal
-from ..adapt.loop import AdaptOptions, uniform_levels
+from ..adapt.loop import adapt, uniform_levels
 from ..adapt.mesh_file import write_msh
-from ..adapt.planned import run_loop
-from ..adapt.sizing import SizingRule, default_contact_weight
+from ..adapt.records import AdaptOptions, default_tol
 from ..errors import InputError
 from ..methods.predictor import scene_dofs
 from ..results.files import write_fields, write_json
 from ..scenes import parse_scene_file
 from .params import build_from_args, is_scene_file, reject_structured_adapt, request_from_args
-
-# --tol's defaults: the goal's relative error, and the residual estimate's (--goal residual).
-GOAL_TOL = 0.01
-RESIDUAL_TOL = 0.05
-RESIDUAL_GROWTH = 4.0  # --goal residual's --growth default
 
 
 def check_remeshable(args: argparse.Namespace) -> None:
@@ -38,27 +32,22 @@ def check_remeshable(args: argparse.Namespace) -> None:
     reject_structured_adapt(args)
 
 
-def contact_weight(args: argparse.Namespace) -> float:
-    """--weight-contact, or its default (1; --goal residual: 10, or 1 with --pressure-tol)."""
-    if args.weight_contact is not None:
-        return float(args.weight_contact)
-    if args.goal != "residual":
-        return 1.0
-    return default_contact_weight(args.pressure_tol)
-
-
 def adapt_options(args: argparse.Namespace) -> AdaptOptions:
-    """The loop's options: the goal loop's defaults, or --goal residual's (the old loop)."""
-    residual = args.goal == "residual"
-    tol = args.tol if args.tol is not None else (RESIDUAL_TOL if residual else GOAL_TOL)
-    growth = args.growth if args.growth is not None else RESIDUAL_GROWTH
+    """The loop's options (InputError for a value out of range).
+
+    Without --goal the pressure goal, or the energy where the scene's pressure is singular
+    (the loop decides, AdaptOptions.fallback); an explicit --goal pressure is refused there.
+    """
+    goal = Goal.PRESSURE if args.goal is None else Goal(args.goal)
     return AdaptOptions(
-        tol,
+        goal,
+        default_tol(goal) if args.tol is None else args.tol,
         args.max_dofs,
         args.max_levels,
-        SizingRule(growth=growth, contact_weight=contact_weight(args)),
+        args.growth,
+        args.weight_contact,
         args.pressure_tol,
-        None if residual else Goal(args.goal),
+        Goal.ENERGY if args.goal is None else None,
     )
 
 
@@ -68,7 +57,6 @@ def run_adapt(args: argparse.Namespace) -> int:
     if not args.verbose:
         logging.getLogger("contactfx").setLevel(logging.WARNING)
     opts = adapt_options(args)
-    opts.check()
     check_remeshable(args)
     request = request_from_args(args)
     say = (lambda line: print(line, flush=True)) if comm.rank == 0 else (lambda line: None)
@@ -85,18 +73,10 @@ def run_adapt(args: argparse.Namespace) -> int:
         )
     paper = not is_scene_file(args.scene)
     say(
-        f"adapt {args.scene} ({args.method}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
+        f"adapt {args.scene} ({request.label}): tol {opts.tol:g}, max {opts.max_dofs} DOFs, "
         f"{comm.size} rank{'s' * (comm.size > 1)}"
     )
-    result = run_loop(
-        scene,
-        request,
-        opts,
-        paper_interface=paper,
-        say=say,
-        mesh_time=mesh_time,
-        growth_cap=args.growth,
-    )
+    result = adapt(scene, request, opts, paper_interface=paper, say=say, mesh_time=mesh_time)
     if args.compare_uniform:
         result.uniform = uniform_levels(
             scene,
@@ -114,9 +94,9 @@ def run_adapt(args: argparse.Namespace) -> int:
         from ..adapt.charts import chart_title, plot_adapt  # matplotlib: rank 0, at the end
 
         assert msh is not None
-        write_json(out / "adapt.json", result.to_json(args.scene, args.method, opts, args.solver))
+        write_json(out / "adapt.json", result.to_json(args.scene, request, opts))
         levels, uni = result.levels, result.uniform
-        title = chart_title(args.scene, args.method, bool(uni))
+        title = chart_title(args.scene, request.label, bool(uni))
         written += [
             out / "adapt.json",
             msh,

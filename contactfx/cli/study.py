@@ -100,7 +100,7 @@ def run_command(args: argparse.Namespace) -> int:
             paper_interface=levels[0].paper_interface,
             max_levels=3 * len(levels),
             pressure_tol=args.pressure_tol,
-            goal=None if args.goal == "residual" else Goal(args.goal),
+            goal=Goal(args.goal),
             say=lambda line: say(line, flush=True),
         )
     if comm.rank == 0:

@@ -1,8 +1,8 @@
 """`study --adaptive`: the adaptive loop beside the uniform levels, on the same charts.
 
 After the uniform study, each method (but schwarz, which has no estimate) runs the adaptive
-loop (adapt/loop.py) from level 0's mesh, up to the DOFs of that method's finest uniform
-level. Each adaptive level is measured like a uniform run: against the exact solution
+loop (adapt/loop.py, no tolerance) from level 0's mesh, up to the DOFs of that method's
+finest uniform level. Each adaptive level is measured like a uniform run: against the exact solution
 (Hertz, patch test) or, without one, against the study's self-convergence reference (the
 finest uniform level of the most accurate method). Its time on the charts is cumulative:
 the meshing of level 0, then the solves, estimates and remeshings of all the levels up to it
@@ -15,9 +15,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from ..adapt.goal import Goal
-from ..adapt.loop import AdaptLevel, AdaptOptions
-from ..adapt.planned import run_loop
-from ..adapt.sizing import SizingRule, default_contact_weight
+from ..adapt.loop import adapt
+from ..adapt.records import AdaptLevel, AdaptOptions
 from ..options import Enforcement
 from ..request import SolveRequest
 from ..scenes import Scene
@@ -26,11 +25,10 @@ from .measures import contact_size, profiles
 from .measures import self_errors as compare_profiles
 from .runs import AdaptiveRun, Run
 
-# The loop is steered by the DOF budget only: no tolerance is reached before it.
-NO_TOL = 1e-12
-# Cells per level at most x 2 (adapt's default is x 4): gmsh makes meshes finer than planned
-# on coarse levels (vertex sizes are the smallest of the cells around), and a study's DOF
-# range is one or two decades, which x 4 steps would cross in one or two levels.
+# The residual goal's cells per level at most x 2 (adapt's default is x 4): gmsh makes
+# meshes finer than planned on coarse levels (vertex sizes are the smallest of the cells
+# around), and a study's DOF range is one or two decades, which x 4 steps would cross in one
+# or two levels.
 GROWTH = 2.0
 
 
@@ -77,20 +75,19 @@ def adaptive_runs(
     max_levels: int = 12,
     growth: float = GROWTH,
     pressure_tol: float | None = None,
-    goal: Goal | None = Goal.PRESSURE,
+    goal: Goal = Goal.PRESSURE,
     say: Callable[[str], None] | None = None,
 ) -> list[AdaptiveRun]:
     """Run the adaptive loop of every request from `scene` (level 0) and measure its levels.
 
-    `requests` are the study's (those it ran, by label; schwarz's are skipped).
+    `requests` are the study's (those it ran, by label; schwarz's are skipped). The loop has
+    no tolerance: each method's budget is its finest uniform level's DOFs.
 
-    `goal`: the goal loop (adapt/planned.py: its estimate per level, its planned growth up
-    to the budget); None the residual estimate's loop (growth `growth`). With
-    `pressure_tol` (residual loop) the contact cells are sized for the pressure too, and
-    the contact terms are not weighted (as adapt's defaults).
+    `goal`: a goal estimate's (adapt/planned.py: its estimate per level, its planned growth
+    up to the budget), or Goal.RESIDUAL (growth `growth`; with `pressure_tol` the contact
+    cells are sized for the pressure too, as adapt's).
     """
-    weight = default_contact_weight(pressure_tol) if goal is None else 1.0
-    rule = SizingRule(growth=growth, contact_weight=weight)
+    residual = goal is Goal.RESIDUAL
     ref = self_reference(study.runs, study.methods) if study.reference["kind"] == "self" else None
     out: list[AdaptiveRun] = []
     for request in adaptive_requests(requests):
@@ -98,10 +95,13 @@ def adaptive_runs(
         cap = budget(study, m) if m in study.methods else None
         if cap is None:
             continue
-        result = run_loop(
+        opts = AdaptOptions(
+            goal, None, cap, max_levels, growth if residual else None, None, pressure_tol, None
+        )
+        result = adapt(
             scene,
             request,
-            AdaptOptions(NO_TOL, cap, max_levels, rule, pressure_tol, goal),
+            opts,
             paper_interface=paper_interface,
             say=_prefixed(say, f"adaptive {m}: "),
             mesh_time=level0_mesh(study),
@@ -121,7 +121,7 @@ def adaptive_runs(
                     float(run.times["total"]),
                     lv.time,
                     cumulative,
-                    float(lv.est.relative if lv.goal is None else lv.goal.relative),
+                    float(lv.relative),
                     _errors(study, lv, ref),
                     result.stop,
                 )

@@ -128,7 +128,9 @@ def test_weight_below_one_refused(tmp_path: Path) -> None:
 
 def test_overshooting_mesh_is_replanned_not_dropped() -> None:
     """A remeshed level above --max-dofs is planned again with a smaller budget and kept."""
-    from contactfx.adapt import loop
+    from contactfx.adapt.goal import Goal
+    from contactfx.adapt.loop import ResidualPlan, adapt
+    from contactfx.adapt.records import AdaptOptions
     from contactfx.adapt.sizing import plan_mesh
     from contactfx.methods.predictor import scene_dofs
     from contactfx.request import SolveRequest
@@ -137,23 +139,24 @@ def test_overshooting_mesh_is_replanned_not_dropped() -> None:
 
     budgets: list[float] = []
 
-    def recording(sol, est, tol, budget, rule, pressure_tol):
-        budgets.append(budget)
-        return plan_mesh(sol, est, tol, budget, rule, pressure_tol)
+    def recording(sol, est, tol, cells, rule, pressure_tol):
+        budgets.append(strategy.budget)
+        return plan_mesh(sol, est, tol, cells, rule, pressure_tol)
 
     def overshoot_once(scene):
         # gmsh's first mesh of level 1 counted as twice --max-dofs, as if it overshot.
         return scene_dofs(scene) if len(budgets) > 1 else 2 * opts.max_dofs
 
-    opts = loop.AdaptOptions(max_levels=2, max_dofs=20_000)
+    opts = AdaptOptions(Goal.RESIDUAL, 0.05, max_levels=2, max_dofs=20_000)
+    strategy = ResidualPlan(opts, size=recording)
     scene = hertz(HertzParams(refine=2, h_far=2, refine_edge=0, slope=0.3))
-    result = loop.adapt(
+    result = adapt(
         scene,
         SolveRequest.parse("mortar"),
         opts,
         say=lambda _: None,
         count_dofs=overshoot_once,
-        plan=recording,
+        strategy=strategy,
     )
     assert len(budgets) == 2 and budgets[1] == pytest.approx(budgets[0] * 0.95 / 2)
     assert len(result.levels) == 2 and result.levels[1].dofs <= opts.max_dofs

@@ -16,8 +16,9 @@ import numpy as np
 from conftest import ROOT
 
 from contactfx import load_scene_file, run_scene
-from contactfx.adapt.loop import AdaptOptions, adapt
-from contactfx.adapt.sizing import SizingRule
+from contactfx.adapt.goal import Goal
+from contactfx.adapt.loop import adapt
+from contactfx.adapt.records import AdaptOptions
 from contactfx.request import SolveRequest
 
 SCENES = ROOT / "demos" / "scenes"
@@ -56,11 +57,13 @@ def sadowsky(data: dict, b: float = 1.0) -> tuple[float, float, bool]:
 
 def test_adaptive_beats_uniform_on_the_flat_punch(tmp_path: Path) -> None:
     start = load_scene_file(uniform_punch(tmp_path, 0.5))
-    opts = AdaptOptions(1e-9, 100_000, 3, SizingRule(growth=2))
-    finest = adapt(start, SolveRequest.parse("nts"), opts, say=lambda line: None).levels[-1]
+    # The residual goal without a tolerance (the budget decides), growth x 2.
+    opts = AdaptOptions(Goal.RESIDUAL, None, 100_000, 3, growth=2)
+    nts = SolveRequest.parse("nts")
+    finest = adapt(start, nts, opts, say=lambda line: None).levels[-1]
     # The uniform mesh with every size 0.2 has more DOFs than the adaptive one (gmsh
     # meets a planned size field only within ~10 %, so "equal" is "at least as many").
-    _, data = run_scene(start.remeshed(0.4), "nts")
+    _, data = run_scene(start.remeshed(0.4), nts)
     data = data.to_json()
     assert finest.dofs <= data["dofs"], (finest.dofs, data["dofs"])
     F_a, p_a, face_a = sadowsky(finest.summary.to_json())

@@ -14,7 +14,8 @@ import pytest
 from conftest import COARSE_HERTZ, ROOT, cli
 
 from contactfx.adapt import charts
-from contactfx.adapt.loop import AdaptOptions
+from contactfx.adapt.goal import Goal
+from contactfx.adapt.records import AdaptOptions
 
 CYLINDER = ROOT / "demos" / "scenes" / "cylinder_between_blocks.toml"
 
@@ -71,8 +72,9 @@ def test_start_over_the_budget_refused(tmp_path: Path) -> None:
 def test_stop_line_in_percent() -> None:
     """The levels print percent; the stop reason does too, tol included."""
     est = SimpleNamespace(relative=2.42e-9, pressure=SimpleNamespace(relative=0.004))
-    assert AdaptOptions(tol=0.05).met(est) == "estimate 2.4e-07 % <= tol 5 %"  # type: ignore[arg-type]
-    both = AdaptOptions(tol=0.05, pressure_tol=0.01).met(est)  # type: ignore[arg-type]
+    residual = AdaptOptions(Goal.RESIDUAL, tol=0.05)
+    assert residual.met(est) == "estimate 2.4e-07 % <= tol 5 %"  # type: ignore[arg-type]
+    both = AdaptOptions(Goal.RESIDUAL, tol=0.05, pressure_tol=0.01).met(est)  # type: ignore[arg-type]
     assert both == "estimate 2.4e-07 % <= tol 5 %, pressure estimate 0.4 % <= 1 %"
 
 

@@ -88,7 +88,7 @@ def test_plan_asks_small_cells_at_the_zone_edge_only() -> None:
     sol = contactfx.solve(scene, "mortar")
     est = estimate(sol)
     assert est.pressure is not None and 0 < est.pressure.relative < 1
-    rule = SizingRule(growth=1e9, contact_weight=1.0)
+    rule = SizingRule(contact_weight=1.0)
     cells = 1e9  # no budget: only the tolerances act
     plain = plan_mesh(sol, est, 0.5, cells, rule)
     with_p = plan_mesh(sol, est, 0.5, cells, rule, pressure_tol=1e-3)

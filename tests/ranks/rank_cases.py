@@ -406,7 +406,7 @@ def adapt_hertz(extra: tuple[str, ...] = ()) -> tuple[Solution, Arrays]:
 
     comm = MPI.COMM_WORLD
     seen = []
-    loop = cli_adapt.run_loop
+    loop = cli_adapt.adapt
 
     def recording(*args: Any, **kwargs: Any) -> Any:
         seen.append(loop(*args, **kwargs))
@@ -416,7 +416,7 @@ def adapt_hertz(extra: tuple[str, ...] = ()) -> tuple[Solution, Arrays]:
     argv += ["--slope", "0.3", "--max-dofs", "12000", "--max-levels", "2", "-q", *extra]
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(comm.bcast(tmp))
-        with mock.patch.object(cli_adapt, "run_loop", recording):
+        with mock.patch.object(cli_adapt, "adapt", recording):
             code = cli.main([*argv, "--out", str(out)])
         assert code == 0, f"contactfx {' '.join(argv)}: exit {code}"
         data, counts = None, None
