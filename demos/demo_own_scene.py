@@ -34,7 +34,9 @@ import matplotlib.pyplot as plt
 
 comm = MPI.COMM_WORLD
 OUT = Path(os.environ.get("CONTACTFX_RESULTS", "results")) / "own_scene"
-TEMPLATE = Path(__file__).resolve().parents[1] / "meshes" / "cylinder_between_blocks.geo"
+TEMPLATE = (
+    Path(__file__).resolve().parents[1] / "meshes" / "cylinder_between_blocks.geo"
+)
 METHODS = ["nts", "sts", "mortar", "penalty"]
 
 
