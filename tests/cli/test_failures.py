@@ -320,3 +320,48 @@ def test_cli_success_writes_json(tmp_path: Path) -> None:
     rc, err, out = cli(tmp_path, *S4, "--method", "penalty")
     assert rc == 0, err
     assert out.exists()
+
+
+# ---------------------------------------------------------------- an error on one rank only
+
+FAIL_ON_RANK = Path(__file__).with_name("fail_on_rank.py")
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize(
+    ("stage", "rank", "kind"),
+    [
+        ("parsing", 1, "input"),
+        ("meshing", 1, "internal"),
+        ("assembly", 1, "input"),
+        ("solve", 1, "input"),
+        ("writing", 1, "internal"),
+    ],
+)
+def test_an_error_on_one_rank_ends_every_rank(
+    tmp_path: Path, stage: str, rank: int, kind: str
+) -> None:
+    """An exception on rank 1 only, while rank 0 goes on into a collective: every rank ends
+    within seconds of the raise, exit 2, one message (with the failing rank), no JSON. It
+    hung until killed: the other rank waited in its collective, the failing one in MPI's
+    finalize or in the collective destroy of the solver."""
+    import time
+
+    raised, out = tmp_path / "raised", tmp_path / "run.json"
+    cmd = [MPIRUN, "-n", "2", sys.executable, str(FAIL_ON_RANK), stage, str(rank), kind]
+    args = ["solve", *S4, "--json", str(out), "--out", str(tmp_path / "out"), "-q"]
+    res = subprocess.run(
+        [*cmd, str(raised), "--", *args], capture_output=True, text=True, env=ENV, timeout=120
+    )
+    ended = time.time()
+    assert res.returncode == 2, res.stdout[-2000:] + res.stderr[-2000:]
+    assert ended - float(raised.read_text()) < 15.0
+    lines = [ln for ln in res.stderr.splitlines() if ln.startswith("contactfx: ")]
+    assert len(lines) == 1, res.stderr
+    assert f"raised on purpose at {stage}" in lines[0] and f"on rank {rank} of 2" in lines[0]
+    assert "MPI_Abort" not in res.stderr + res.stdout
+    if kind == "input":
+        assert lines[0].startswith("contactfx: error: ") and "Traceback" not in res.stderr
+    else:  # a bug: the traceback once, then the line
+        assert res.stderr.count("Traceback") == 1 and "internal error: RuntimeError" in lines[0]
+    assert not out.exists()
