@@ -15,6 +15,7 @@ from contextlib import redirect_stderr, redirect_stdout
 from mpi4py import MPI
 
 from .failure import fail
+from .params import check_outputs
 from .parser import parser
 
 
@@ -64,6 +65,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _run(args: argparse.Namespace) -> int:
     """The subcommand of `args`."""
+    check_outputs(args)
     # Each subcommand's module is imported when it runs: a plain solve loads neither the
     # adapt loop's charts (matplotlib) nor the study's tables.
     if args.command == "adapt":

@@ -81,6 +81,28 @@ PARAM_HELP = {
 }
 
 
+def check_outputs(args: argparse.Namespace) -> None:
+    """InputError before anything runs if --out or --json cannot be written as asked.
+
+    --out names a directory (an existing file of that name would fail only after the solve);
+    --json a file. Decided on rank 0 (the rank that writes) for every rank.
+    """
+    comm = MPI.COMM_WORLD
+    problem = None
+    if comm.rank == 0:
+        out, json = getattr(args, "out", None), getattr(args, "json", None)
+        if out is not None and out.exists() and not out.is_dir():
+            problem = (
+                f"--out {out}: a file of that name exists, and --out names a directory for "
+                "the outputs: give another path or remove the file"
+            )
+        elif json is not None and json.is_dir():
+            problem = f"--json {json} is a directory: give the path of the JSON file"
+    problem = comm.bcast(problem, root=0)
+    if problem is not None:
+        raise InputError(problem)
+
+
 def reject_structured_adapt(args: argparse.Namespace) -> None:
     """InputError before anything runs: the structured Hertz mesh has no gmsh geometry."""
     if not is_scene_file(args.scene) and getattr(args, "mesh", None) == "structured":

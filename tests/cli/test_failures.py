@@ -365,3 +365,22 @@ def test_an_error_on_one_rank_ends_every_rank(
     else:  # a bug: the traceback once, then the line
         assert res.stderr.count("Traceback") == 1 and "internal error: RuntimeError" in lines[0]
     assert not out.exists()
+
+
+@pytest.mark.parametrize("option", ["--out", "--json"])
+def test_an_output_path_of_the_wrong_kind_is_refused_before_the_solve(
+    tmp_path: Path, option: str
+) -> None:
+    """--out naming an existing file (a FileExistsError traceback after the whole solve) and
+    --json naming a directory: one line, exit 2, before anything runs, the path untouched."""
+    target = tmp_path / "taken"
+    if option == "--out":
+        target.write_text("keep me")
+    else:
+        target.mkdir()
+    res = run_in_process("solve", *S4, option, str(target))
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert res.returncode == 2 and len(lines) == 1, res.stderr
+    assert lines[0].startswith(f"contactfx: error: {option} {target}"), lines
+    assert res.stdout == ""  # nothing meshed nor solved
+    assert target.read_text() == "keep me" if option == "--out" else target.is_dir()
