@@ -83,3 +83,50 @@ def test_advice_names_the_python_classes_too() -> None:
     with pytest.raises(SingularSystemError) as err:
         run_scene(load_scene_file(SCENES / "disk_between_plates.toml"), "mortar")
     assert "[[dirichlet]]" in str(err.value) and "Dirichlet in Python" in str(err.value)
+
+
+def scene_copy(tmp_path: Path, name: str, old: str = "", new: str = "") -> Path:
+    """tests/scenes/NAME with its mesh path made absolute and `old` replaced by `new`."""
+    text = (SCENES / name).read_text()
+    geo = text.split('mesh = "')[1].split('"')[0]
+    text = text.replace(f'mesh = "{geo}"', f'mesh = "{SCENES / geo}"')
+    assert old in text, old
+    path = tmp_path / name
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+def one_line_refusal(*args: str) -> str:
+    """The CLI's one stderr line for a refused input (exit 2, no traceback)."""
+    proc = cli(*args)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr[-3000:]
+    assert "Traceback" not in proc.stderr and lines[0].startswith("contactfx: error: ")
+    return lines[0]
+
+
+@pytest.mark.serial
+def test_a_modulus_no_units_allow_is_refused_at_input(tmp_path: Path) -> None:
+    """E = 1e308 ended in a traceback from scipy's linprog (load_paths): now refused when
+    the scene is read, naming the body, the value and the range, nothing written."""
+    path = scene_copy(tmp_path, "stacked_blocks.toml", "E = 7000.0", "E = 1e308")
+    out = tmp_path / "r.json"
+    line = one_line_refusal("solve", str(path), "--json", str(out))
+    assert "Young's modulus E = 1e+308 is outside 1e-10 to 1e+15" in line and "units" in line
+    assert not out.exists()
+    assert "body 1: Young's modulus E = 1e+300" in one_line_refusal("solve", "blocks", "--E1", "1e300")
+
+
+@pytest.mark.serial
+def test_load_paths_refuses_an_overflowed_system_in_one_line() -> None:
+    """Past the input check (a Material made in Python and put into a scene as it is): the
+    assembled load is not finite; load_paths says so instead of HiGHS's ValueError."""
+    from dataclasses import replace
+
+    from contactfx import Material
+
+    scene = load_scene_file(SCENES / "stacked_blocks.toml")
+    first = replace(scene.bodies[0], material=Material(1e308, 0.3))
+    scene = replace(scene, bodies=(first, *scene.bodies[1:]))
+    with pytest.raises(InputError, match="overflows double precision"):
+        run_scene(scene, "mortar")
