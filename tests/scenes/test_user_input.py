@@ -130,3 +130,38 @@ def test_load_paths_refuses_an_overflowed_system_in_one_line() -> None:
     scene = replace(scene, bodies=(first, *scene.bodies[1:]))
     with pytest.raises(InputError, match="overflows double precision"):
         run_scene(scene, "mortar")
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize(
+    ("line", "said"),
+    [
+        ("model = 3", "model: expected one of plane_strain, plane_stress, axisymmetric (a string)"),
+        ("units = { length = 5 }", "units.length: expected a unit name (a string), got 5"),
+        ("name = 3", "name: expected a name (a string), got 3"),
+        ("mesh = 3", "mesh: expected a mesh file path (a string), got 3"),
+    ],
+)
+def test_a_top_level_key_of_the_wrong_type_says_what_it_wanted(
+    tmp_path: Path, line: str, said: str
+) -> None:
+    """These said "expected a group name (a string)", which none of them is."""
+    path = scene_copy(tmp_path, "stacked_blocks.toml")
+    text = path.read_text()
+    if line.startswith("mesh"):
+        text = "\n".join(ln for ln in text.splitlines() if not ln.startswith("mesh ="))
+    path.write_text(f"{line}\n{text}")
+    refusal = one_line_refusal("solve", str(path))
+    assert said in refusal and "group name" not in refusal
+
+
+def test_the_scene_file_reference_says_what_each_top_level_key_wants() -> None:
+    """The generated reference repeated "a group name" for mesh, name and model."""
+    from contactfx.scenes.schema import reference_markdown
+
+    rows = {ln.split("|")[1].strip(): ln for ln in reference_markdown().splitlines() if "| `" in ln}
+    assert "mesh file path" in rows["`mesh`"] and "expected a name" in rows["`name`"]
+    assert "plane_strain, plane_stress, axisymmetric (a string)" in rows["`model`"]
+    for key in ("`mesh`", "`name`", "`model`"):
+        assert "group name" not in rows[key]
+    assert "group name" in rows["`active`"]
