@@ -138,6 +138,16 @@ def _check_conditions(scene: Scene) -> None:
         values = [load.p] if hasattr(load, "p") else list(load.t)
         if not all(math.isfinite(float(v)) for v in values):
             raise InputError(f"load on '{load.group}': values must be finite")
+        stiffest = max(b.material.E for b in scene.bodies)
+        if max(abs(float(v)) for v in values) > stiffest:
+            # The stiffest body strained beyond 100 %: units, not a load (1e300 overflowed
+            # the solve into a DIVERGED_NANORINF that named no load).
+            key = "p" if hasattr(load, "p") else "t"
+            raise InputError(
+                f"load on '{load.group}': {key} = {_text(values)} exceeds the largest Young's "
+                f"modulus of the bodies ({stiffest:g}), a strain beyond 100 % (contactfx is "
+                "a small-strain code): check its units"
+            )
     for ref in scene.references:
         pair = getattr(ref, "pair", 0)
         if isinstance(ref, LameReference):
@@ -147,6 +157,10 @@ def _check_conditions(scene: Scene) -> None:
                 f"reference: pair {pair} does not exist (the scene has "
                 f"{len(scene.contacts)} contact pairs and {len(scene.obstacles)} obstacles)"
             )
+
+
+def _text(values: list[float]) -> str:
+    return f"{values[0]:g}" if len(values) == 1 else "[" + ", ".join(f"{v:g}" for v in values) + "]"
 
 
 def _check_axis(scene: Scene) -> None:

@@ -165,3 +165,17 @@ def test_the_scene_file_reference_says_what_each_top_level_key_wants() -> None:
     for key in ("`mesh`", "`name`", "`model`"):
         assert "group name" not in rows[key]
     assert "group name" in rows["`active`"]
+
+
+@pytest.mark.serial
+def test_a_load_that_would_overflow_is_refused_naming_the_load(tmp_path: Path) -> None:
+    """p = 1e300 ended in "linear solve (gmres) did not converge ... DIVERGED_NANORINF" and
+    --P 1e300 in a mesher's message naming no option: each now names its load, before
+    anything is meshed or solved."""
+    path = scene_copy(tmp_path, "stacked_blocks.toml", "p = 10.0", "p = 1e300")
+    line = one_line_refusal("solve", str(path))
+    assert "load on 'b4_top': p = 1e+300 exceeds the largest Young's modulus" in line
+    line = one_line_refusal("solve", "hertz", "--P", "1e300")
+    assert "P = 1e+300 gives a Hertz contact half-width a = 1.44e+149 beyond the radius" in line
+    line = one_line_refusal("solve", "blocks", "--p", "1e300")
+    assert "p = 1e+300 exceeds the larger Young's modulus 70000" in line
