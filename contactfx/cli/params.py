@@ -6,12 +6,14 @@ Shared by `solve` and `study` (cli/solve.py, cli/study.py).
 from __future__ import annotations
 
 import argparse
+import math
 from dataclasses import replace
 from pathlib import Path
 
 from mpi4py import MPI
 
 from ..errors import InputError
+from ..methods.solver_choice import mem_available_mb
 from ..options import Basis, Predictor, SolverSpec, solver_spec
 from ..request import SolveRequest
 from ..scenes import (
@@ -21,8 +23,14 @@ from ..scenes import (
     Model,
     Scene,
     build_scene,
+    hertz_exact,
     load_scene_file,
+    validate,
 )
+
+# The least memory a solve takes per DOF: the condensed solver's peak, about 110 MB per 100k
+# DOFs (docs/results.md, "peak MB per 100k DOFs"; MUMPS takes about 3 times more).
+LEAST_BYTES_PER_DOF = 1.1e3
 
 BLOCK_KEYS = (
     "l1",
@@ -157,7 +165,43 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
     ]
     if unused:
         raise InputError(f"option --{unused[0]} does not apply to the {args.scene} scene")
-    return replace(base, **given)
+    params = replace(base, **given)
+    if isinstance(params, HertzParams):
+        check_hertz_size(params, getattr(args, "available_memory", None))
+    return params
+
+
+def hertz_cells(params: HertzParams) -> float:
+    """About how many cells the graded Hertz mesh has (both bodies), before any meshing.
+
+    Sizes grow as refine + slope d with the distance d from the refined stretch of the
+    contact line (length r_refine): its strips hold length / (slope refine) cells per body,
+    its ends (pi / slope^2) ln(1 + h_far / refine). Within 30 % of gmsh's count from the
+    defaults to refine 0.005 (tests/cli/test_messages.py).
+    """
+    length = params.r_refine or 1.4 * hertz_exact(params)["a"]
+    h_far = params.h_far or params.R / 6
+    h, s = params.refine, params.slope
+    return 2 * (length / (s * h) + math.pi / s**2 * math.log(1 + h_far / h))
+
+
+def check_hertz_size(params: HertzParams, available_mb: float | None) -> None:
+    """InputError before gmsh runs if the Hertz mesh of --refine could not be solved here.
+
+    The memory of its DOFs (2 a cell) at the least any solver takes (LEAST_BYTES_PER_DOF)
+    against --available-memory or MemAvailable; nothing is refused where neither is known.
+    """
+    validate(params)
+    cells = hertz_cells(params)
+    need_mb = 2 * cells * LEAST_BYTES_PER_DOF / 1e6
+    available = available_mb if available_mb is not None else mem_available_mb()
+    if available is not None and need_mb > available:
+        raise InputError(
+            f"--refine {params.refine:g} (--slope {params.slope:g}) makes a mesh of about "
+            f"{cells:.2g} cells ({2 * cells:.2g} DOFs), whose solve needs at least "
+            f"{need_mb / 1e3:.3g} GB of memory, more than the {available / 1e3:.3g} GB "
+            "available: give a larger --refine"
+        )
 
 
 def spec_from_args(args: argparse.Namespace) -> SolverSpec:
