@@ -384,3 +384,19 @@ def test_an_output_path_of_the_wrong_kind_is_refused_before_the_solve(
     assert lines[0].startswith(f"contactfx: error: {option} {target}"), lines
     assert res.stdout == ""  # nothing meshed nor solved
     assert target.read_text() == "keep me" if option == "--out" else target.is_dir()
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["solve", *S4, "--goal", "energy"], "--goal energy applies with --estimate only"),
+        (["study", *S4, "--goal", "force", "--out", "s"], "--goal applies to study --adaptive"),
+    ],
+)
+def test_a_goal_without_its_estimate_is_refused(tmp_path: Path, args: list[str], words: str) -> None:
+    """`solve --goal energy` without --estimate was silently ignored (a run that seemed to
+    estimate the energy error and did not): refused, one line, before anything runs."""
+    res = run_in_process(*args, cwd=tmp_path)
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert res.returncode == 2 and len(lines) == 1 and words in lines[0], res.stderr
+    assert not any(tmp_path.iterdir())
