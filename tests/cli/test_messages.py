@@ -208,3 +208,15 @@ def test_the_hertz_cell_estimate_is_within_30_percent_of_gmsh(params: dict) -> N
     scene = build_scene("hertz", p, comm=MPI.COMM_SELF)
     cells = scene.mesh.topology.index_map(2).size_local
     assert abs(cells / hertz_cells(p) - 1) < 0.3, (cells, hertz_cells(p))
+
+
+@pytest.mark.mpi
+def test_a_usage_error_under_mpirun_is_printed_once() -> None:
+    """argparse's usage and error lines came once per rank."""
+    from conftest import run_cli
+
+    proc = run_cli("solve", "blocks", "--no-such-option", ranks=2)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.count("usage: contactfx") == 1, proc.stderr
+    errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("contactfx: error:")]
+    assert errors == ["contactfx: error: unrecognized arguments: --no-such-option"], proc.stderr
