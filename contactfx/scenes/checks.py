@@ -163,6 +163,31 @@ def _text(values: list[float]) -> str:
     return f"{values[0]:g}" if len(values) == 1 else "[" + ", ".join(f"{v:g}" for v in values) + "]"
 
 
+# The largest prescribed overlap relative to the model's size: the strain it makes is about
+# that ratio, and contactfx is a small-strain code (the thermal strain's bound too: fits.py).
+OVERLAP_MAX = 0.1
+
+
+def _check_overlaps(scene: Scene) -> None:
+    """InputError for an `interference = D` beyond OVERLAP_MAX of the model's extent."""
+    given = [(k, p) for k, p in enumerate(scene.contacts) if p.prescribed_overlap > 0]
+    if not given:
+        return
+    x = scene.mesh.geometry.x[:, :2]
+    comm = scene.comm
+    lo = comm.allreduce(x.min(axis=0, initial=np.inf), op=MPI.MIN)
+    hi = comm.allreduce(x.max(axis=0, initial=-np.inf), op=MPI.MAX)
+    extent = float(np.max(hi - lo))
+    for k, pair in given:
+        d = pair.prescribed_overlap
+        if d > OVERLAP_MAX * extent:
+            raise InputError(
+                f"contact {k} ('{pair.active}' on '{pair.passive}'): interference = {d:g} is "
+                f"more than {OVERLAP_MAX:g} of the model's size {extent:g} (a strain far "
+                "beyond small strain): check its units"
+            )
+
+
 def _check_axis(scene: Scene) -> None:
     """Axisymmetric: x is the radius; a cell with a node at x < 0 (beyond round-off) is refused."""
     if scene.model is not Model.AXISYMMETRIC:
@@ -190,4 +215,5 @@ def check_scene(scene: Scene) -> Scene:
     curve_bodies = _check_pairs(scene)
     curve_bodies.update(_check_obstacles(scene, curve_bodies))
     _check_conditions(scene)
+    _check_overlaps(scene)
     return replace(scene, curve_bodies=curve_bodies)

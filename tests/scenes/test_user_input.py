@@ -179,3 +179,11 @@ def test_a_load_that_would_overflow_is_refused_naming_the_load(tmp_path: Path) -
     assert "P = 1e+300 gives a Hertz contact half-width a = 1.44e+149 beyond the radius" in line
     line = one_line_refusal("solve", "blocks", "--p", "1e300")
     assert "p = 1e+300 exceeds the larger Young's modulus 70000" in line
+
+
+@pytest.mark.serial
+def test_an_interference_beyond_the_models_size_is_refused(tmp_path: Path) -> None:
+    """interference = 1e6 on rings of outer radius 3 was solved without a word."""
+    path = scene_copy(tmp_path, "shrink_fit_touching.toml", "interference = 0.002", "interference = 1e6")
+    line = one_line_refusal("solve", str(path))
+    assert "interference = 1e+06 is more than 0.1 of the model's size 3" in line, line
