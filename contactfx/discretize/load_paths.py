@@ -245,6 +245,25 @@ def floating_message(
     return "; ".join(parts) + ": " + advice(pairs, hold, loose)
 
 
+def what_pulls(scene: Scene) -> str:
+    """What pulls the bodies apart, as the scene has it: its loads, its thermal strains, both.
+
+    A cooled body between walls has no load to blame: the message names its shrinking.
+    """
+    strains = [
+        f"alpha dT = {b.material.thermal_strain:.3g} in '{b.name}'"
+        for b in scene.bodies
+        if b.material.thermal_strain
+    ]
+    if not strains:
+        return "the load pulls the bodies apart"
+    cooled = all(b.material.thermal_strain <= 0 for b in scene.bodies)
+    thermal = f"the thermal strain ({', '.join(strains)}{': it shrinks' if cooled else ''})"
+    if scene.loads:
+        return f"the load and {thermal} pull the bodies apart"
+    return f"{thermal} pulls the bodies apart (no load is applied)"
+
+
 def _verdict(comm: MPI.Comm, a: np.ndarray, load: np.ndarray) -> tuple[Any, Any]:
     """Rank 0's carrying_rows (and pulled_away where nothing carries), on every rank.
 
@@ -318,7 +337,7 @@ def load_paths(
             for k in loose
         ]
         raise SingularSystemError(
-            f"{'; '.join(said)}; decided before the first solve: the load pulls the bodies apart"
+            f"{'; '.join(said)}; decided before the first solve: {what_pulls(scene)}"
         )
     paths = LoadPaths(rows, carries)
     message = floating_message(pairs, layout_pair, hold, paths)

@@ -187,3 +187,13 @@ def test_an_interference_beyond_the_models_size_is_refused(tmp_path: Path) -> No
     path = scene_copy(tmp_path, "shrink_fit_touching.toml", "interference = 0.002", "interference = 1e6")
     line = one_line_refusal("solve", str(path))
     assert "interference = 1e+06 is more than 0.1 of the model's size 3" in line, line
+
+
+@pytest.mark.serial
+def test_a_cooled_body_between_walls_blames_its_thermal_strain(tmp_path: Path) -> None:
+    """heated_block.toml cooled (dT = -100) shrinks off its walls: refused as "the load
+    pulls the bodies apart", where the scene applies no load."""
+    path = scene_copy(tmp_path, "heated_block.toml", "dT = 100.0", "dT = -100.0")
+    line = one_line_refusal("solve", str(path))
+    assert "the thermal strain (alpha dT = -0.001 in 'block': it shrinks) pulls" in line, line
+    assert "(no load is applied)" in line and "the load pulls" not in line
