@@ -90,3 +90,16 @@ def test_readme_says_what_a_run_summary_holds() -> None:
     names = {f.name for f in dataclasses.fields(RunSummary)} | set(dir(RunSummary))
     for name in ("hertz", "patch", "to_json", "with_estimate"):
         assert name in names, name
+
+
+@pytest.mark.serial
+def test_readme_commands_write_under_an_ignored_folder() -> None:
+    """The README's command left out/ and r.json untracked in the repository root: every
+    --json and --out it gives lies under results/, which .gitignore ignores."""
+    lines = [ln for ln in README.splitlines() if ln.startswith(".venv/bin/python -m contactfx")]
+    ignored = (ROOT / ".gitignore").read_text().splitlines()
+    assert "/results/" in ignored
+    for line in lines:
+        args = parser().parse_args(line.split()[3:])
+        for path in (getattr(args, "json", None), getattr(args, "out", None)):
+            assert path is None or path.parts[0] == "results", line
