@@ -103,3 +103,21 @@ def test_readme_commands_write_under_an_ignored_folder() -> None:
         args = parser().parse_args(line.split()[3:])
         for path in (getattr(args, "json", None), getattr(args, "out", None)):
             assert path is None or path.parts[0] == "results", line
+
+
+@pytest.mark.serial
+def test_make_installs_the_package_without_the_editable_banner() -> None:
+    """`make demo` printed setuptools' editable-install banner (a build-backend warning that
+    pip's --quiet lets through): every editable install runs with warnings ignored."""
+    import shutil
+    import subprocess
+
+    if shutil.which("make") is None:
+        pytest.skip("no make")
+    for target in ("venv", "docs"):
+        dry = subprocess.run(
+            ["make", "-n", "-B", target], cwd=ROOT, capture_output=True, text=True, check=True
+        )
+        installs = [ln for ln in dry.stdout.splitlines() if "pip install" in ln and " -e " in ln]
+        assert installs, dry.stdout
+        assert all("PYTHONWARNINGS=ignore" in ln for ln in installs), installs
