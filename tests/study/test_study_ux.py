@@ -77,3 +77,33 @@ def test_missing_half_width_says_why() -> None:
     )  # fmt: skip
     line = next(ln for ln in terminal_summary(run) if ln.startswith("Hertz"))
     assert "nan" not in line and "a: n/a (3 active nodes" in line, line
+
+
+def _study_lines(dofs: list[int], mesh: list[float], costs: list[float]) -> list[str]:
+    """The progress lines of a one-method study with these DOFs, meshing and run costs."""
+    lines: list[str] = []
+    progress = Progress(["mortar"], len(dofs), 2.0, lines.append)
+    for k, (n, m, c) in enumerate(zip(dofs, mesh, costs, strict=True)):
+        run = Run("mortar", k, 1.0, dofs=n, times={"total": m + c, "mesh": m})
+        progress.finished(run, m)
+    return lines
+
+
+def test_no_time_left_is_guessed_from_the_first_level_alone() -> None:
+    """A study hertz said ~88 s left after its first run (29 s real): the DOFs of the graded
+    Hertz meshes grow about 2.35x a level, not ratio^2 = 4, and level 0 is mostly overhead.
+    Until two levels are measured the line says when the estimate comes."""
+    # study hertz --levels 4 --size-factor 2 (one method): DOFs, meshing, solve times.
+    lines = _study_lines([4180, 9610, 22614, 56922], [0.1, 0.25, 1.64, 6.3], [0.2, 0.26, 0.7, 3.0])
+    assert lines[0].endswith("time left estimated after level 1"), lines[0]
+    assert re.search(r"~\d+\.\d s left$", lines[1]) and lines[-1].endswith("done"), lines
+
+
+def test_levels_not_meshed_yet_are_meshed_at_the_fresh_rate_seen() -> None:
+    """Level 1 came from the mesh cache (6x faster than gmsh per DOF), level 0 from gmsh:
+    the meshing of level 2 is estimated at gmsh's rate, not the cache's."""
+    progress = Progress(["mortar"], 3, 2.0, lambda _: None)
+    for k, (n, m) in enumerate([(10_000, 0.8), (40_000, 0.4)]):
+        progress.finished(Run("mortar", k, 1.0, dofs=n, times={"total": m, "mesh": m}), m)
+    solve = 0.0  # the runs cost nothing here: what is left is level 2's meshing
+    assert progress.left([("mortar", 2)]) == pytest.approx(solve + 8e-5 * 160_000)
