@@ -107,3 +107,40 @@ def test_levels_not_meshed_yet_are_meshed_at_the_fresh_rate_seen() -> None:
         progress.finished(Run("mortar", k, 1.0, dofs=n, times={"total": m, "mesh": m}), m)
     solve = 0.0  # the runs cost nothing here: what is left is level 2's meshing
     assert progress.left([("mortar", 2)]) == pytest.approx(solve + 8e-5 * 160_000)
+
+
+def test_the_time_chart_plots_each_runs_time_after_meshing(tmp_path: Path) -> None:
+    """accuracy_vs_time.png put cached meshing (0.2 s) and gmsh's (6 s) on one axis with the
+    solves: it plots the time after meshing, with the rate of the points drawn, and says so."""
+    import matplotlib.pyplot as plt
+
+    from contactfx.study import charts
+
+    runs = [
+        Run("mortar", k, 1.0, dofs=n, times={"total": m + t, "mesh": m}, errors={"l2": e})
+        for k, (n, m, t, e) in enumerate([(1e4, 0.2, 1.0, 4e-3), (4e4, 6.0, 4.0, 2e-3)])
+    ]
+    study: Any = SimpleNamespace(
+        runs=runs, methods=["mortar"], error_names=["l2"], reference={"kind": "exact", "type": "hertz"},
+        rates={"mortar": {"l2": 1.0}}, flags={}, adaptive=[], scene="hertz", ranks=1,
+    )  # fmt: skip
+    xs, errors = charts._series(study, "mortar", "l2", "solve")
+    assert list(xs) == [1.0, 4.0] and list(errors) == [4e-3, 2e-3]
+    captured: dict[str, Any] = {}
+    finish = charts._finish
+
+    def keep(fig: Any, path: Path, title: str) -> Path:
+        ax = fig.axes[0]
+        captured["x"] = list(ax.lines[0].get_xdata())
+        captured["label"], captured["legend"] = ax.get_xlabel(), ax.get_legend_handles_labels()[1]
+        return finish(fig, path, title)
+
+    charts._finish = keep
+    try:
+        charts.plot_time(study, tmp_path / "t.png")
+    finally:
+        charts._finish = finish
+        plt.close("all")
+    assert captured["x"] == [1.0, 4.0], captured
+    assert "after meshing" in captured["label"] and "left out" in captured["label"]
+    assert captured["legend"] == ["mortar: error ~ t^-0.50"], captured["legend"]
