@@ -93,4 +93,3 @@ def abort(err: BaseException, errors: MPI.Comm) -> None:
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 2)
     errors.Abort(2)
-

@@ -73,7 +73,9 @@ def run_command(args: argparse.Namespace) -> int:
         check_adaptive(args, requests)
     elif args.goal is not None or args.pressure_tol is not None:
         given = "--goal" if args.goal is not None else "--pressure-tol"
-        raise InputError(f"{given} applies to study --adaptive only: add --adaptive or leave it out")
+        raise InputError(
+            f"{given} applies to study --adaptive only: add --adaptive or leave it out"
+        )
     levels = levels_from_args(args, comm)
     say = print if comm.rank == 0 else (lambda *a, **k: None)
     say(

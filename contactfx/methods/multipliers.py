@@ -33,8 +33,8 @@ from .active_set import (
     Step,
     run_active_set,
 )
-from .cleanup import released
 from .autosolve import Prepared, prepare_solver, warn_if_too_big
+from .cleanup import released
 from .solution import Solution, finish
 from .solvers import BLR_KEYS, setup_solver
 

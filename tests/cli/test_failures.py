@@ -393,7 +393,9 @@ def test_an_output_path_of_the_wrong_kind_is_refused_before_the_solve(
         (["study", *S4, "--goal", "force", "--out", "s"], "--goal applies to study --adaptive"),
     ],
 )
-def test_a_goal_without_its_estimate_is_refused(tmp_path: Path, args: list[str], words: str) -> None:
+def test_a_goal_without_its_estimate_is_refused(
+    tmp_path: Path, args: list[str], words: str
+) -> None:
     """`solve --goal energy` without --estimate was silently ignored (a run that seemed to
     estimate the energy error and did not): refused, one line, before anything runs."""
     res = run_in_process(*args, cwd=tmp_path)

@@ -114,7 +114,9 @@ def test_a_modulus_no_units_allow_is_refused_at_input(tmp_path: Path) -> None:
     line = one_line_refusal("solve", str(path), "--json", str(out))
     assert "Young's modulus E = 1e+308 is outside 1e-10 to 1e+15" in line and "units" in line
     assert not out.exists()
-    assert "body 1: Young's modulus E = 1e+300" in one_line_refusal("solve", "blocks", "--E1", "1e300")
+    assert "body 1: Young's modulus E = 1e+300" in one_line_refusal(
+        "solve", "blocks", "--E1", "1e300"
+    )
 
 
 @pytest.mark.serial
@@ -184,7 +186,9 @@ def test_a_load_that_would_overflow_is_refused_naming_the_load(tmp_path: Path) -
 @pytest.mark.serial
 def test_an_interference_beyond_the_models_size_is_refused(tmp_path: Path) -> None:
     """interference = 1e6 on rings of outer radius 3 was solved without a word."""
-    path = scene_copy(tmp_path, "shrink_fit_touching.toml", "interference = 0.002", "interference = 1e6")
+    path = scene_copy(
+        tmp_path, "shrink_fit_touching.toml", "interference = 0.002", "interference = 1e6"
+    )
     line = one_line_refusal("solve", str(path))
     assert "interference = 1e+06 is more than 0.1 of the model's size 3" in line, line
 

@@ -121,8 +121,9 @@ def test_the_time_chart_plots_each_runs_time_after_meshing(tmp_path: Path) -> No
         for k, (n, m, t, e) in enumerate([(1e4, 0.2, 1.0, 4e-3), (4e4, 6.0, 4.0, 2e-3)])
     ]
     study: Any = SimpleNamespace(
-        runs=runs, methods=["mortar"], error_names=["l2"], reference={"kind": "exact", "type": "hertz"},
-        rates={"mortar": {"l2": 1.0}}, flags={}, adaptive=[], scene="hertz", ranks=1,
+        runs=runs, methods=["mortar"], error_names=["l2"], rates={"mortar": {"l2": 1.0}},
+        reference={"kind": "exact", "type": "hertz"}, flags={}, adaptive=[], scene="hertz",
+        ranks=1,
     )  # fmt: skip
     xs, errors = charts._series(study, "mortar", "l2", "solve")
     assert list(xs) == [1.0, 4.0] and list(errors) == [4e-3, 2e-3]
