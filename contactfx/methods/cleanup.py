@@ -29,9 +29,14 @@ def released(comm: MPI.Comm, *objs: Destroyable) -> Iterator[None]:
     try:
         yield
     except BaseException:
-        if comm.size == 1:
-            for obj in objs:
-                obj.destroy()
+        dropped(comm, *objs)
         raise
     for obj in objs:
         obj.destroy()
+
+
+def dropped(comm: MPI.Comm, *objs: Destroyable) -> None:
+    """Destroy `objs` on an error's way out: in serial only (mpirun: see the module's note)."""
+    if comm.size == 1:
+        for obj in objs:
+            obj.destroy()
