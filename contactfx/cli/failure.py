@@ -29,14 +29,24 @@ from ..errors import ContactFxError
 AGREE_SECONDS = 3.0
 
 
+def is_bug(err: BaseException) -> bool:
+    """Whether `err` is a bug of contactfx: neither a ContactFxError (every input contactfx
+    refuses raises one) nor a file the system refused (an OSError naming its file)."""
+    return not isinstance(err, ContactFxError) and not (
+        isinstance(err, OSError) and err.filename is not None
+    )
+
+
 def message(err: BaseException) -> str:
     """The line the user reads: a contactfx error's text, or an internal error's type and text.
 
-    An exception that is no ContactFxError is a bug (contactfx raises a ContactFxError for
-    every input it refuses): its traceback is printed before the line.
+    A bug's traceback is printed before the line.
     """
     if isinstance(err, ContactFxError):
         return f"contactfx: error: {err}"
+    if not is_bug(err):
+        assert isinstance(err, OSError)
+        return f"contactfx: error: {err.filename}: {err.strerror}"
     return (
         f"contactfx: internal error: {type(err).__name__}: {err} (a bug in contactfx, not "
         "in the input: please report it with the traceback above)"
@@ -62,7 +72,7 @@ def fail(err: Exception, errors: MPI.Comm | None, wait: float = AGREE_SECONDS) -
     alone, it prints with its rank and calls MPI_Abort, which ends the ranks that wait.
     """
     line = message(err)
-    internal = not isinstance(err, ContactFxError)
+    internal = is_bug(err)
     if errors is None or errors.size == 1:
         if internal:
             traceback.print_exception(err)
@@ -80,7 +90,7 @@ def fail(err: Exception, errors: MPI.Comm | None, wait: float = AGREE_SECONDS) -
 
 def abort(err: BaseException, errors: MPI.Comm) -> None:
     """Print `err` once, with this rank, and end every rank of the job with code 2."""
-    if not isinstance(err, ContactFxError):
+    if is_bug(err):
         traceback.print_exception(err)
     print(
         f"{message(err)} (on rank {errors.rank} of {errors.size} only: every rank is stopped)",

@@ -106,9 +106,21 @@ def check_outputs(args: argparse.Namespace) -> None:
             )
         elif json is not None and json.is_dir():
             problem = f"--json {json} is a directory: give the path of the JSON file"
+        for option, path in (("--out", out), ("--json", json)):
+            blocked = _file_above(path) if path is not None else None
+            if problem is None and blocked is not None:
+                problem = f"{option} {path}: {blocked} is a file, not a directory to write in"
     problem = comm.bcast(problem, root=0)
     if problem is not None:
         raise InputError(problem)
+
+
+def _file_above(path: Path) -> Path | None:
+    """The nearest existing folder above `path` if it is a file (it cannot hold `path`)."""
+    for parent in path.absolute().parents:
+        if parent.exists():
+            return None if parent.is_dir() else parent
+    return None
 
 
 def reject_structured_adapt(args: argparse.Namespace) -> None:

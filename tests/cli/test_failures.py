@@ -367,23 +367,24 @@ def test_an_error_on_one_rank_ends_every_rank(
     assert not out.exists()
 
 
-@pytest.mark.parametrize("option", ["--out", "--json"])
+@pytest.mark.parametrize(("option", "inside"), [("--out", ""), ("--json", ""), ("--json", "x")])
 def test_an_output_path_of_the_wrong_kind_is_refused_before_the_solve(
-    tmp_path: Path, option: str
+    tmp_path: Path, option: str, inside: str
 ) -> None:
-    """--out naming an existing file (a FileExistsError traceback after the whole solve) and
-    --json naming a directory: one line, exit 2, before anything runs, the path untouched."""
+    """--out naming an existing file (a FileExistsError traceback after the whole solve),
+    --json naming a directory or a path under a file: one line, exit 2, before anything
+    runs, the path untouched."""
     target = tmp_path / "taken"
-    if option == "--out":
+    if option == "--out" or inside:
         target.write_text("keep me")
     else:
         target.mkdir()
-    res = run_in_process("solve", *S4, option, str(target))
+    res = run_in_process("solve", *S4, option, str(target / inside if inside else target))
     lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
     assert res.returncode == 2 and len(lines) == 1, res.stderr
     assert lines[0].startswith(f"contactfx: error: {option} {target}"), lines
     assert res.stdout == ""  # nothing meshed nor solved
-    assert target.read_text() == "keep me" if option == "--out" else target.is_dir()
+    assert target.read_text() == "keep me" if option == "--out" or inside else target.is_dir()
 
 
 @pytest.mark.parametrize(
@@ -402,3 +403,28 @@ def test_a_goal_without_its_estimate_is_refused(
     lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
     assert res.returncode == 2 and len(lines) == 1 and words in lines[0], res.stderr
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("err", "last"),
+    [
+        (PermissionError(13, "Permission denied", "/x/r.json"), "/x/r.json: Permission denied"),
+        (RuntimeError("a bug"), "internal error: RuntimeError: a bug (a bug in contactfx"),
+    ],
+)
+def test_cli_ends_any_exception_with_exit_2(err: Exception, last: str, monkeypatch, capsys) -> None:
+    """A file the system refuses is one line; a bug keeps its traceback, then one line; both
+    exit 2 (a bug's traceback ended the process with exit 1, and under mpirun hung it)."""
+    from contactfx import cli
+    from contactfx.cli import solve as cli_solve
+
+    def fail(args: object) -> int:
+        raise err
+
+    monkeypatch.setattr(cli_solve, "run", fail)
+    assert cli.main(["solve", "blocks"]) == 2
+    text = capsys.readouterr().err
+    lines = text.strip().splitlines()
+    assert lines[-1].startswith("contactfx: ") and last in lines[-1], text
+    assert ("Traceback" in text) == isinstance(err, RuntimeError)
+    assert len(lines) == 1 or isinstance(err, RuntimeError)
