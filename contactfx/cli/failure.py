@@ -30,8 +30,11 @@ AGREE_SECONDS = 3.0
 
 
 def is_bug(err: BaseException) -> bool:
-    """Whether `err` is a bug of contactfx: neither a ContactFxError (every input contactfx
-    refuses raises one) nor a file the system refused (an OSError naming its file)."""
+    """Whether `err` is a bug of contactfx.
+
+    Not a bug: a ContactFxError (every input contactfx refuses raises one), or a file the
+    system refused (an OSError naming its file).
+    """
     return not isinstance(err, ContactFxError) and not (
         isinstance(err, OSError) and err.filename is not None
     )

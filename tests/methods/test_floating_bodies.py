@@ -227,5 +227,5 @@ def test_a_program_that_refuses_its_input_is_an_error_on_every_rank() -> None:
     a = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
     with pytest.raises(ValueError, match="linprog"):
         carrying_rows(a, np.array([np.nan, 1.0]))
-    with pytest.raises(SingularSystemError, match="the check of which contacts .* failed"):
+    with pytest.raises(SingularSystemError, match=r"the check of which contacts .* failed"):
         _verdict(MPI.COMM_SELF, a, np.array([np.nan, 1.0]))
