@@ -315,6 +315,14 @@ def test_cli_failure_under_mpi(tmp_path: Path) -> None:
     assert "SingularSystemError" not in line
 
 
+@pytest.mark.mpi
+def test_cli_failure_inside_the_solve_under_mpi(tmp_path: Path) -> None:
+    """Raised on every rank inside the active-set loop, where the solver's PETSc objects are
+    left to the traceback under mpirun (methods/cleanup.py): freed alike on every rank."""
+    args = ["hertz", "--refine", "0.1", "--max-iterations", "1"]
+    assert_clean_failure(tmp_path, args, "did not converge in 1 iterations", mpi=2)
+
+
 def test_cli_success_writes_json(tmp_path: Path) -> None:
     # The counterpart: the same command line with a valid pressure writes its JSON.
     rc, err, out = cli(tmp_path, *S4, "--method", "penalty")
