@@ -179,7 +179,7 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
         raise InputError(f"option --{unused[0]} does not apply to the {args.scene} scene")
     params = replace(base, **given)
     if isinstance(params, HertzParams):
-        check_hertz_size(params, getattr(args, "available_memory", None))
+        check_hertz_size(params, mem_available_mb())
     return params
 
 
@@ -201,12 +201,13 @@ def check_hertz_size(params: HertzParams, available_mb: float | None) -> None:
     """InputError before gmsh runs if the Hertz mesh of --refine could not be solved here.
 
     The memory of its DOFs (2 a cell) at the least any solver takes (LEAST_BYTES_PER_DOF)
-    against --available-memory or MemAvailable; nothing is refused where neither is known.
+    against `available_mb` (MemAvailable; not --available-memory, which steers --solver
+    auto's choice); nothing is refused where it is unknown.
     """
     validate(params)
     cells = hertz_cells(params)
     need_mb = 2 * cells * LEAST_BYTES_PER_DOF / 1e6
-    available = available_mb if available_mb is not None else mem_available_mb()
+    available = available_mb
     if available is not None and need_mb > available:
         raise InputError(
             f"--refine {params.refine:g} (--slope {params.slope:g}) makes a mesh of about "

@@ -192,11 +192,17 @@ def test_a_refine_too_fine_is_refused_before_gmsh_with_the_memory_it_needs() -> 
     cells are estimated first and the memory they need compared with what there is."""
     from conftest import cli
 
-    proc = cli("solve", "hertz", "--refine", "1e-5", "--available-memory", "1000")
+    from contactfx.cli.params import check_hertz_size
+
+    proc = cli("solve", "hertz", "--refine", "1e-9")
     lines = proc.stderr.strip().splitlines()
     assert proc.returncode == 2 and len(lines) == 1, proc.stderr
-    assert "--refine 1e-05 (--slope 0.1) makes a mesh of about 4e+06 cells" in lines[0]
-    assert "more than the 1 GB available" in lines[0] and proc.stdout == ""
+    assert "--refine 1e-09 (--slope 0.1) makes a mesh of about 4e+10 cells" in lines[0]
+    assert re.search(r"needs at least 8.86e\+04 GB of memory, more than the [\d.]+ GB", lines[0])
+    assert proc.stdout == ""
+    with pytest.raises(InputError, match=r"about 4e\+06 cells .* more than the 1 GB available"):
+        check_hertz_size(HertzParams(refine=1e-5), 1000.0)
+    check_hertz_size(HertzParams(refine=1e-5), 10_000.0)  # 8.8 GB: fits
 
 
 @pytest.mark.serial
