@@ -207,13 +207,19 @@ def check_hertz_size(params: HertzParams, available_mb: float | None) -> None:
     validate(params)
     cells = hertz_cells(params)
     need_mb = 2 * cells * LEAST_BYTES_PER_DOF / 1e6
+    # Under mpirun the memory is per node: this node holds its ranks' share of the DOFs.
+    world = MPI.COMM_WORLD
+    node = world.Split_type(MPI.COMM_TYPE_SHARED)
+    share = node.size / world.size
+    node.Free()
     available = available_mb
-    if available is not None and need_mb > available:
+    short = available is not None and need_mb * share > available
+    if world.allreduce(short, op=MPI.LOR):  # the fullest node decides, on every rank
         raise InputError(
             f"--refine {params.refine:g} (--slope {params.slope:g}) makes a mesh of about "
             f"{cells:.2g} cells ({2 * cells:.2g} DOFs), whose solve needs at least "
-            f"{need_mb / 1e3:.3g} GB of memory, more than the {available / 1e3:.3g} GB "
-            "available: give a larger --refine"
+            f"{need_mb / 1e3:.3g} GB of memory, more than the "
+            f"{(available or 0.0) / share / 1e3:.3g} GB available: give a larger --refine"
         )
 
 
