@@ -23,14 +23,18 @@ LOCK      := requirements.lock
 UV        := uv==0.13.9
 PIP       := pip==26.3
 
+# PYTHONWARNINGS=ignore: setuptools' editable wheel prints a banner about folders named like
+# the package (a warning of the build backend, which pip's --quiet passes through).
+QUIET_PIP := PYTHONWARNINGS=ignore $(PY) -m pip install --quiet
+
 $(STAMP): pyproject.toml $(wildcard $(LOCK))
 	@test -n "$(PYTHON312)" || { echo "python3.12 not found" >&2; exit 1; }
 	@test -x $(PY) || $(PYTHON312) -m venv $(VENV)
 	$(PY) -m pip install --quiet $(PIP)
 	@if [ -f $(LOCK) ]; then \
-	  $(PY) -m pip install --quiet -c $(LOCK) -e ".[test]" ; \
+	  $(QUIET_PIP) -c $(LOCK) -e ".[test]" ; \
 	else \
-	  $(PY) -m pip install --quiet -e ".[test]" ; \
+	  $(QUIET_PIP) -e ".[test]" ; \
 	fi
 	@touch $(STAMP)
 
@@ -60,9 +64,9 @@ test: $(STAMP)
 DOCS_STAMP := $(VENV)/.docs-installed
 $(DOCS_STAMP): $(STAMP)
 	@if [ -f $(LOCK) ]; then \
-	  $(PY) -m pip install --quiet -c $(LOCK) -e ".[docs]" ; \
+	  $(QUIET_PIP) -c $(LOCK) -e ".[docs]" ; \
 	else \
-	  $(PY) -m pip install --quiet -e ".[docs]" ; \
+	  $(QUIET_PIP) -e ".[docs]" ; \
 	fi
 	@touch $(DOCS_STAMP)
 

@@ -6,12 +6,14 @@ Shared by `solve` and `study` (cli/solve.py, cli/study.py).
 from __future__ import annotations
 
 import argparse
+import math
 from dataclasses import replace
 from pathlib import Path
 
 from mpi4py import MPI
 
 from ..errors import InputError
+from ..methods.solver_choice import mem_available_mb
 from ..options import Basis, Predictor, SolverSpec, solver_spec
 from ..request import SolveRequest
 from ..scenes import (
@@ -21,8 +23,14 @@ from ..scenes import (
     Model,
     Scene,
     build_scene,
+    hertz_exact,
     load_scene_file,
+    validate,
 )
+
+# The least memory a solve takes per DOF: the condensed solver's peak, about 110 MB per 100k
+# DOFs (docs/results.md, "peak MB per 100k DOFs"; MUMPS takes about 3 times more).
+LEAST_BYTES_PER_DOF = 1.1e3
 
 BLOCK_KEYS = (
     "l1",
@@ -81,6 +89,40 @@ PARAM_HELP = {
 }
 
 
+def check_outputs(args: argparse.Namespace) -> None:
+    """InputError before anything runs if --out or --json cannot be written as asked.
+
+    --out names a directory (an existing file of that name would fail only after the solve);
+    --json a file. Decided on rank 0 (the rank that writes) for every rank.
+    """
+    comm = MPI.COMM_WORLD
+    problem = None
+    if comm.rank == 0:
+        out, json = getattr(args, "out", None), getattr(args, "json", None)
+        if out is not None and out.exists() and not out.is_dir():
+            problem = (
+                f"--out {out}: a file of that name exists, and --out names a directory for "
+                "the outputs: give another path or remove the file"
+            )
+        elif json is not None and json.is_dir():
+            problem = f"--json {json} is a directory: give the path of the JSON file"
+        for option, path in (("--out", out), ("--json", json)):
+            blocked = _file_above(path) if path is not None else None
+            if problem is None and blocked is not None:
+                problem = f"{option} {path}: {blocked} is a file, not a directory to write in"
+    problem = comm.bcast(problem, root=0)
+    if problem is not None:
+        raise InputError(problem)
+
+
+def _file_above(path: Path) -> Path | None:
+    """The nearest existing folder above `path` if it is a file (it cannot hold `path`)."""
+    for parent in path.absolute().parents:
+        if parent.exists():
+            return None if parent.is_dir() else parent
+    return None
+
+
 def reject_structured_adapt(args: argparse.Namespace) -> None:
     """InputError before anything runs: the structured Hertz mesh has no gmsh geometry."""
     if not is_scene_file(args.scene) and getattr(args, "mesh", None) == "structured":
@@ -135,7 +177,50 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
     ]
     if unused:
         raise InputError(f"option --{unused[0]} does not apply to the {args.scene} scene")
-    return replace(base, **given)
+    params = replace(base, **given)
+    if isinstance(params, HertzParams):
+        check_hertz_size(params, mem_available_mb())
+    return params
+
+
+def hertz_cells(params: HertzParams) -> float:
+    """About how many cells the graded Hertz mesh has (both bodies), before any meshing.
+
+    Sizes grow as refine + slope d with the distance d from the refined stretch of the
+    contact line (length r_refine): its strips hold length / (slope refine) cells per body,
+    its ends (pi / slope^2) ln(1 + h_far / refine). Within 30 % of gmsh's count from the
+    defaults to refine 0.005 (tests/cli/test_messages.py).
+    """
+    length = params.r_refine or 1.4 * hertz_exact(params)["a"]
+    h_far = params.h_far or params.R / 6
+    h, s = params.refine, params.slope
+    return 2 * (length / (s * h) + math.pi / s**2 * math.log(1 + h_far / h))
+
+
+def check_hertz_size(params: HertzParams, available_mb: float | None) -> None:
+    """InputError before gmsh runs if the Hertz mesh of --refine could not be solved here.
+
+    The memory of its DOFs (2 a cell) at the least any solver takes (LEAST_BYTES_PER_DOF)
+    against `available_mb` (MemAvailable; not --available-memory, which steers --solver
+    auto's choice); nothing is refused where it is unknown.
+    """
+    validate(params)
+    cells = hertz_cells(params)
+    need_mb = 2 * cells * LEAST_BYTES_PER_DOF / 1e6
+    # Under mpirun the memory is per node: this node holds its ranks' share of the DOFs.
+    world = MPI.COMM_WORLD
+    node = world.Split_type(MPI.COMM_TYPE_SHARED)
+    share = node.size / world.size
+    node.Free()
+    available = available_mb
+    short = available is not None and need_mb * share > available
+    if world.allreduce(short, op=MPI.LOR):  # the fullest node decides, on every rank
+        raise InputError(
+            f"--refine {params.refine:g} (--slope {params.slope:g}) makes a mesh of about "
+            f"{cells:.2g} cells ({2 * cells:.2g} DOFs), whose solve needs at least "
+            f"{need_mb / 1e3:.3g} GB of memory, more than the "
+            f"{(available or 0.0) / share / 1e3:.3g} GB available: give a larger --refine"
+        )
 
 
 def spec_from_args(args: argparse.Namespace) -> SolverSpec:

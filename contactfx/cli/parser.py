@@ -101,10 +101,10 @@ def _study_parser(sub: Any) -> None:
     )
     s.add_argument(
         "--goal",
-        default="pressure",
+        default=None,
         choices=[*GOALS, "residual"],
-        help="with --adaptive: the goal loop's quantity (as adapt's --goal; the loop runs to "
-        "the finest uniform level's DOFs)",
+        help="with --adaptive (refused without it): the goal loop's quantity (as adapt's "
+        "--goal, default pressure; the loop runs to the finest uniform level's DOFs)",
     )
     _solver_options(s)
     o = s.add_argument_group("output")
@@ -223,10 +223,10 @@ def _solve_parser(sub: Any) -> None:
     )
     o.add_argument(
         "--goal",
-        default="pressure",
+        default=None,
         choices=GOALS,
-        help="with --estimate: the quantity whose relative error is estimated by a second "
-        "solve on a refined mesh (default pressure; energy, force)",
+        help="with --estimate (refused without it): the quantity whose relative error is "
+        "estimated by a second solve on a refined mesh (default pressure; energy, force)",
     )
     o.add_argument("--json", type=Path, help="write the JSON summary here")
     o.add_argument(

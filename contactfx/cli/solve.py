@@ -90,7 +90,7 @@ def goal_block(args: argparse.Namespace, request: SolveRequest, sol: Solution) -
     """
     from ..adapt.goal import Goal, goal_estimate  # the refined solve's machinery, on request
 
-    goal = Goal(args.goal)
+    goal = Goal(args.goal or "pressure")
     if sol.scene.recipe is None or getattr(args, "mesh", None) == "structured":
         note = "no geometry to remesh: the goal estimate needs a refined solve"
         return {"goal": goal.value, "goal_estimate": None, "goal_note": note}
@@ -104,6 +104,12 @@ def run(args: argparse.Namespace) -> int:
     schwarz = request.enforcement is Enforcement.SCHWARZ
     if args.estimate and schwarz:
         raise InputError("--estimate needs a multiplier or penalty method, not schwarz")
+    if args.goal is not None and not args.estimate:
+        # The goal's estimate is a second solve: not implied, so that a run costs what it says.
+        raise InputError(
+            f"--goal {args.goal} applies with --estimate only (the goal's error is estimated "
+            "by a second solve on a refined mesh): add --estimate, or leave --goal out"
+        )
     t_start = time.perf_counter()
     timers = Timers()
     with timers("mesh"):

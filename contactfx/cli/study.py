@@ -71,6 +71,11 @@ def run_command(args: argparse.Namespace) -> int:
     ]
     if args.adaptive:
         check_adaptive(args, requests)
+    elif args.goal is not None or args.pressure_tol is not None:
+        given = "--goal" if args.goal is not None else "--pressure-tol"
+        raise InputError(
+            f"{given} applies to study --adaptive only: add --adaptive or leave it out"
+        )
     levels = levels_from_args(args, comm)
     say = print if comm.rank == 0 else (lambda *a, **k: None)
     say(
@@ -100,7 +105,7 @@ def run_command(args: argparse.Namespace) -> int:
             paper_interface=levels[0].paper_interface,
             max_levels=3 * len(levels),
             pressure_tol=args.pressure_tol,
-            goal=Goal(args.goal),
+            goal=Goal(args.goal or "pressure"),
             say=lambda line: say(line, flush=True),
         )
     if comm.rank == 0:

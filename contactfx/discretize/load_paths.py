@@ -20,6 +20,7 @@ which the load does work and no gap closes) names the bodies that the load pulls
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from dolfinx import fem
@@ -28,7 +29,7 @@ from petsc4py import PETSc
 
 from ..contact.geometry import Surface
 from ..contact.sparse import CSR
-from ..errors import SingularSystemError
+from ..errors import InputError, SingularSystemError
 from ..scenes import Body, Scene
 from .pairs import PairData
 from .supports import Holding, _free_motions, body_blocks, rigid_modes_at
@@ -244,6 +245,47 @@ def floating_message(
     return "; ".join(parts) + ": " + advice(pairs, hold, loose)
 
 
+def what_pulls(scene: Scene) -> str:
+    """What pulls the bodies apart, as the scene has it: its loads, its thermal strains, both.
+
+    A cooled body between walls has no load to blame: the message names its shrinking.
+    """
+    strains = [
+        f"alpha dT = {b.material.thermal_strain:.3g} in '{b.name}'"
+        for b in scene.bodies
+        if b.material.thermal_strain
+    ]
+    if not strains:
+        return "the load pulls the bodies apart"
+    cooled = all(b.material.thermal_strain <= 0 for b in scene.bodies)
+    thermal = f"the thermal strain ({', '.join(strains)}{': it shrinks' if cooled else ''})"
+    if scene.loads:
+        return f"the load and {thermal} pull the bodies apart"
+    return f"{thermal} pulls the bodies apart (no load is applied)"
+
+
+def _verdict(comm: MPI.Comm, a: np.ndarray, load: np.ndarray) -> tuple[Any, Any]:
+    """Rank 0's carrying_rows (and pulled_away where nothing carries), on every rank.
+
+    An exception there (HiGHS refusing its input) is sent to every rank and raised on each,
+    so that none waits in the broadcast for a rank that has failed.
+    """
+    verdict: tuple[Any, Any] = (None, None)
+    error = None
+    if comm.rank == 0:
+        try:
+            carries = carrying_rows(a, load)
+            verdict = (carries, pulled_away(a, load) if carries is None else None)
+        except ValueError as exc:
+            error = str(exc)
+    verdict, error = comm.bcast((verdict, error), root=0)
+    if error is not None:
+        raise SingularSystemError(
+            f"the check of which contacts can hold the bodies failed: {error}"
+        )
+    return verdict
+
+
 def load_paths(
     scene: Scene,
     V: fem.FunctionSpace,
@@ -275,13 +317,15 @@ def load_paths(
     a = rows @ free.T
     a[np.abs(a) <= ROW_RTOL * float(np.abs(a).max(initial=0.0))] = 0.0
     work = mode_loads(scene, V, f, hold)
+    if not (np.isfinite(work).all() and np.isfinite(a).all()):
+        # inf or nan in the assembled system (a lifting of 0 * inf): no program can decide.
+        raise InputError(
+            "the assembled load is not a finite number (it overflows double precision): "
+            "check the magnitudes of the Young's moduli and the loads (their units)"
+        )
     load = free @ work
     load[np.abs(load) <= LOAD_RTOL * float(np.abs(work).sum())] = 0.0
-    verdict: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
-    if scene.comm.rank == 0:
-        carries = carrying_rows(a, load)
-        verdict = (carries, pulled_away(a, load) if carries is None else None)
-    carries, away = scene.comm.bcast(verdict, root=0)
+    carries, away = _verdict(scene.comm, a, load)
     if carries is None:
         assert away is not None
         motion = (free.T @ away)[None, :]
@@ -293,7 +337,7 @@ def load_paths(
             for k in loose
         ]
         raise SingularSystemError(
-            f"{'; '.join(said)}; decided before the first solve: the load pulls the bodies apart"
+            f"{'; '.join(said)}; decided before the first solve: {what_pulls(scene)}"
         )
     paths = LoadPaths(rows, carries)
     message = floating_message(pairs, layout_pair, hold, paths)

@@ -22,7 +22,7 @@ from .coupling import (
     petsc_constraint,
 )
 from .elasticity import Elasticity, assemble_elasticity
-from .load_paths import advice, load_paths
+from .load_paths import advice, load_paths, what_pulls
 from .obstacles import (
     GatheredObstacle,
     build_obstacle_pairs,
@@ -57,6 +57,7 @@ class ContactSetup:
     needs_contact: list[Body]  # bodies whose supports alone leave a rigid mode free
     holding: Holding  # the bodies' rigid frames and what their supports fix
     row_modes: np.ndarray  # (n, 3 nb) B m of every rigid mode m at every row (global)
+    pulls: str = "the load pulls the bodies apart"  # load_paths.what_pulls of the scene
 
     def normalized_gap(self, u: fem.Function) -> np.ndarray:
         """Nodal gap (weighted gap / weight) of the owned rows at displacement u."""
@@ -87,7 +88,7 @@ class ContactSetup:
         if n_active == 0 and self.needs_contact:
             raise SingularSystemError(
                 f"body '{self.needs_contact[0].name}' is not held by its supports alone and no "
-                "node is in contact (empty active set): the load pulls the bodies apart"
+                f"node is in contact (empty active set): {self.pulls}"
             )
 
     def loaded(self, active: np.ndarray, lam: np.ndarray) -> np.ndarray:
@@ -294,6 +295,7 @@ def prepare_contact(
         hold.needs_contact(),
         hold,
         paths.rows,
+        what_pulls(scene),
     )
 
 

@@ -27,6 +27,7 @@ from ..options import SOLVERS, SolverKind
 from ..request import SolveRequest, direct_path
 from ..scenes import Scene
 from ..timers import Timers
+from .cleanup import dropped, released
 from .solver_choice import (
     CHECK_KB_PER_DOF,
     COARSE_BOUND_DOFS,
@@ -73,7 +74,7 @@ def prepare_solver(
             return coarse
         return _resolve(setup, scene, request, timers)
     except BaseException:
-        setup.destroy()
+        dropped(scene.comm, setup)
         raise
 
 
@@ -104,14 +105,10 @@ def _coarse_bound(
         coarse = scene.remeshed(COARSE_BOUND_FACTOR)
         coarse_dofs = scene_dofs(coarse)
         csetup = prepare_contact(coarse, request.kernel, penetration_tol, Timers(), request.basis)
-        try:
+        with released(comm, csetup):
             linear = setup_solver(csetup, direct, coarse, reuse=True)
-            try:
+            with released(comm, linear):
                 est = linear.mumps_estimate() if isinstance(linear, SaddleSolver) else None
-            finally:
-                linear.destroy()
-        finally:
-            csetup.destroy()
     rank_mb = None if est is None else scaled_bound(est.rank_mb, coarse_dofs, dofs)
     needed, avail = node_budget(comm, rank_mb, request.available_mb)
     choice = choose(needed, avail, request.diagonal)
@@ -138,7 +135,7 @@ def _resolve(setup: ContactSetup, scene: Scene, request: SolveRequest, timers: T
         )
         choice = choose(needed, avail, request.diagonal)
     except BaseException:
-        linear.destroy()
+        dropped(scene.comm, linear)
         raise
     seconds = None if estimate is None else estimate.seconds
     if choice is Choice.DIRECT:

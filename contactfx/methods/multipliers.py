@@ -34,6 +34,7 @@ from .active_set import (
     run_active_set,
 )
 from .autosolve import Prepared, prepare_solver, warn_if_too_big
+from .cleanup import released
 from .solution import Solution, finish
 from .solvers import setup_solver
 
@@ -310,7 +311,7 @@ def solve_contact(
         prepared = prepare_solver(scene, request, aso.penetration_tol, timers)
     setup, request = prepared.setup, prepared.request
     spec = request.solver
-    try:
+    with released(scene.comm, setup):
         # One solver for the whole loop: fixed matrix pattern, reused analysis and setup.
         linear = prepared.linear
         if linear is None:
@@ -323,10 +324,8 @@ def solve_contact(
         )
         iteration = MultiplierIteration(setup, linear, aso, guess is not None, label)
         active = iteration.start(setup.initial_active(aso.penetration_tol * setup.h), guess)
-        try:
+        with released(scene.comm, linear):
             step, active, history = run_active_set(setup, iteration, active, aso, timers)
-        finally:
-            linear.destroy()
         ref = (
             reference_solve(setup, spec, scene, active, timers)
             if request.reference_timing
@@ -335,8 +334,6 @@ def solve_contact(
         sol = finish(
             setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
         )
-    finally:
-        setup.destroy()
     sol.basis = request.basis
     sol.solver_choice = prepared.choice
     if ref is not None:

@@ -28,6 +28,7 @@ from ..request import SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
 from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .cleanup import released
 from .solution import PenaltyResult, Solution, finish
 from .solvers import with_ordering
 
@@ -79,27 +80,25 @@ def _solve(
     ksp = PETSc.KSP().create(K.getComm())
     ksp.setOperators(A)
     info: dict[str, float] = {}
-    try:
-        with petsc_options(with_ordering(options, K.getSize()[0])) as prefix:
-            ksp.setOptionsPrefix(prefix)
-            ksp.setFromOptions()
-            if condition:
-                ksp.setComputeSingularValues(True)
-            ksp.setUp()
-            ksp.solve(rhs, x)
-        # getConvergedReason() returns an int; the stub says the enum class.
-        reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
-        if condition and its > 0:
-            smax, smin = ksp.computeExtremeSingularValues()
-            info["condition"] = float(smax / smin) if smin > 0 else float("inf")
-        ok = reason > 0 and np.isfinite(x.norm())
-        u = x.array.copy()
-        ksp_type = ksp.getType()
-    except PETSc.Error as err:
-        raise SolverError(petsc_error_message(err, "penalty solve")) from None
-    finally:
-        for obj in (ksp, A, BA, BAT, rhs, tmp, x, d):
-            obj.destroy()
+    with released(K.getComm().tompi4py(), ksp, A, BA, BAT, rhs, tmp, x, d):
+        try:
+            with petsc_options(with_ordering(options, K.getSize()[0])) as prefix:
+                ksp.setOptionsPrefix(prefix)
+                ksp.setFromOptions()
+                if condition:
+                    ksp.setComputeSingularValues(True)
+                ksp.setUp()
+                ksp.solve(rhs, x)
+            # getConvergedReason() returns an int; the stub says the enum class.
+            reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
+            if condition and its > 0:
+                smax, smin = ksp.computeExtremeSingularValues()
+                info["condition"] = float(smax / smin) if smin > 0 else float("inf")
+            ok = reason > 0 and np.isfinite(x.norm())
+            u = x.array.copy()
+            ksp_type = ksp.getType()
+        except PETSc.Error as err:
+            raise SolverError(petsc_error_message(err, "penalty solve")) from None
     info["converged"] = float(ok)
     if check and not ok:
         raise SolverError(
@@ -173,7 +172,7 @@ def solve_penalty(
     aso = aso or ActiveSetOptions(request.max_iterations)
     timers = timers or Timers()
     setup = prepare_contact(scene, request.kernel, aso.penetration_tol, timers)
-    try:
+    with released(scene.comm, setup):
         eps = default_penalty(setup.e_max, setup.h) if request.penalty is None else request.penalty
         iteration = PenaltyIteration(setup, eps, request.solver.petsc, False)
         active = setup.initial_active(aso.penetration_tol * setup.h)
@@ -182,8 +181,6 @@ def solve_penalty(
         sol = finish(
             setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
         )
-    finally:
-        setup.destroy()
     sol.penalty = PenaltyResult(eps, penetration(sol), estimate)
     return sol
 

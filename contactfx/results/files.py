@@ -20,12 +20,24 @@ from .stress import sigma_field, sigma_zz_field
 
 
 def write_json(path: Path, data: dict[str, Any]) -> None:
-    """Write JSON through a temporary file so a failed run never leaves half a file."""
+    """Write JSON through a temporary file so a failed run never leaves half a file.
+
+    The file gets the mode any new file gets (0666 less the umask: 0644 as a rule), not the
+    temporary file's private 0600.
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     with os.fdopen(fd, "w") as fh:
         json.dump(data, fh, indent=1, allow_nan=False)
+        os.fchmod(fh.fileno(), 0o666 & ~_umask())
     os.replace(tmp, path)
+
+
+def _umask() -> int:
+    """The process's umask (read by setting it: there is no other way to read it)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def field_grid(sol: Solution, cell_fields: tuple[fem.Function, ...] = ()) -> Any:

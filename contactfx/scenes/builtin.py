@@ -127,9 +127,20 @@ def validate(params: BlockParams | HertzParams) -> None:
                 raise InputError(f"{key} = {getattr(params, key)} is larger than the half width")
         if not math.isfinite(params.p):
             raise InputError(f"p must be finite (got {params.p})")
+        if abs(params.p) > max(params.E1, params.E2):
+            raise InputError(
+                f"p = {params.p:g} exceeds the larger Young's modulus {max(params.E1, params.E2):g}"
+                " (a strain beyond 100 %: contactfx is a small-strain code)"
+            )
     else:
         if params.refine > params.R / 10:
             raise InputError(f"refine = {params.refine} is too coarse for R = {params.R}")
+        a = hertz_exact(params)["a"]
+        if not a < params.R:
+            raise InputError(
+                f"P = {params.P:g} gives a Hertz contact half-width a = {a:.3g} beyond the radius "
+                f"R = {params.R:g}: far beyond small strain (lower P)"
+            )
         if params.mesh not in MESHERS:
             raise InputError(f"unknown mesh '{params.mesh}' (choose {' or '.join(MESHERS)})")
         if params.r_refine < 0:

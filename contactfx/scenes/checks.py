@@ -136,6 +136,16 @@ def _check_conditions(scene: Scene) -> None:
         values = [load.p] if hasattr(load, "p") else list(load.t)
         if not all(math.isfinite(float(v)) for v in values):
             raise InputError(f"load on '{load.group}': values must be finite")
+        stiffest = max(b.material.E for b in scene.bodies)
+        if max(abs(float(v)) for v in values) > stiffest:
+            # The stiffest body strained beyond 100 %: units, not a load (1e300 overflowed
+            # the solve into a DIVERGED_NANORINF that named no load).
+            key = "p" if hasattr(load, "p") else "t"
+            raise InputError(
+                f"load on '{load.group}': {key} = {_text(values)} exceeds the largest Young's "
+                f"modulus of the bodies ({stiffest:g}), a strain beyond 100 % (contactfx is "
+                "a small-strain code): check its units"
+            )
     for ref in [*scene.references, *scene.probes]:
         pair = getattr(ref, "pair", 0)
         if isinstance(ref, LameReference):
@@ -147,6 +157,35 @@ def _check_conditions(scene: Scene) -> None:
             raise InputError(
                 f"{what}: pair {pair} does not exist (the scene has "
                 f"{len(scene.contacts)} contact pairs and {len(scene.obstacles)} obstacles)"
+            )
+
+
+def _text(values: list[float]) -> str:
+    return f"{values[0]:g}" if len(values) == 1 else "[" + ", ".join(f"{v:g}" for v in values) + "]"
+
+
+# The largest prescribed overlap relative to the model's size: the strain it makes is about
+# that ratio, and contactfx is a small-strain code (the thermal strain's bound too: fits.py).
+OVERLAP_MAX = 0.1
+
+
+def _check_overlaps(scene: Scene) -> None:
+    """InputError for an `interference = D` beyond OVERLAP_MAX of the model's extent."""
+    given = [(k, p) for k, p in enumerate(scene.contacts) if p.prescribed_overlap > 0]
+    if not given:
+        return
+    x = scene.mesh.geometry.x[:, :2]
+    comm = scene.comm
+    lo = comm.allreduce(x.min(axis=0, initial=np.inf), op=MPI.MIN)
+    hi = comm.allreduce(x.max(axis=0, initial=-np.inf), op=MPI.MAX)
+    extent = float(np.max(hi - lo))
+    for k, pair in given:
+        d = pair.prescribed_overlap
+        if d > OVERLAP_MAX * extent:
+            raise InputError(
+                f"contact {k} ('{pair.active}' on '{pair.passive}'): interference = {d:g} is "
+                f"more than {OVERLAP_MAX:g} of the model's size {extent:g} (a strain far "
+                "beyond small strain): check its units"
             )
 
 
@@ -177,4 +216,5 @@ def check_scene(scene: Scene) -> Scene:
     curve_bodies = _check_pairs(scene)
     curve_bodies.update(_check_obstacles(scene, curve_bodies))
     _check_conditions(scene)
+    _check_overlaps(scene)
     return replace(scene, curve_bodies=curve_bodies)

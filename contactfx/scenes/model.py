@@ -55,6 +55,11 @@ class Units:
     stress: str = "stress"
 
 
+# Young's moduli of solids in any unit system (kPa to dyn/cm^2) lie far inside; beyond, the
+# stiffness and the loads' lifting overflow or underflow double precision.
+E_RANGE = (1e-10, 1e15)
+
+
 @dataclass(frozen=True)
 class Material:
     """Isotropic linear elasticity: Young's modulus and Poisson ratio.
@@ -77,6 +82,12 @@ class Material:
         """Raise InputError unless E > 0, -1 < nu < 0.5, and alpha and dT come together."""
         if not (math.isfinite(self.E) and self.E > 0):
             raise InputError(f"{where}: Young's modulus must be > 0 (got E = {self.E})")
+        if not E_RANGE[0] <= self.E <= E_RANGE[1]:
+            raise InputError(
+                f"{where}: Young's modulus E = {self.E:g} is outside {E_RANGE[0]:g} to "
+                f"{E_RANGE[1]:g}, where every solid lies in any units (steel: 2.1e5 MPa, "
+                "2.1e11 Pa): check its units"
+            )
         if not (math.isfinite(self.nu) and -1.0 < self.nu < 0.5):
             raise InputError(f"{where}: Poisson ratio must lie in (-1, 0.5) (got nu = {self.nu})")
         check_thermal(self.alpha, self.dT, where)

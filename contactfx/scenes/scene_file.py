@@ -69,9 +69,10 @@ def _number(where: str, value: Any) -> float:
     return float(value)
 
 
-def _string(where: str, value: Any) -> str:
+def _string(where: str, value: Any, kind: str = "group") -> str:
+    """A non-empty string; `kind` (a TYPE_ERRORS key) says what the key wanted."""
     if not isinstance(value, str) or not value:
-        raise InputError(f"{where}: {TYPE_ERRORS['string']}, got {value!r}")
+        raise InputError(f"{where}: {TYPE_ERRORS[kind]}, got {value!r}")
     return value
 
 
@@ -214,7 +215,7 @@ def _probe(k: int, entry: Any) -> Probe:
 def _units(table: Any) -> Units:
     """The `units` table: the names of the length and stress units (labels for pictures)."""
     e = _keys("units", table, {"length", "stress"}, set())
-    return Units(**{k: _string(f"units.{k}", v) for k, v in e.items()})
+    return Units(**{k: _string(f"units.{k}", v, "unit") for k, v in e.items()})
 
 
 def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
@@ -231,9 +232,9 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
     if "contact" not in doc and "obstacle" not in doc:
         raise InputError(f"{path.name}: missing key 'contact' (or 'obstacle')")
     # Relative to the file; `..` collapsed (the demo scenes name ../../meshes/*.geo).
-    mesh = Path(os.path.normpath(path.parent / _string("mesh", doc["mesh"])))
-    name = str(doc.get("name", path.stem))
-    model = Model.parse(_string("model", doc.get("model", Model.PLANE_STRAIN.value)))
+    mesh = Path(os.path.normpath(path.parent / _string("mesh", doc["mesh"], "path")))
+    name = _string("name", doc.get("name", path.stem), "name")
+    model = Model.parse(_string("model", doc.get("model", Model.PLANE_STRAIN.value), "model"))
     units = _units(doc.get("units", {}))
     if not isinstance(doc["bodies"], dict) or not doc["bodies"]:
         raise InputError("bodies: expected [bodies.NAME] tables with E and nu")

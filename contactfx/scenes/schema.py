@@ -38,7 +38,12 @@ class Key:
 TYPE_ERRORS = {
     "number": "expected a number",
     "integer": "expected an integer index",
-    "string": "expected a group name (a string)",
+    "string": "expected a string",
+    "group": "expected a group name (a string)",
+    "path": "expected a mesh file path (a string)",
+    "name": "expected a name (a string)",
+    "model": "expected one of {models} (a string)",
+    "unit": "expected a unit name (a string)",
     "bool": "expected true or false",
     "bool or number": "expected true, false or a number > 0",
     "vector": "expected a vector [x, y]",
@@ -48,14 +53,15 @@ TYPE_ERRORS = {
     "tables": "expected one or more [[NAME]] tables",
 }
 
-_GROUP = "string"
+_GROUP = "group"
 _MODELS = ", ".join(m.value for m in Model)
+TYPE_ERRORS["model"] = TYPE_ERRORS["model"].format(models=_MODELS)
 
 SECTIONS: dict[str, tuple[Key, ...]] = {
     "": (
-        Key("mesh", "string", None, "gmsh .msh, or .geo (meshed in 2D), relative to the file"),
-        Key("name", "string", "the file name", "label of the scene in the JSON"),
-        Key("model", "string", Model.PLANE_STRAIN.value, f"the 2D model: {_MODELS}"),
+        Key("mesh", "path", None, "gmsh .msh, or .geo (meshed in 2D), relative to the file"),
+        Key("name", "name", "the file name", "label of the scene in the JSON"),
+        Key("model", "model", Model.PLANE_STRAIN.value, f"the 2D model: {_MODELS}"),
         Key(
             "units",
             "table",
@@ -150,7 +156,7 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("sigma", "tensor", None, "the stress exact in every body", "an unsymmetric sigma"),
     ),
     "obstacle": (
-        Key("name", "string", "obstacleK", "label in the JSON and the output files"),
+        Key("name", "name", "obstacleK", "label in the JSON and the output files"),
         Key("shape", "string", None, f"one of {', '.join(OBSTACLE_SHAPES)}", "another shape"),
         Key("surface", _GROUP, None, "the body's curve group that may touch it"),
         Key("displacement", "vector", "[0, 0]", "prescribed rigid motion"),

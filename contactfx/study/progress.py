@@ -1,10 +1,18 @@
 """Progress of a study: run i of n, the elapsed time and an estimate of what is left.
 
-A pending run's cost is its method's latest measured cost scaled by the DOFs: cost ~ N^alpha,
-alpha fitted on the method's two latest levels and held in [1, 1.5] (a direct solver is
-superlinear; a coarse level's cost is mostly fixed overheads such as form compilation, which
-would make alpha < 1 and the estimate collapse). The DOFs of a level not meshed yet grow as
-the last two levels' did (ratio^2 until two are seen); meshing is scaled linearly in DOFs.
+The estimate extrapolates by DOFs from the levels measured so far, and is given only once
+two levels are: how the DOFs grow per level depends on the mesh family (ratio^2 for
+uniform refinement, about ratio^1.2 for the graded Hertz meshes) and a coarse level's time is
+mostly fixed overheads such as form compilation, so one level alone can be off by a factor
+of three either way. Then:
+- a pending level's DOFs grow as the last two levels' did;
+- a pending run costs its method's latest cost times (N / N_latest)^alpha, alpha fitted on
+  the method's two latest levels and held in [1, 1.5] (a direct solver is superlinear; a
+  fitted alpha < 1 is the coarse level's overhead);
+- a level not meshed yet is meshed at the largest time per DOF seen: a level from the mesh
+  cache loads in a fraction of gmsh's time, and a finer level misses the cache on its first
+  study (a recording over the cache's size limit is never kept), so the fresh rate is the
+  one to expect once it has been seen.
 """
 
 from __future__ import annotations
@@ -85,14 +93,18 @@ class Progress:
         per_dof = [t / self.dofs[k] for (_, j), t in self.cost.items() if j == k]
         return float(np.mean(per_dof)) * self.level_dofs(level)
 
-    def left(self, pending: list[tuple[str, int]]) -> float:
-        """Estimated seconds for the pending runs and the levels not meshed yet."""
+    def left(self, pending: list[tuple[str, int]]) -> float | None:
+        """Estimated seconds for the pending runs and the levels not meshed yet.
+
+        None until two levels have DOFs (see the module's docstring).
+        """
+        if len(self.dofs) < 2:
+            return None
         t = sum(self.estimate(m, k) for m, k in pending)
-        known = [k for k in self.mesh if k in self.dofs]
-        if known:
-            k = max(known)
+        rates = [self.mesh[k] / self.dofs[k] for k in self.mesh if self.dofs.get(k)]
+        if rates:
             unmeshed = {j for _, j in pending if j > max(self.mesh)}
-            t += sum(self.mesh[k] * self.level_dofs(j) / self.dofs[k] for j in unmeshed)
+            t += max(rates) * sum(self.level_dofs(j) for j in unmeshed)
         return t
 
     def meshing(self, level: Level) -> None:
@@ -124,7 +136,13 @@ class Progress:
             else f"FAILED: {run.message}"
         )
         left = self.left(pending)
+        if not pending:
+            ahead = "done"
+        elif left is None:
+            ahead = "time left estimated after level 1"
+        else:
+            ahead = f"~{format_seconds(left)} left"
         self.say(
             f"[run {self.done}/{self.total}] level {run.level} {run.method}: {what} | "
-            f"elapsed {format_seconds(elapsed)}, ~{format_seconds(left)} left"
+            f"elapsed {format_seconds(elapsed)}, {ahead}"
         )

@@ -315,8 +315,124 @@ def test_cli_failure_under_mpi(tmp_path: Path) -> None:
     assert "SingularSystemError" not in line
 
 
+@pytest.mark.mpi
+def test_cli_failure_inside_the_solve_under_mpi(tmp_path: Path) -> None:
+    """Raised on every rank inside the active-set loop, where the solver's PETSc objects are
+    left to the traceback under mpirun (methods/cleanup.py): freed alike on every rank."""
+    args = ["hertz", "--refine", "0.1", "--max-iterations", "1"]
+    assert_clean_failure(tmp_path, args, "did not converge in 1 iterations", mpi=2)
+
+
 def test_cli_success_writes_json(tmp_path: Path) -> None:
     # The counterpart: the same command line with a valid pressure writes its JSON.
     rc, err, out = cli(tmp_path, *S4, "--method", "penalty")
     assert rc == 0, err
     assert out.exists()
+
+
+# ---------------------------------------------------------------- an error on one rank only
+
+FAIL_ON_RANK = Path(__file__).with_name("fail_on_rank.py")
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize(
+    ("stage", "rank", "kind"),
+    [
+        ("parsing", 1, "input"),
+        ("meshing", 1, "internal"),
+        ("assembly", 1, "input"),
+        ("solve", 1, "input"),
+        ("writing", 1, "internal"),
+    ],
+)
+def test_an_error_on_one_rank_ends_every_rank(
+    tmp_path: Path, stage: str, rank: int, kind: str
+) -> None:
+    """An exception on rank 1 only, while rank 0 goes on into a collective: every rank ends
+    within seconds of the raise, exit 2, one message (with the failing rank), no JSON. It
+    hung until killed: the other rank waited in its collective, the failing one in MPI's
+    finalize or in the collective destroy of the solver."""
+    import time
+
+    raised, out = tmp_path / "raised", tmp_path / "run.json"
+    cmd = [MPIRUN, "-n", "2", sys.executable, str(FAIL_ON_RANK), stage, str(rank), kind]
+    args = ["solve", *S4, "--json", str(out), "--out", str(tmp_path / "out"), "-q"]
+    res = subprocess.run(
+        [*cmd, str(raised), "--", *args], capture_output=True, text=True, env=ENV, timeout=120
+    )
+    ended = time.time()
+    assert res.returncode == 2, res.stdout[-2000:] + res.stderr[-2000:]
+    assert ended - float(raised.read_text()) < 15.0
+    lines = [ln for ln in res.stderr.splitlines() if ln.startswith("contactfx: ")]
+    assert len(lines) == 1, res.stderr
+    assert f"raised on purpose at {stage}" in lines[0] and f"on rank {rank} of 2" in lines[0]
+    assert "MPI_Abort" not in res.stderr + res.stdout
+    if kind == "input":
+        assert lines[0].startswith("contactfx: error: ") and "Traceback" not in res.stderr
+    else:  # a bug: the traceback once, then the line
+        assert res.stderr.count("Traceback") == 1 and "internal error: RuntimeError" in lines[0]
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(("option", "inside"), [("--out", ""), ("--json", ""), ("--json", "x")])
+def test_an_output_path_of_the_wrong_kind_is_refused_before_the_solve(
+    tmp_path: Path, option: str, inside: str
+) -> None:
+    """--out naming an existing file (a FileExistsError traceback after the whole solve),
+    --json naming a directory or a path under a file: one line, exit 2, before anything
+    runs, the path untouched."""
+    target = tmp_path / "taken"
+    if option == "--out" or inside:
+        target.write_text("keep me")
+    else:
+        target.mkdir()
+    res = run_in_process("solve", *S4, option, str(target / inside if inside else target))
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert res.returncode == 2 and len(lines) == 1, res.stderr
+    assert lines[0].startswith(f"contactfx: error: {option} {target}"), lines
+    assert res.stdout == ""  # nothing meshed nor solved
+    assert target.read_text() == "keep me" if option == "--out" or inside else target.is_dir()
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["solve", *S4, "--goal", "energy"], "--goal energy applies with --estimate only"),
+        (["study", *S4, "--goal", "force", "--out", "s"], "--goal applies to study --adaptive"),
+    ],
+)
+def test_a_goal_without_its_estimate_is_refused(
+    tmp_path: Path, args: list[str], words: str
+) -> None:
+    """`solve --goal energy` without --estimate was silently ignored (a run that seemed to
+    estimate the energy error and did not): refused, one line, before anything runs."""
+    res = run_in_process(*args, cwd=tmp_path)
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert res.returncode == 2 and len(lines) == 1 and words in lines[0], res.stderr
+    assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("err", "last"),
+    [
+        (PermissionError(13, "Permission denied", "/x/r.json"), "/x/r.json: Permission denied"),
+        (RuntimeError("a bug"), "internal error: RuntimeError: a bug (a bug in contactfx"),
+    ],
+)
+def test_cli_ends_any_exception_with_exit_2(err: Exception, last: str, monkeypatch, capsys) -> None:
+    """A file the system refuses is one line; a bug keeps its traceback, then one line; both
+    exit 2 (a bug's traceback ended the process with exit 1, and under mpirun hung it)."""
+    from contactfx import cli
+    from contactfx.cli import solve as cli_solve
+
+    def fail(args: object) -> int:
+        raise err
+
+    monkeypatch.setattr(cli_solve, "run", fail)
+    assert cli.main(["solve", "blocks"]) == 2
+    text = capsys.readouterr().err
+    lines = text.strip().splitlines()
+    assert lines[-1].startswith("contactfx: ") and last in lines[-1], text
+    assert ("Traceback" in text) == isinstance(err, RuntimeError)
+    assert len(lines) == 1 or isinstance(err, RuntimeError)

@@ -184,3 +184,45 @@ def test_field_pictures_render_off_screen_without_an_x_warning(tmp_path: Path) -
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert "X server" not in proc.stderr + proc.stdout, proc.stderr[-2000:]
     assert png.stat().st_size > 20_000
+
+
+@pytest.mark.serial
+def test_a_refine_too_fine_is_refused_before_gmsh_with_the_memory_it_needs() -> None:
+    """--refine 1e-9 ran into gmsh and ended in "gmsh failed: " with an empty reason: the
+    cells are estimated first and the memory they need compared with what there is."""
+    from conftest import cli
+
+    from contactfx.cli.params import check_hertz_size
+
+    proc = cli("solve", "hertz", "--refine", "1e-9")
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "--refine 1e-09 (--slope 0.1) makes a mesh of about 4e+10 cells" in lines[0]
+    assert re.search(r"needs at least 8.86e\+04 GB of memory, more than the [\d.]+ GB", lines[0])
+    assert proc.stdout == ""
+    with pytest.raises(InputError, match=r"about 4e\+06 cells .* more than the 1 GB available"):
+        check_hertz_size(HertzParams(refine=1e-5), 1000.0)
+    check_hertz_size(HertzParams(refine=1e-5), 10_000.0)  # 8.8 GB: fits
+
+
+@pytest.mark.serial
+@pytest.mark.parametrize("params", [{}, {"refine": 0.05, "slope": 0.3}])
+def test_the_hertz_cell_estimate_is_within_30_percent_of_gmsh(params: dict) -> None:
+    from contactfx.cli.params import hertz_cells
+
+    p = HertzParams(**params)
+    scene = build_scene("hertz", p, comm=MPI.COMM_SELF)
+    cells = scene.mesh.topology.index_map(2).size_local
+    assert abs(cells / hertz_cells(p) - 1) < 0.3, (cells, hertz_cells(p))
+
+
+@pytest.mark.mpi
+def test_a_usage_error_under_mpirun_is_printed_once() -> None:
+    """argparse's usage and error lines came once per rank."""
+    from conftest import run_cli
+
+    proc = run_cli("solve", "blocks", "--no-such-option", ranks=2)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.count("usage: contactfx") == 1, proc.stderr
+    errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("contactfx: error:")]
+    assert errors == ["contactfx: error: unrecognized arguments: --no-such-option"], proc.stderr

@@ -101,3 +101,34 @@ def test_testing_page_counts_the_rank_cases() -> None:
         sys.path.pop(0)
     text = " ".join((ROOT / "docs" / "testing.md").read_text().split())
     assert f"compares {len(CASES)} cases" in text
+
+
+@pytest.mark.serial
+def test_readme_commands_write_under_an_ignored_folder() -> None:
+    """The README's command left out/ and r.json untracked in the repository root: every
+    --json and --out it gives lies under results/, which .gitignore ignores."""
+    lines = [ln for ln in README.splitlines() if ln.startswith(".venv/bin/python -m contactfx")]
+    ignored = (ROOT / ".gitignore").read_text().splitlines()
+    assert "/results/" in ignored
+    for line in lines:
+        args = parser().parse_args(line.split()[3:])
+        for path in (getattr(args, "json", None), getattr(args, "out", None)):
+            assert path is None or path.parts[0] == "results", line
+
+
+@pytest.mark.serial
+def test_make_installs_the_package_without_the_editable_banner() -> None:
+    """`make demo` printed setuptools' editable-install banner (a build-backend warning that
+    pip's --quiet lets through): every editable install runs with warnings ignored."""
+    import shutil
+    import subprocess
+
+    if shutil.which("make") is None:
+        pytest.skip("no make")
+    for target in ("venv", "docs"):
+        dry = subprocess.run(
+            ["make", "-n", "-B", target], cwd=ROOT, capture_output=True, text=True, check=True
+        )
+        installs = [ln for ln in dry.stdout.splitlines() if "pip install" in ln and " -e " in ln]
+        assert installs, dry.stdout
+        assert all("PYTHONWARNINGS=ignore" in ln for ln in installs), installs

@@ -214,3 +214,18 @@ def test_body_blocks_are_the_sorted_unique_blocks() -> None:
         expected = np.unique(V.dofmap.list[cells].ravel())
         assert np.array_equal(body_blocks(V, cells), expected)
     assert body_blocks(V, np.zeros(0, dtype=np.int32)).size == 0
+
+
+def test_a_program_that_refuses_its_input_is_an_error_on_every_rank() -> None:
+    """HiGHS's ValueError on rank 0 (a nan in the program) was raised there alone while the
+    other ranks waited in the broadcast of its verdict: now it is broadcast and raised as a
+    SingularSystemError on each rank."""
+    from mpi4py import MPI
+
+    from contactfx.discretize.load_paths import _verdict
+
+    a = np.array([[1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    with pytest.raises(ValueError, match="linprog"):
+        carrying_rows(a, np.array([np.nan, 1.0]))
+    with pytest.raises(SingularSystemError, match=r"the check of which contacts .* failed"):
+        _verdict(MPI.COMM_SELF, a, np.array([np.nan, 1.0]))

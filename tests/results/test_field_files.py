@@ -135,3 +135,21 @@ def test_two_ranks_write_one_piece_each_and_the_same_fields(tmp_path: Path) -> N
     got = open_every_file(out, tmp_path)
     assert {"fields.pvtu", "fields_p0.vtu", "fields_p1.vtu"} <= set(got)
     check_fields(got["fields.pvtu"], data)
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o077])
+def test_the_json_gets_the_mode_of_any_new_file(tmp_path: Path, umask: int) -> None:
+    """JSON files were 0600 (the temporary file's mode) where every other file is 0644."""
+    import os
+
+    from contactfx.results.files import write_json
+
+    saved = os.umask(umask)
+    try:
+        write_json(tmp_path / "r.json", {"a": 1})
+        (tmp_path / "other.txt").write_text("x")
+    finally:
+        os.umask(saved)
+    mode = (tmp_path / "r.json").stat().st_mode & 0o777
+    assert mode == 0o666 & ~umask == (tmp_path / "other.txt").stat().st_mode & 0o777
+    assert json.loads((tmp_path / "r.json").read_text()) == {"a": 1}

@@ -80,3 +80,71 @@ def test_missing_half_width_says_why() -> None:
     )  # fmt: skip
     line = next(ln for ln in terminal_summary(run) if ln.startswith("Hertz"))
     assert "nan" not in line and "a: n/a (3 active nodes" in line, line
+
+
+def _study_lines(dofs: list[int], mesh: list[float], costs: list[float]) -> list[str]:
+    """The progress lines of a one-method study with these DOFs, meshing and run costs."""
+    lines: list[str] = []
+    progress = Progress(["mortar"], len(dofs), 2.0, lines.append)
+    for k, (n, m, c) in enumerate(zip(dofs, mesh, costs, strict=True)):
+        run = Run("mortar", k, 1.0, dofs=n, times={"total": m + c, "mesh": m})
+        progress.finished(run, m)
+    return lines
+
+
+def test_no_time_left_is_guessed_from_the_first_level_alone() -> None:
+    """A study hertz said ~88 s left after its first run (29 s real): the DOFs of the graded
+    Hertz meshes grow about 2.35x a level, not ratio^2 = 4, and level 0 is mostly overhead.
+    Until two levels are measured the line says when the estimate comes."""
+    # study hertz --levels 4 --size-factor 2 (one method): DOFs, meshing, solve times.
+    lines = _study_lines([4180, 9610, 22614, 56922], [0.1, 0.25, 1.64, 6.3], [0.2, 0.26, 0.7, 3.0])
+    assert lines[0].endswith("time left estimated after level 1"), lines[0]
+    assert re.search(r"~\d+\.\d s left$", lines[1]) and lines[-1].endswith("done"), lines
+
+
+def test_levels_not_meshed_yet_are_meshed_at_the_fresh_rate_seen() -> None:
+    """Level 1 came from the mesh cache (6x faster than gmsh per DOF), level 0 from gmsh:
+    the meshing of level 2 is estimated at gmsh's rate, not the cache's."""
+    progress = Progress(["mortar"], 3, 2.0, lambda _: None)
+    for k, (n, m) in enumerate([(10_000, 0.8), (40_000, 0.4)]):
+        progress.finished(Run("mortar", k, 1.0, dofs=n, times={"total": m, "mesh": m}), m)
+    solve = 0.0  # the runs cost nothing here: what is left is level 2's meshing
+    assert progress.left([("mortar", 2)]) == pytest.approx(solve + 8e-5 * 160_000)
+
+
+def test_the_time_chart_plots_each_runs_time_after_meshing(tmp_path: Path) -> None:
+    """accuracy_vs_time.png put cached meshing (0.2 s) and gmsh's (6 s) on one axis with the
+    solves: it plots the time after meshing, with the rate of the points drawn, and says so."""
+    import matplotlib.pyplot as plt
+
+    from contactfx.study import charts
+
+    runs = [
+        Run("mortar", k, 1.0, dofs=n, times={"total": m + t, "mesh": m}, errors={"l2": e})
+        for k, (n, m, t, e) in enumerate([(1e4, 0.2, 1.0, 4e-3), (4e4, 6.0, 4.0, 2e-3)])
+    ]
+    study: Any = SimpleNamespace(
+        runs=runs, methods=["mortar"], error_names=["l2"], rates={"mortar": {"l2": 1.0}},
+        reference={"kind": "exact", "type": "hertz"}, flags={}, adaptive=[], scene="hertz",
+        ranks=1,
+    )  # fmt: skip
+    xs, errors = charts._series(study, "mortar", "l2", "solve")
+    assert list(xs) == [1.0, 4.0] and list(errors) == [4e-3, 2e-3]
+    captured: dict[str, Any] = {}
+    finish = charts._finish
+
+    def keep(fig: Any, path: Path, title: str) -> Path:
+        ax = fig.axes[0]
+        captured["x"] = list(ax.lines[0].get_xdata())
+        captured["label"], captured["legend"] = ax.get_xlabel(), ax.get_legend_handles_labels()[1]
+        return finish(fig, path, title)
+
+    charts._finish = keep
+    try:
+        charts.plot_time(study, tmp_path / "t.png")
+    finally:
+        charts._finish = finish
+        plt.close("all")
+    assert captured["x"] == [1.0, 4.0], captured
+    assert "after meshing" in captured["label"] and "left out" in captured["label"]
+    assert captured["legend"] == ["mortar: error ~ t^-0.50"], captured["legend"]
