@@ -249,7 +249,7 @@ def _adapt_parser(sub: Any) -> None:
         "mesh would exceed --max-dofs. Writes adapt.json, mesh.msh, fields.pvtu (with the "
         "indicators eta) and the charts adapt_dofs.png, adapt_time.png to --out. Example: "
         "`contactfx adapt hertz --refine 1 --h-far 10 --refine-edge 0 --max-dofs 60000 "
-        "--out out/adapt` adapts an ungraded start (1,052 DOFs) over four levels to a "
+        "--out results/adapt` adapts an ungraded start (1,052 DOFs) over four levels to a "
         "pressure estimate of 0.69 % at 7,332 DOFs (`adapt hertz` alone starts from the "
         "graded default mesh, already within --tol 0.01 at level 0).",
     )
