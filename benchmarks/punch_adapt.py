@@ -80,7 +80,9 @@ def measures(data: dict, ref: dict | None) -> dict:
 def reference(tmp: Path, slope: float, hmin: float) -> dict:
     """A mesh graded towards the punch edge: h = max(hmin, slope r), at most 2."""
     f = f"Min(2, Max({hmin}, {slope} * Sqrt((x - 1)^2 + y^2)))"
-    _, data = run_scene(load_scene_file(scene_with(tmp, f"ref{slope}", f)), "nts")
+    _, data = run_scene(
+        load_scene_file(scene_with(tmp, f"ref{slope}", f)), SolveRequest.parse("nts")
+    )
     data = data.to_json()
     return measures(data, None)
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contactfx import run_scene
+from contactfx import SolveRequest, run_scene
 from contactfx.results.interface import pair_interface
 from contactfx.scenes.gmsh_io import scene_from_gmsh
 from contactfx.scenes.scene_file import parse_scene_file
@@ -49,7 +49,7 @@ def scene(request, tmp_path_factory):
 
 @pytest.mark.parametrize("method, basis", METHODS)
 def test_edges_agree_and_no_node_released_inside(scene, method, basis):
-    sol, _ = run_scene(scene, method, basis=basis)
+    sol, _ = run_scene(scene, SolveRequest.parse(method, basis=basis))
     it = pair_interface(sol, 0)
     y, p = np.array(it["y"]), np.array(it["pressure"])
     active = np.array(it["active"])
