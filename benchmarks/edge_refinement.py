@@ -50,11 +50,11 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "tests" / "scenes" / "press_fit.toml"
 H = 0.5  # the hub's half length (press_fit.geo)
 METHODS = {
-    "mortar": ("mortar", None),
+    "mortar": ("mortar", "standard"),
     "dual mortar": ("mortar", "dual"),
-    "sts": ("sts", None),
-    "penalty": ("penalty", None),
-    "nts": ("nts", None),
+    "sts": ("sts", "standard"),
+    "penalty": ("penalty", "standard"),
+    "nts": ("nts", "standard"),
 }
 
 
@@ -62,13 +62,13 @@ def press_fit(tmp: Path, **params: float) -> Any:
     """The press-fit scene with the .geo's constants overridden (DefineConstant keeps them)."""
     from mpi4py import MPI
 
-    from contactfx.scenes.gmsh_io import scene_from_gmsh
+    from contactfx.scenes.gmsh_io import scene_from_parts
     from contactfx.scenes.scene_file import parse_scene_file
 
     mesh, parts = parse_scene_file(SCENE)
     geo = tmp / "press_fit.geo"
     geo.write_text("".join(f"{k} = {v!r};\n" for k, v in params.items()) + mesh.read_text())
-    return scene_from_gmsh(geo, parts, MPI.COMM_WORLD)
+    return scene_from_parts(geo, parts, MPI.COMM_WORLD)
 
 
 def edge_values(interface: dict[str, Any], ell: float) -> dict[str, float]:

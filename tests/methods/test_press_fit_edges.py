@@ -15,7 +15,7 @@ from mpi4py import MPI
 
 from contactfx import SolveRequest, run_scene
 from contactfx.results.interface import pair_interface
-from contactfx.scenes.gmsh_io import scene_from_gmsh
+from contactfx.scenes.gmsh_io import scene_from_parts
 from contactfx.scenes.scene_file import parse_scene_file
 
 SCENE = Path(__file__).parents[1] / "scenes" / "press_fit.toml"
@@ -25,9 +25,9 @@ PLACEMENTS = [(0.0, 0.3), (0.5, 0.72), (0.25, 0.95)]
 METHODS = [
     ("mortar", "standard"),
     ("mortar", "dual"),
-    ("sts", None),
-    ("nts", None),
-    ("penalty", None),
+    ("sts", "standard"),
+    ("nts", "standard"),
+    ("penalty", "standard"),
 ]
 H = 0.5  # the hub's half length
 
@@ -38,7 +38,7 @@ def press_fit(tmp: Path, **params: float):
     mesh, parts = parse_scene_file(SCENE)
     geo = tmp / "press_fit.geo"
     geo.write_text("".join(f"{k} = {v!r};\n" for k, v in params.items()) + mesh.read_text())
-    return scene_from_gmsh(geo, parts, MPI.COMM_WORLD)
+    return scene_from_parts(geo, parts, MPI.COMM_WORLD)
 
 
 @pytest.fixture(scope="module", params=PLACEMENTS, ids=lambda p: f"top{p[0]}-bot{p[1]}")
