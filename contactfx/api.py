@@ -15,7 +15,7 @@ from mpi4py import MPI
 
 from .errors import InputError
 from .methods.active_set import ActiveSetOptions
-from .methods.autosolve import prepare_solver
+from .methods.autosolve import prepare_solver, warn_if_stretched
 from .methods.multipliers import solve_contact
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.solution import Solution
@@ -97,6 +97,8 @@ def solve_request(
     if request.solver.kind is SolverKind.AUTO:
         prepared = prepare_solver(scene, request, aso.penetration_tol, timers)
         request = prepared.request
+    else:
+        warn_if_stretched(scene.mesh, request)  # `auto` logs its own choice
     try:
         init = (
             coarse_initial_set(initial, margin=coarse_margin(request.solver))
