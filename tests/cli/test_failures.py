@@ -112,6 +112,24 @@ def test_bad_parameters_raise_input_error(change: dict, words: str) -> None:
         )
 
 
+def test_hertz_default_sizes_are_none_and_a_zero_asks_for_them_on_the_command_line() -> None:
+    """r_refine and h_far default to None (1.4 a, R / 6); a 0 is refused from Python and, on
+    the command line, still asks for the default."""
+    from contactfx.cli.params import scene_params
+    from contactfx.cli.parser import parser
+    from contactfx.scenes import HertzParams
+    from contactfx.scenes.builtin import validate
+
+    assert (HertzParams().r_refine, HertzParams().h_far) == (None, None)
+    for key in ("r_refine", "h_far"):
+        with pytest.raises(InputError, match=f"{key} must be positive"):
+            validate(replace(HertzParams(), **{key: 0.0}))
+    zeros = parser().parse_args(["solve", "hertz", "--h-far", "0", "--r-refine", "0"])
+    assert scene_params(zeros) == HertzParams()
+    given = parser().parse_args(["solve", "hertz", "--h-far", "3", "--r-refine", "2"])
+    assert scene_params(given) == HertzParams(h_far=3.0, r_refine=2.0)
+
+
 def test_unknown_scene_raises_input_error() -> None:
     with pytest.raises(InputError, match="unknown scene 'cube'"):
         build_scene("cube", COARSE, comm=MPI.COMM_SELF)
