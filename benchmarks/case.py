@@ -74,7 +74,7 @@ def main() -> None:
     edge = args.refine / 4 if args.refine_edge is None else args.refine_edge
     params = HertzParams(
         refine=args.refine,
-        h_far=args.h_far,
+        h_far=args.h_far or None,  # 0: the default grading (R / 6)
         mesh=args.mesh,
         **({"refine_edge": edge} if args.mesh == "gmsh" else {}),
     )

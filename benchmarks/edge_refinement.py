@@ -132,7 +132,7 @@ PLACEMENTS = [0.0, 0.001, 0.25, 0.5, 0.72, 0.9, 0.999]
 
 def placements(path: Path) -> int:
     """Both edges' peaks as the shaft's nodes move across the bottom end (hc = 0.005)."""
-    from contactfx import run_scene
+    from contactfx import SolveRequest, run_scene
 
     out: dict[str, Any] = {"hc": 0.005, "f_top": 0.0, "f_bot": PLACEMENTS, "methods": {}}
     with tempfile.TemporaryDirectory() as tmp:
@@ -140,7 +140,7 @@ def placements(path: Path) -> int:
         for name, (method, basis) in METHODS.items():
             top, bottom = [], []
             for scene in scenes:
-                _, summary = run_scene(scene, method, basis=basis)
+                _, summary = run_scene(scene, SolveRequest.parse(method, basis=basis))
                 vals = edge_values(summary.to_json()["contacts"][0]["interface"], 0.05)
                 top.append(vals["peak_top"])
                 bottom.append(vals["peak_bottom"])
@@ -166,7 +166,7 @@ def main() -> int:
     args = ap.parse_args()
     if args.placements:
         return placements(ROOT / "benchmarks" / "edge_placements.json")
-    from contactfx import run_scene
+    from contactfx import SolveRequest, run_scene
 
     s = edge_exponent()
     rows: dict[str, dict[str, list[float]]] = {m: {} for m in METHODS}
@@ -175,7 +175,7 @@ def main() -> int:
         for hc in args.hc:
             scene = press_fit(Path(tmp), hc=hc, f_top=0.0, f_bot=0.72)
             for name, (method, basis) in METHODS.items():
-                _, summary = run_scene(scene, method, basis=basis)
+                _, summary = run_scene(scene, SolveRequest.parse(method, basis=basis))
                 data = summary.to_json()
                 vals = edge_values(data["contacts"][0]["interface"], args.ell)
                 for key, v in vals.items():

@@ -26,7 +26,7 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from contactfx import run_case
+from contactfx import SolveRequest, run_case
 from contactfx.contact.search import project
 from contactfx.discretize.elasticity import sigma
 from contactfx.methods.solution import Solution
@@ -73,7 +73,10 @@ def norms(x: np.ndarray, v: np.ndarray, a: float, p0: float) -> tuple[float, flo
 def level(f: float, mesher: str) -> None:
     """Solve one level and print the three variants."""
     sol, data = run_case(
-        "hertz", hertz_at(HertzParams(mesh=mesher), f), "mortar", comm=MPI.COMM_SELF
+        "hertz",
+        hertz_at(HertzParams(mesh=mesher), f),
+        SolveRequest.parse("mortar"),
+        comm=MPI.COMM_SELF,
     )
     data = data.to_json()
     pv = sol.pairs[0]

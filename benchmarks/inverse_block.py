@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 
 import contactfx.linalg.mumps as mumps
+from contactfx import SolveRequest
 from contactfx.api import run_case
 from contactfx.scenes import HertzParams
 
@@ -30,7 +31,7 @@ def main() -> None:
     for _ in range(2):
         for block in blocks:
             mumps.inverse_block = lambda n, block=block: block  # the rule, replaced
-            _, data = run_case("hertz", CASES[name], "mortar")
+            _, data = run_case("hertz", CASES[name], SolveRequest.parse("mortar"))
             data = data.to_json()
             first = data["active_set"][0]
             print(

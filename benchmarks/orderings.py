@@ -16,6 +16,7 @@ import time
 
 from mpi4py import MPI
 
+from contactfx import SolveRequest
 from contactfx.api import run_scene
 from contactfx.options import solver_spec
 from contactfx.scenes import HertzParams
@@ -55,7 +56,9 @@ def main() -> None:
             for k in order:
                 spec = solver_spec("mumps").with_petsc([f"mat_mumps_icntl_7={k}"])
                 t0 = time.perf_counter()
-                _, data = run_scene(scene, "mortar", solver=spec, reference_timing=True)
+                _, data = run_scene(
+                    scene, SolveRequest.parse("mortar", solver=spec, reference_timing=True)
+                )
                 data = data.to_json()
                 t = data["times"]
                 dofs = data["dofs"]

@@ -1,4 +1,4 @@
-"""The Python API: solve(scene, method) -> Solution, run_scene with its JSON summary, run_case.
+"""The Python API: solve(scene, method) -> Solution; run_scene and run_case add the summary.
 
 The CLI, the demos, the benchmarks and the tests are thin layers over these calls. The
 options given by name become one SolveRequest (request.py), validated when it is made;
@@ -15,7 +15,7 @@ from mpi4py import MPI
 
 from .errors import InputError
 from .methods.active_set import ActiveSetOptions
-from .methods.autosolve import prepare_solver
+from .methods.autosolve import prepare_solver, warn_if_stretched
 from .methods.multipliers import solve_contact
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.solution import Solution
@@ -97,6 +97,8 @@ def solve_request(
     if request.solver.kind is SolverKind.AUTO:
         prepared = prepare_solver(scene, request, aso.penetration_tol, timers)
         request = prepared.request
+    else:
+        warn_if_stretched(scene.mesh, request)  # `auto` logs its own choice
     try:
         init = (
             coarse_initial_set(initial, margin=coarse_margin(request.solver))
@@ -112,32 +114,41 @@ def solve_request(
 
 def run_scene(
     scene: Scene,
-    request: SolveRequest | Method | str = Method.MORTAR,
+    request: SolveRequest,
     *,
     t_start: float | None = None,
     timers: Timers | None = None,
     paper_interface: bool = False,
     initial: Solution | None = None,
-    **options: Unpack[RequestOptions],
 ) -> tuple[Solution, RunSummary]:
-    """Solve `scene` and return the solution with its summary (times from `t_start`).
+    """Solve `scene` as `request` asks; return the solution with its summary.
 
-    `request` and the options are `solve`'s; `paper_interface` adds the x-sorted `interface`
-    block of pair 0 (the paper's scenes: one horizontal contact line). The summary's
-    `to_json()` is the JSON of `contactfx solve --json`.
+    `request` is one SolveRequest (`SolveRequest.parse("mortar", basis="dual")` names one);
+    `t_start` is where the summary's total time starts; `timers`, `initial` are `solve`'s;
+    `paper_interface` adds the x-sorted `interface` block of pair 0 (the paper's scenes: one
+    horizontal contact line). The summary's `to_json()` is the JSON of `contactfx solve --json`.
     """
+    _require_request(request)
     t_start = time.perf_counter() if t_start is None else t_start
     timers = timers or Timers()
-    req = as_request(request, **options)
-    sol = solve_request(scene, req, timers, initial)
+    sol = solve_request(scene, request, timers, initial)
     times = {k: timers.seconds.get(k, 0.0) for k in TIME_KEYS}
     for key in ("predictor", "reference_solve", "reference_lu", "reference_ldlt"):
         if key in timers.seconds:
             times[key] = timers.seconds[key]
     times["total"] = time.perf_counter() - t_start
     return sol, summary(
-        sol, times, request=req, memory=peak_memory(scene.comm), paper_interface=paper_interface
+        sol, times, request=request, memory=peak_memory(scene.comm), paper_interface=paper_interface
     )
+
+
+def _require_request(request: object) -> None:
+    """Refuse a method's name where a SolveRequest is due (it would fail deep in the solve)."""
+    if not isinstance(request, SolveRequest):
+        raise InputError(
+            f"expected a SolveRequest, not {request!r}: name one with SolveRequest.parse"
+            f"({request!r}, ...), or call contactfx.solve"
+        )
 
 
 def peak_memory(comm: MPI.Comm) -> dict[str, float]:
@@ -153,18 +164,17 @@ def peak_memory(comm: MPI.Comm) -> dict[str, float]:
 def run_case(
     kind: str,
     params: BlockParams | HertzParams,
-    request: SolveRequest | Method | str,
+    request: SolveRequest,
     active: int = 2,
     comm: MPI.Comm = MPI.COMM_WORLD,
-    **options: Unpack[RequestOptions],
 ) -> tuple[Solution, RunSummary]:
     """Mesh, assemble and solve a built-in scene; return the solution and its summary.
 
-    `request` and the options are `solve`'s; the summary carries the paper's `interface` block.
+    `request` is `run_scene`'s; the summary carries the paper's `interface` block.
     """
+    _require_request(request)  # refused before the mesh is made
     t_start = time.perf_counter()
     timers = Timers()
-    req = as_request(request, **options)  # refused before the mesh is made
     with timers("mesh"):
         scene = build_scene(kind, params, active=active, comm=comm)
-    return run_scene(scene, req, t_start=t_start, timers=timers, paper_interface=True)
+    return run_scene(scene, request, t_start=t_start, timers=timers, paper_interface=True)

@@ -29,6 +29,7 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
+from contactfx import SolveRequest
 from contactfx.api import run_case
 from contactfx.options import Method
 from contactfx.results.figures import deformed_fields
@@ -66,7 +67,9 @@ t0 = time.perf_counter()
 for name, params in BLOCK_SCENES.items():
     for active in (2,) if name == "S1" else (2, 1):
         for method in METHODS:
-            sol, data = run_case("blocks", params, method, active=active, comm=comm)
+            sol, data = run_case(
+                "blocks", params, SolveRequest.parse(method), active=active, comm=comm
+            )
             data = data.to_json()
             corner = params.l2 / 2
             row = {

@@ -31,7 +31,7 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 from contactfx.discretize import elasticity
 
 matplotlib.use("Agg")
@@ -85,7 +85,7 @@ def walls(dT: float, method: str, model: str = "plane_strain") -> np.ndarray:
     OUT.mkdir(parents=True, exist_ok=True)
     path = OUT / f"heated_{model}_{comm.rank}.toml"
     path.write_text(scene_text(dT, model))
-    sol, _ = run_scene(load_scene_file(path, comm), method)
+    sol, _ = run_scene(load_scene_file(path, comm), SolveRequest.parse(method))
     return np.concatenate([sol.pressure[pv.rows] for pv in sol.pairs])
 
 

@@ -33,6 +33,7 @@ from mpi4py import MPI
 from contactfx import (
     HertzReference,
     Obstacle,
+    SolveRequest,
     load_scene_file,
     run_scene,
     scene_from_gmsh,
@@ -92,7 +93,7 @@ indenter = load_scene_file(SCENES / "rigid_indenter.toml", comm)
 hertz = {}
 for method, options in METHODS:
     t0 = time.perf_counter()
-    sol, data = run_scene(indenter, method, **options)
+    sol, data = run_scene(indenter, SolveRequest.parse(method, **options))
     data = data.to_json()
     c = data["contacts"][0]
     P = 2.0 * abs(c["force"][1])
@@ -129,7 +130,7 @@ same = scene_from_gmsh(
     ],
     comm=comm,
 )
-_, again = run_scene(same, "mortar")
+_, again = run_scene(same, SolveRequest.parse("mortar"))
 again = again.to_json()
 say(f"Python API: force {again['contacts'][0]['force']}")
 # -
@@ -168,7 +169,7 @@ def sadowsky(c: dict, b: float = 1.0) -> tuple[float, float, float]:
 punch = load_scene_file(SCENES / "rigid_punch.toml", comm)
 flat = {}
 for method, options in METHODS:
-    _, data = run_scene(punch, method, **options)
+    _, data = run_scene(punch, SolveRequest.parse(method, **options))
     data = data.to_json()
     c = data["contacts"][0]
     P, interior, l1 = sadowsky(c)

@@ -27,7 +27,7 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -135,7 +135,7 @@ scene = load_scene_file(toml_path, comm)
 results = {}
 for method in METHODS:
     t0 = time.perf_counter()
-    _, data = run_scene(scene, method)
+    _, data = run_scene(scene, SolveRequest.parse(method))
     data = data.to_json()
     results[method] = data
     for h, c in zip(data["hertz_pairs"], data["contacts"], strict=True):

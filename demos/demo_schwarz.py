@@ -35,6 +35,7 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
+from contactfx import SolveRequest
 from contactfx.api import run_case
 from contactfx.errors import ConvergenceError
 from contactfx.methods.schwarz import SchwarzOptions
@@ -79,13 +80,16 @@ def interface_arrays(data: dict) -> dict[str, np.ndarray]:
 # +
 runs = {}
 for name, params in BLOCK_SCENES.items():
-    _, mortar = run_case("blocks", params, Method.MORTAR, comm=comm)
+    _, mortar = run_case("blocks", params, SolveRequest.parse(Method.MORTAR), comm=comm)
     mortar = mortar.to_json()
     runs[name] = {"mortar": mortar}
     for label, opts in SETTINGS.items():
         try:
             sol, data = run_case(
-                "blocks", params, Method.SCHWARZ, comm=comm, schwarz=opts
+                "blocks",
+                params,
+                SolveRequest.parse(Method.SCHWARZ, schwarz=opts),
+                comm=comm,
             )
             data = data.to_json()
             entry = {"data": data, "history": data["active_set"], "converged": True}
@@ -149,9 +153,11 @@ levels = (1, 2) if QUICK else (1, 2, 4, 8)
 sweep = []
 for k in levels:
     params = replace(BLOCK_SCENES["S2"], size1=0.08 / k, size2=0.1 / k)
-    _, mortar = run_case("blocks", params, Method.MORTAR, comm=comm)
+    _, mortar = run_case("blocks", params, SolveRequest.parse(Method.MORTAR), comm=comm)
     mortar = mortar.to_json()
-    sol, schwarz = run_case("blocks", params, Method.SCHWARZ, comm=comm)
+    sol, schwarz = run_case(
+        "blocks", params, SolveRequest.parse(Method.SCHWARZ), comm=comm
+    )
     schwarz = schwarz.to_json()
     sweep.append(
         {

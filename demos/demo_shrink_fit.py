@@ -33,7 +33,7 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -60,7 +60,7 @@ def say(*args: object) -> None:
 scene = load_scene_file(SCENE, comm)
 rows, curves = [], {}
 for method in METHODS:
-    sol, run = run_scene(scene, method)
+    sol, run = run_scene(scene, SolveRequest.parse(method))
     data = run.to_json()
     (lame,) = data["lame"]
     c = data["contacts"][0]

@@ -25,6 +25,7 @@ import matplotlib
 import numpy as np
 from mpi4py import MPI
 
+from contactfx import SolveRequest
 from contactfx.api import run_case
 from contactfx.results.references import exact_pressure
 from contactfx.scenes import HertzParams, Model, hertz_exact
@@ -71,7 +72,9 @@ say(
 rows, profiles = [], {}
 for h in EDGES:
     for method in METHODS:
-        sol, record = run_case("hertz", graded(h), method, comm=comm)
+        sol, record = run_case(
+            "hertz", graded(h), SolveRequest.parse(method), comm=comm
+        )
         data = record.to_json()
         hz = data["hertz"]
         rows.append(

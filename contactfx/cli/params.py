@@ -164,6 +164,9 @@ def scene_params(args: argparse.Namespace) -> BlockParams | HertzParams:
             f"unknown scene '{args.scene}' (choose blocks, hertz or a .toml scene file)"
         )
     given = {k: getattr(args, k) for k in keys if getattr(args, k) is not None}
+    for key in ("r_refine", "h_far"):
+        if given.get(key) == 0.0:
+            given[key] = None  # 0: the default (1.4 a, R / 6), as the option always took it
     if getattr(args, "model", None) is not None:
         given["model"] = Model.parse(args.model, "--model")
     if args.mesh is not None:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from dolfinx import fem
+from dolfinx import fem, mesh
 
 from ..scenes import Scene
 
@@ -11,6 +11,16 @@ from ..scenes import Scene
 def scene_dofs(scene: Scene) -> int:
     """Displacement dofs of `scene` (P1 vector: two per vertex)."""
     return 2 * scene.mesh.topology.index_map(0).size_global
+
+
+def max_cell_aspect(msh: mesh.Mesh) -> float:
+    """The largest longest-to-shortest edge ratio of the local cells (Q1 quadrilaterals)."""
+    x = msh.geometry.x[msh.geometry.dofmaps[0], :2]  # (cells, 4, 2): tensor-product order
+    if len(x) == 0:
+        return 1.0
+    # The edges of a DOLFINx quadrilateral: 0-1, 1-3, 3-2, 2-0.
+    edges = np.linalg.norm(x[:, [1, 3, 2, 0]] - x[:, [0, 1, 3, 2]], axis=2)
+    return float(np.max(edges.max(axis=1) / edges.min(axis=1)))
 
 
 def vertex_to_block(V: fem.FunctionSpace) -> np.ndarray:

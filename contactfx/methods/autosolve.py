@@ -16,9 +16,10 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, replace
 
+from dolfinx import mesh
 from mpi4py import MPI
 
-from ..discretize.mesh_utils import scene_dofs
+from ..discretize.mesh_utils import max_cell_aspect, scene_dofs
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import InputError
 from ..linalg import LinearSolver
@@ -183,6 +184,28 @@ def warn_if_too_big(
     if choose(needed, avail, True) is not Choice.DIRECT and scene.comm.rank == 0:
         reason = SolverChoice(request.solver.name, needed, avail, None).reason
         log.warning("solver: %s, although %s", request.solver.name, reason)
+
+
+# Past this cell aspect (longest over shortest edge) both multigrids of the condensed system
+# are poor cycles: the default Hertz grading (150:1 to about 1,000:1) needs 86-156 CG
+# iterations and MUMPS is 16-30x faster, where the accurate grading (up to 20:1) needs 5-7
+# (docs/scale.md, "Where each solver fails").
+STRETCHED_ASPECT = 100.0
+
+
+def warn_if_stretched(msh: mesh.Mesh, request: SolveRequest) -> None:
+    """An explicit condensed solver runs as asked; a log line warns where cells are stretched."""
+    if not request.solver.traits.needs_diagonal_d:
+        return
+    aspect = msh.comm.allreduce(max_cell_aspect(msh), op=MPI.MAX)
+    if aspect > STRETCHED_ASPECT and msh.comm.rank == 0:
+        log.warning(
+            "solver: %s, although cells are stretched up to %.0f:1 (past %.0f:1 its multigrid "
+            "needs tens to hundreds of CG iterations; mumps is faster there: docs/scale.md)",
+            request.solver.name,
+            aspect,
+            STRETCHED_ASPECT,
+        )
 
 
 def _say(record: SolverChoice, comm: MPI.Comm) -> None:

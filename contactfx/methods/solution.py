@@ -40,24 +40,59 @@ class Fields:
 class PairView:
     """One contact pair of a solution: its surfaces, multiplier rows and their geometry.
 
-    Row i of `B` is the pair's multiplier row `rows[i]` (layout order): the weighted gap's
-    linearization, whose transpose spreads the multipliers into nodal forces. Against a
-    rigid obstacle (`obstacle` set) there is no passive body or surface; row i of `motion`
-    is the same row's derivative by the obstacle's displacement (its force: motion^T lambda).
+    `data` is the pair as the setup built it (its bodies, gathered surfaces, obstacle and
+    initial overlap; read through the properties below). Row i of `B` is the pair's
+    multiplier row `rows[i]` (layout order): the weighted gap's linearization, whose
+    transpose spreads the multipliers into nodal forces. Against a rigid obstacle
+    (`obstacle` set) there is no passive body or surface; row i of `motion` is the same
+    row's derivative by the obstacle's displacement (its force: motion^T lambda).
     """
 
-    index: int
-    pair: ContactPair
-    active_body: Body
-    passive_body: Body | None
-    active: GatheredSurface
-    passive: GatheredSurface | None
+    data: PairData
     rows: np.ndarray  # layout rows of the pair's multipliers
     gblock: np.ndarray  # global node (dof block) of each of those rows
     B: CSR
-    obstacle: Obstacle | None = None
-    motion: CSR | None = None
-    initial_overlap: float = 0.0  # max over the pair's rows of -gap before the solve
+    motion: CSR | None = None  # `data.motion`'s rows in the order of `rows`
+
+    @property
+    def index(self) -> int:
+        """The pair's index in the scene."""
+        return self.data.index
+
+    @property
+    def pair(self) -> ContactPair:
+        """The scene's pair (its curve groups, interference)."""
+        return self.data.pair
+
+    @property
+    def active_body(self) -> Body:
+        """The body of the active (multiplier) surface."""
+        return self.data.active_body
+
+    @property
+    def passive_body(self) -> Body | None:
+        """The body of the passive surface; None against an obstacle."""
+        return self.data.passive_body
+
+    @property
+    def active(self) -> GatheredSurface:
+        """The gathered active surface."""
+        return self.data.active
+
+    @property
+    def passive(self) -> GatheredSurface | None:
+        """The gathered passive surface; None against an obstacle."""
+        return self.data.passive
+
+    @property
+    def obstacle(self) -> Obstacle | None:
+        """The rigid obstacle of the pair, if any."""
+        return self.data.obstacle
+
+    @property
+    def initial_overlap(self) -> float:
+        """Max over the pair's rows of -gap before the solve (>= 0)."""
+        return self.data.initial_overlap
 
     @property
     def label(self) -> str:
@@ -199,18 +234,11 @@ def pair_views(
     for p in setup_pairs:
         rows = np.flatnonzero(layout.pair == p.index)
         view = PairView(
-            p.index,
-            p.pair,
-            p.active_body,
-            p.passive_body,
-            p.active,
-            p.passive,
+            p,
             rows,
             layout.gblock[rows],
             B.rows(order[rows]),
-            p.obstacle,
             None if p.motion is None else p.motion.rows(order[rows] - p.first_row),
-            p.initial_overlap,
         )
         out.append(view)
     return out

@@ -63,13 +63,13 @@ class HertzParams:
     nu1: float = 0.23
     nu2: float = 0.23
     refine: float = 0.02  # element size on the contact zone, x <= r_refine (cm)
-    r_refine: float = 0.0  # end of the refined zone; 0 = 1.4 a (Hertz's half-width)
+    r_refine: float | None = None  # end of the refined zone; None: 1.4 a (Hertz's half-width)
     refine_edge: float = 0.005  # element size at x = a, the pressure's sqrt edge; 0 = off
     slope: float = 0.1  # growth of the element size per unit distance
     width: float = 60.0
     height: float = 60.0
     mesh: str = "gmsh"  # "gmsh" (graded unstructured quads) or "structured" (large runs)
-    h_far: float = 0.0  # largest element size (cm); 0 = R / 6
+    h_far: float | None = None  # largest element size (cm); None: R / 6
     # Axisymmetric: a (hemi)sphere on a cylindrical block, P the total force (MPa*cm^2).
     model: Model = Model.PLANE_STRAIN
 
@@ -143,12 +143,14 @@ def validate(params: BlockParams | HertzParams) -> None:
             )
         if params.mesh not in MESHERS:
             raise InputError(f"unknown mesh '{params.mesh}' (choose {' or '.join(MESHERS)})")
-        if params.r_refine < 0:
-            raise InputError(f"r_refine must be >= 0 (got {params.r_refine})")
+        if params.r_refine is not None and not (
+            math.isfinite(params.r_refine) and params.r_refine > 0
+        ):
+            raise InputError(f"r_refine must be positive (got {params.r_refine}; None: 1.4 a)")
         if not (math.isfinite(params.refine_edge) and params.refine_edge >= 0):
             raise InputError(f"refine_edge must be >= 0 (got {params.refine_edge})")
-        if not (math.isfinite(params.h_far) and params.h_far >= 0):
-            raise InputError(f"h_far must be >= 0 (got {params.h_far})")
+        if params.h_far is not None and not (math.isfinite(params.h_far) and params.h_far > 0):
+            raise InputError(f"h_far must be positive (got {params.h_far}; None: R / 6)")
 
 
 @dataclass(frozen=True)
@@ -176,7 +178,7 @@ class BuiltinRecipe:
                 p,
                 refine=p.refine * factor,
                 refine_edge=p.refine_edge * factor,
-                h_far=p.h_far * factor,
+                h_far=None if p.h_far is None else p.h_far * factor,
             )
         return replace(self, params=scaled)
 
@@ -287,16 +289,16 @@ def hertz(
     validate(params)
     params = replace(params, model=Model.parse(params.model))
     exact = hertz_exact(params)
-    if params.r_refine == 0.0:
+    if params.r_refine is None:
         # Refine where the contact zone will be: Hertz's a, with margin for the active set.
         params = replace(params, r_refine=round(1.4 * exact["a"], 6))
     h = params
-    h_far = h.h_far or None
+    assert h.r_refine is not None  # set just above
     lines = None
     if h.mesh == "structured":
         # Built directly in DOLFINx: gmsh's quad mesher is too slow for millions of DOFs.
         data, lines = build_hertz_structured(
-            comm, h.R, h.width, h.height, h.refine, h.r_refine, h_far, h.slope
+            comm, h.R, h.width, h.height, h.refine, h.r_refine, h.h_far, h.slope
         )
     else:
         # The edge grading targets the Hertz estimate of a, as a user would plan a mesh.
@@ -308,14 +310,15 @@ def hertz(
             h.height,
             h.refine,
             h.r_refine,
-            h_far=h_far,
+            h_far=h.h_far,
             slope=h.slope,
             edge=edge,
             size_field=_field(size_field),
         )
         data = cached_to_dolfinx(comm, build)
     ref = (HertzReference(pair=0, R=h.R, P=h.P, symmetric=True),)
-    extra: dict[str, Any] = {"hertz_exact": exact}
+    # The JSON's params keep h_far 0 for the default far size (R / 6), as `--h-far 0` asks.
+    extra: dict[str, Any] = {"h_far": h.h_far or 0.0, "hertz_exact": exact}
     # The load on the flat face: P over its width 2 R (a cylinder), or its disc pi R^2 (a sphere).
     load = h.P / (math.pi * h.R**2) if h.model is Model.AXISYMMETRIC else h.P / (2 * h.R)
     scene = _two_body_scene(data, h, load, active, "hertz", ref, extra, size_field)

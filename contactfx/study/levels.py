@@ -57,14 +57,14 @@ def hertz_at(params: HertzParams, f: float) -> HertzParams:
     slope = params.slope * math.sqrt(f)
     if f > 1.0:
         slope = min(slope, max(SLOPE_CAP, params.slope))
-    # h_far = 0 means R / 6, a cap that the slope leaves inactive; a given far size is a
+    # h_far None means R / 6, a cap that the slope leaves inactive; a given far size is a
     # bulk size like the slope's and follows it.
     return replace(
         params,
         refine=params.refine * f,
         refine_edge=params.refine_edge * f,
         slope=slope,
-        h_far=params.h_far * math.sqrt(f),
+        h_far=None if params.h_far is None else params.h_far * math.sqrt(f),
     )
 
 

@@ -151,7 +151,9 @@ def test_true_error_norm_is_the_models_energy(model: str, rel: float) -> None:
     from contactfx.scenes import BLOCK_SCENES, Model
 
     params = replace(BLOCK_SCENES["S1"], model=Model(model), size1=0.5, size2=0.5)
-    sol, _ = contactfx.run_case("blocks", params, "mortar", comm=MPI.COMM_SELF)
+    sol, _ = contactfx.run_case(
+        "blocks", params, contactfx.SolveRequest.parse("mortar"), comm=MPI.COMM_SELF
+    )
     el = sol.fields
     a_uu = fem.assemble_scalar(fem.form(energy_form(sol.u, sol.u, el.E, el.nu, Model(model))))
     got = energy_error(sol, sol)

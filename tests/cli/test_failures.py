@@ -107,7 +107,27 @@ def assert_clean_failure(tmp_path: Path, args: list[str], words: str, mpi: int =
 )
 def test_bad_parameters_raise_input_error(change: dict, words: str) -> None:
     with pytest.raises(InputError, match=words):
-        run_case("blocks", replace(COARSE, **change), "mortar", comm=MPI.COMM_SELF)
+        run_case(
+            "blocks", replace(COARSE, **change), SolveRequest.parse("mortar"), comm=MPI.COMM_SELF
+        )
+
+
+def test_hertz_default_sizes_are_none_and_a_zero_asks_for_them_on_the_command_line() -> None:
+    """r_refine and h_far default to None (1.4 a, R / 6); a 0 is refused from Python and, on
+    the command line, still asks for the default."""
+    from contactfx.cli.params import scene_params
+    from contactfx.cli.parser import parser
+    from contactfx.scenes import HertzParams
+    from contactfx.scenes.builtin import validate
+
+    assert (HertzParams().r_refine, HertzParams().h_far) == (None, None)
+    for key in ("r_refine", "h_far"):
+        with pytest.raises(InputError, match=f"{key} must be positive"):
+            validate(replace(HertzParams(), **{key: 0.0}))
+    zeros = parser().parse_args(["solve", "hertz", "--h-far", "0", "--r-refine", "0"])
+    assert scene_params(zeros) == HertzParams()
+    given = parser().parse_args(["solve", "hertz", "--h-far", "3", "--r-refine", "2"])
+    assert scene_params(given) == HertzParams(h_far=3.0, r_refine=2.0)
 
 
 def test_unknown_scene_raises_input_error() -> None:
@@ -188,7 +208,7 @@ def test_penetration_within_tolerance_is_accepted() -> None:
 @pytest.mark.parametrize("method", ["mortar", "nts", "penalty"])
 def test_body_pulled_off_is_singular(method: str) -> None:
     with pytest.raises(SingularSystemError, match="body 'body2' is not held by its supports"):
-        run_case("blocks", replace(COARSE, p=-50.0), method, comm=MPI.COMM_SELF)
+        run_case("blocks", replace(COARSE, p=-50.0), SolveRequest.parse(method), comm=MPI.COMM_SELF)
 
 
 @pytest.mark.parametrize("solve", solvers(), ids=["mortar", "penalty"])
@@ -207,18 +227,23 @@ def test_linear_solve_not_converging_reports_reason() -> None:
     few = ["ksp_max_it=5", "fieldsplit_lambda_ksp_max_it=1"]
     with pytest.raises(SolverError, match=r"reason -3 \(DIVERGED_MAX_IT\) after 5 iterations"):
         spec = SOLVERS["fieldsplit"].with_petsc(few)
-        run_case("blocks", COARSE, "mortar", solver=spec, comm=MPI.COMM_SELF)
+        run_case("blocks", COARSE, SolveRequest.parse("mortar", solver=spec), comm=MPI.COMM_SELF)
     # Penalty factorizes: an iterative spec is refused when the request is made.
     plain = SolverSpec(SolverKind.CONDENSED, {"ksp_type": "gmres", "pc_type": "none"})
     with pytest.raises(InputError, match="no multiplier block"):
-        run_case("blocks", COARSE, "penalty", solver=plain.with_petsc(few[:1]), comm=MPI.COMM_SELF)
+        run_case(
+            "blocks",
+            COARSE,
+            SolveRequest.parse("penalty", solver=plain.with_petsc(few[:1])),
+            comm=MPI.COMM_SELF,
+        )
 
 
 @pytest.mark.parametrize(("method", "solver"), [("mortar", "fieldsplit"), ("penalty", "mumps")])
 def test_petsc_error_becomes_solver_error(method: str, solver: str) -> None:
     bogus = SOLVERS[solver].with_petsc(["ksp_type=bogus"])
     with pytest.raises(SolverError, match=r"PETSc error 86 .*Unable to find requested KSP type"):
-        run_case("blocks", COARSE, method, solver=bogus, comm=MPI.COMM_SELF)
+        run_case("blocks", COARSE, SolveRequest.parse(method, solver=bogus), comm=MPI.COMM_SELF)
 
 
 def test_petsc_options_cannot_change_the_solver_kind() -> None:
@@ -232,7 +257,9 @@ def test_petsc_options_cannot_change_the_solver_kind() -> None:
 
 def test_penalty_refuses_fieldsplit() -> None:
     with pytest.raises(InputError, match="no multiplier block"):
-        run_case("blocks", COARSE, "penalty", solver="fieldsplit", comm=MPI.COMM_SELF)
+        run_case(
+            "blocks", COARSE, SolveRequest.parse("penalty", solver="fieldsplit"), comm=MPI.COMM_SELF
+        )
 
 
 # Serial mortar with MUMPS converges in two steps (every row probed first), penalty in more.
@@ -241,7 +268,12 @@ def test_active_set_iteration_limit(method: str, limit: int) -> None:
     from contactfx.scenes import HertzParams
 
     with pytest.raises(ActiveSetError, match=f"did not converge in {limit} iterations"):
-        run_case("hertz", HertzParams(refine=0.1), method, max_iterations=limit, comm=MPI.COMM_SELF)
+        run_case(
+            "hertz",
+            HertzParams(refine=0.1),
+            SolveRequest.parse(method, max_iterations=limit),
+            comm=MPI.COMM_SELF,
+        )
 
 
 @pytest.mark.parametrize(

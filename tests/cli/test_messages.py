@@ -160,10 +160,11 @@ RENDER = textwrap.dedent(
     """
     from pathlib import Path
     from mpi4py import MPI
-    from contactfx import run_case
+    from contactfx import SolveRequest, run_case
     from contactfx.results.figures import deformed_fields
     from contactfx.scenes import BLOCK_SCENES
-    sol, _ = run_case("blocks", BLOCK_SCENES["S1"], "mortar", comm=MPI.COMM_SELF)
+    mortar = SolveRequest.parse("mortar")
+    sol, _ = run_case("blocks", BLOCK_SCENES["S1"], mortar, comm=MPI.COMM_SELF)
     print(deformed_fields(sol, Path(__import__("sys").argv[1])))
     """
 )

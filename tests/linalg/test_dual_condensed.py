@@ -11,7 +11,7 @@ import pytest
 from conftest import ROOT, solver_for
 from mpi4py import MPI
 
-from contactfx import load_scene_file, run_scene, solve
+from contactfx import SolveRequest, load_scene_file, run_scene, solve
 from contactfx.errors import InputError
 from contactfx.scenes import BLOCK_SCENES, HertzParams, build_scene, hertz
 
@@ -21,7 +21,7 @@ SCENES = ROOT / "tests" / "scenes"
 @pytest.mark.parametrize("name", ["inclined_patch.toml", "inclined_patch_b1.toml"])
 def test_dual_mortar_inclined_patch_test(name: str) -> None:
     """Dual mortar passes the inclined patch test (either side active) to 1e-8."""
-    _, data = run_scene(load_scene_file(SCENES / name), "mortar", basis="dual")
+    _, data = run_scene(load_scene_file(SCENES / name), SolveRequest.parse("mortar", basis="dual"))
     data = data.to_json()
     assert data["patch"]["max"] < 1e-8, data["patch"]
     assert data["basis"] == "dual"
@@ -31,7 +31,7 @@ def test_dual_mortar_inclined_patch_test(name: str) -> None:
 def test_dual_mortar_straight_patch_test(active: int) -> None:
     """S4 (graded non-matching, E ratio 10): sigma_yy = -p to 1e-8 with the dual basis."""
     scene = build_scene("blocks", BLOCK_SCENES["S4"], active=active, comm=MPI.COMM_SELF)
-    _, data = run_scene(scene, "mortar", basis="dual")
+    _, data = run_scene(scene, SolveRequest.parse("mortar", basis="dual"))
     data = data.to_json()
     assert data["patch"]["max"] < 1e-8
 
@@ -43,7 +43,8 @@ def test_dual_hertz_within_ten_percent_of_standard() -> None:
     vs 1.03e-3, p0 1.24e-3 vs 1.53e-3, L2 2.46e-3 vs 3.43e-3)."""
     scene = build_scene("hertz", HertzParams(), comm=MPI.COMM_SELF)
     out = {
-        b: run_scene(scene, "mortar", basis=b)[1].to_json()["hertz"] for b in ("standard", "dual")
+        b: run_scene(scene, SolveRequest.parse("mortar", basis=b))[1].to_json()["hertz"]
+        for b in ("standard", "dual")
     }
     for key, exact in (("a", "a_exact"), ("p0", "p0_exact")):
         errs = {b: abs(h[key] / h[exact] - 1) for b, h in out.items()}

@@ -447,9 +447,9 @@ def test_run_case_coarse_predictor() -> None:
     from contactfx.methods.predictor import use_coarse
 
     params = HertzParams(refine=0.025, mesh="structured")
-    base, s_base = run_case("hertz", params, "mortar", predictor="none")
+    base, s_base = run_case("hertz", params, SolveRequest.parse("mortar", predictor="none"))
     s_base = s_base.to_json()
-    sol, s = run_case("hertz", params, "mortar", predictor="coarse")
+    sol, s = run_case("hertz", params, SolveRequest.parse("mortar", predictor="coarse"))
     s = s.to_json()
     assert "predictor" in s["times"] and "predictor" not in s_base["times"]
     assert np.array_equal(sol.active, base.active)
@@ -471,7 +471,7 @@ def test_auto_predictor_by_candidate_rows() -> None:
     assert contact_facets(few) <= PROBE_ALL_ROWS < contact_facets(many)
     assert not use_coarse(Predictor.AUTO, few, SOLVERS["mumps"])
     assert use_coarse(Predictor.AUTO, many, SOLVERS["mumps"])
-    sol, data = run_scene(many, "mortar")
+    sol, data = run_scene(many, SolveRequest.parse("mortar"))
     data = data.to_json()
     assert abs(contact_facets(many) - data["multipliers"]) <= 1  # facets + 1 nodes per curve
     assert "predictor" in data["times"]

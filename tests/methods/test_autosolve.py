@@ -15,12 +15,13 @@ import pytest
 from conftest import run_cli
 from mpi4py import MPI
 
-from contactfx import run_scene
+from contactfx import run_scene, solve
 from contactfx.api import as_request
-from contactfx.discretize.mesh_utils import scene_dofs
+from contactfx.discretize.mesh_utils import max_cell_aspect, scene_dofs
 from contactfx.errors import InputError
 from contactfx.linalg.saddle import SaddleSolver
 from contactfx.methods import solver_choice
+from contactfx.methods.autosolve import STRETCHED_ASPECT, warn_if_stretched
 from contactfx.methods.solver_choice import (
     SAFETY,
     Choice,
@@ -221,3 +222,32 @@ def test_auto_under_mpi(tmp_path: Path) -> None:
     lines = [ln for ln in bad.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and "would not fit" in lines[0], bad.stderr
     assert "Traceback" not in bad.stderr
+
+
+def test_cell_aspect_of_a_stretched_grid() -> None:
+    """10 x 1 cm in 2 x 10 quadrilaterals: every cell 5 cm by 0.1 cm, aspect 50."""
+    from dolfinx import mesh
+
+    grid = mesh.create_rectangle(
+        MPI.COMM_SELF, [[0.0, 0.0], [10.0, 1.0]], [2, 10], mesh.CellType.quadrilateral
+    )
+    assert max_cell_aspect(grid) == pytest.approx(50.0, rel=1e-12)
+
+
+def test_explicit_condensed_warns_on_stretched_cells(scene, caplog) -> None:
+    """The default grading (cells past 100:1): an explicit condensed solver runs, with one
+    warning line; the accurate grading (`scene`, h_far = 10 h), or mumps: no warning."""
+    stretched = hertz(HertzParams(refine=0.08, mesh="structured"), comm=MPI.COMM_SELF)
+    assert max_cell_aspect(stretched.mesh) > STRETCHED_ASPECT > max_cell_aspect(scene.mesh)
+    with caplog.at_level("WARNING", logger="contactfx"):
+        sol = solve(stretched, "nts", solver="condensed")
+    assert sol.history and all(h["linear_iterations"] > 1 for h in sol.history)  # CG ran
+    warned = [r.getMessage() for r in caplog.records if "stretched" in r.getMessage()]
+    assert len(warned) == 1, warned
+    assert warned[0].startswith("solver: condensed, although cells are stretched up to ")
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="contactfx"):
+        warn_if_stretched(scene.mesh, SolveRequest.parse("nts", solver="condensed"))
+        warn_if_stretched(stretched.mesh, SolveRequest.parse("nts", solver="mumps"))
+        warn_if_stretched(stretched.mesh, SolveRequest.parse("nts", solver="auto"))
+    assert "stretched" not in caplog.text

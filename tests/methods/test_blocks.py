@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from conftest import MULTIPLIER_METHODS
 
+from contactfx import SolveRequest
 from contactfx.api import run_case
 from contactfx.results.paper import patch_errors
 from contactfx.results.stress import body_stress_deviation
@@ -20,7 +21,7 @@ P = S4.p
 def test_patch_test_matching_meshes(multiplier_method: str, active: int) -> None:
     """Equal widths and matching uniform meshes: every method gives sigma_yy = -p exactly."""
     params = replace(S4, size1=0.125, size2=0.125, grading1=1.0, grading2=1.0)
-    sol, data = run_case("blocks", params, multiplier_method, active=active)
+    sol, data = run_case("blocks", params, SolveRequest.parse(multiplier_method), active=active)
     data = data.to_json()
     dev = body_stress_deviation(sol, -P)
     assert dev["body1"] < 1e-8 and dev["body2"] < 1e-8
@@ -31,7 +32,7 @@ def test_patch_test_matching_meshes(multiplier_method: str, active: int) -> None
 def test_contact_force_equals_load(scene: str, multiplier_method: str) -> None:
     """The top block is held only by contact, so the contact force is the whole load p*l2/2."""
     params = BLOCK_SCENES[scene]
-    _, data = run_case("blocks", params, multiplier_method)
+    _, data = run_case("blocks", params, SolveRequest.parse(multiplier_method))
     data = data.to_json()
     assert data["contact_force"] == pytest.approx(params.p * params.l2 / 2, rel=1e-10)
     assert data["iterations"] == 1
@@ -42,7 +43,7 @@ def test_contact_force_equals_load(scene: str, multiplier_method: str) -> None:
 def test_mortar_passes_patch_test_on_nonmatching_meshes(active: int, graded: bool) -> None:
     """Segment-based mortar reproduces the uniform state to round-off (SPEC S4 bar: 1e-8)."""
     params = S4 if graded else replace(S4, grading1=1.0, grading2=1.0)
-    sol, data = run_case("blocks", params, "mortar", active=active)
+    sol, data = run_case("blocks", params, SolveRequest.parse("mortar"), active=active)
     data = data.to_json()
     dev = body_stress_deviation(sol, -P)
     assert max(dev.values()) < 1e-8
@@ -65,7 +66,7 @@ KNOWN_S4_ERRORS = {
 @pytest.mark.parametrize(("method", "active"), list(KNOWN_S4_ERRORS))
 def test_nts_and_sts_fail_patch_test_by_known_amount(method: str, active: int) -> None:
     """NTS and STS do not pass the non-matching patch test; their errors keep a known size."""
-    sol, data = run_case("blocks", S4, method, active=active)
+    sol, data = run_case("blocks", S4, SolveRequest.parse(method), active=active)
     data = data.to_json()
     dev = body_stress_deviation(sol, -P)
     measured = (dev["body1"], dev["body2"], patch_errors(data["interface"], P)["pressure"])
@@ -82,7 +83,10 @@ def test_s1_methods_agree_away_from_corner() -> None:
     the pressure is compared on the inner two thirds.
     """
     params = BLOCK_SCENES["S1"]
-    results = {m: run_case("blocks", params, m)[1].to_json()["interface"] for m in METHODS}
+    results = {
+        m: run_case("blocks", params, SolveRequest.parse(m))[1].to_json()["interface"]
+        for m in METHODS
+    }
     x = np.asarray(results["nts"]["x"])
     corner = params.l2 / 2
     for key, zone in (("sigma_yy_1", 0.9), ("sigma_yy_2", 0.9), ("pressure", 2 / 3)):

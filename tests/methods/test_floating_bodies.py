@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, cli, run_cli
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 from contactfx.discretize.load_paths import _carrying_lp, _one_mode, carrying_rows, pulled_away
 from contactfx.discretize.setup import prepare_contact
 from contactfx.errors import SingularSystemError
@@ -102,7 +102,7 @@ def test_load_that_pulls_a_block_off_has_no_equilibrium() -> None:
 @pytest.mark.serial
 def test_stacked_blocks_carry_the_load_through_every_pair() -> None:
     """The correct stack: every pair carries p L = 20 along y (statics), balanced."""
-    _, data = run_scene(load_scene_file(STACK), "mortar")
+    _, data = run_scene(load_scene_file(STACK), SolveRequest.parse("mortar"))
     data = data.to_json()
     assert len(data["contacts"]) == 3
     for c in data["contacts"]:
@@ -117,7 +117,7 @@ def test_far_pair_leaves_two_bodies_floating_and_is_refused(method: str) -> None
     message = refused_before_any_solve(FAR, method)
     assert_names_the_floating_bodies(message)
     with pytest.raises(SingularSystemError) as err:
-        run_scene(load_scene_file(FAR), method)
+        run_scene(load_scene_file(FAR), SolveRequest.parse(method))
     assert str(err.value) == message
 
 
@@ -162,7 +162,7 @@ def test_refusal_comes_before_the_loop_whatever_max_iterations(
 
     monkeypatch.setattr(multipliers, "run_active_set", no_loop)
     with pytest.raises(SingularSystemError) as err:
-        run_scene(load_scene_file(FAR), "mortar", max_iterations=max_iterations)
+        run_scene(load_scene_file(FAR), SolveRequest.parse("mortar", max_iterations=max_iterations))
     assert not entered
     assert_names_the_floating_bodies(str(err.value))
 

@@ -24,7 +24,9 @@ def mortar_finest() -> dict:
 
     The rates over the three levels are asserted per method in tests/study/test_study.py.
     """
-    return run_case("hertz", _graded(0.01, 0.141), "mortar", comm=MPI.COMM_SELF)[1].to_json()
+    return run_case(
+        "hertz", _graded(0.01, 0.141), SolveRequest.parse("mortar"), comm=MPI.COMM_SELF
+    )[1].to_json()
 
 
 def test_exact_formulas_against_johnson() -> None:
@@ -66,7 +68,9 @@ def test_profile_matches_exact_on_coarse_graded_mesh(mortar_finest: dict) -> Non
 
 
 def test_active_set_iterations_bounded(multiplier_method: str) -> None:
-    sol, data = run_case("hertz", _graded(0.02, 0.2), multiplier_method, comm=MPI.COMM_SELF)
+    sol, data = run_case(
+        "hertz", _graded(0.02, 0.2), SolveRequest.parse(multiplier_method), comm=MPI.COMM_SELF
+    )
     data = data.to_json()
     assert data["iterations"] <= 4
     hist = data["active_set"]
@@ -118,17 +122,24 @@ def test_lcp_kernel_on_a_small_m_matrix() -> None:
 
 def test_pulling_load_is_a_clear_error() -> None:
     with pytest.raises(SingularSystemError, match="pulls the bodies apart"):
-        run_case("blocks", BlockParams(p=-50.0, size1=0.5, size2=0.5), "mortar", comm=MPI.COMM_SELF)
+        run_case(
+            "blocks",
+            BlockParams(p=-50.0, size1=0.5, size2=0.5),
+            SolveRequest.parse("mortar"),
+            comm=MPI.COMM_SELF,
+        )
     # A negative Hertz load has no Hertz solution: rejected as input.
     with pytest.raises(InputError, match="P must be a positive"):
-        run_case("hertz", HertzParams(P=-100.0), "mortar", comm=MPI.COMM_SELF)
+        run_case("hertz", HertzParams(P=-100.0), SolveRequest.parse("mortar"), comm=MPI.COMM_SELF)
 
 
 @pytest.mark.parametrize("preset", ["S1", "S4"])
 def test_block_scenes_still_one_iteration(preset: str) -> None:
     from contactfx.scenes import BLOCK_SCENES
 
-    _, data = run_case("blocks", BLOCK_SCENES[preset], "mortar", comm=MPI.COMM_SELF)
+    _, data = run_case(
+        "blocks", BLOCK_SCENES[preset], SolveRequest.parse("mortar"), comm=MPI.COMM_SELF
+    )
     data = data.to_json()
     assert data["iterations"] == 1
     assert data["active_nodes"] == data["multipliers"]

@@ -14,7 +14,7 @@ import pytest
 from conftest import ROOT, cli, run_cli
 from mpi4py import MPI
 
-from contactfx import load_scene_file
+from contactfx import SolveRequest, load_scene_file
 from contactfx.api import run_case, run_scene
 from contactfx.errors import InputError
 from contactfx.results.interface import u_at_points
@@ -47,14 +47,14 @@ def _settlement(sol) -> float:
 def test_plane_stress_blocks_settle_by_p_h_over_e(method: str) -> None:
     """Plane stress: sigma_zz = 0, eps_yy = -p/E, the top moves by p (h1/E1 + h2/E2)."""
     params = replace(S4 if method == "mortar" else MATCHING, model=Model.PLANE_STRESS)
-    sol, record = run_case("blocks", params, method, comm=MPI.COMM_SELF)
+    sol, record = run_case("blocks", params, SolveRequest.parse(method), comm=MPI.COMM_SELF)
     assert record.to_json()["params"]["model"] == "plane_stress"
     exact = -params.p * (params.h1 / params.E1 + params.h2 / params.E2)
     assert _settlement(sol) == pytest.approx(exact, rel=1e-8)
     assert max(body_stress_deviation(sol, -params.p).values()) < 1e-8
     # The plane-strain settlement is (1 - nu^2) times smaller: the model is really switched.
     strain_params = replace(params, model=Model.PLANE_STRAIN)
-    strain, _ = run_case("blocks", strain_params, method, comm=MPI.COMM_SELF)
+    strain, _ = run_case("blocks", strain_params, SolveRequest.parse(method), comm=MPI.COMM_SELF)
     assert _settlement(strain) == pytest.approx(exact * (1 - params.nu1**2), rel=1e-8)
 
 
@@ -72,7 +72,9 @@ AXI_METHODS = [
 def test_axisymmetric_patch_test(method: str, options: dict) -> None:
     """Two stacked cylinders under uniform p: u_r = nu p r / E, u_y linear, exact in Q1."""
     params = replace(MATCHING, model=Model.AXISYMMETRIC)
-    sol, record = run_case("blocks", params, method, comm=MPI.COMM_SELF, **options)
+    sol, record = run_case(
+        "blocks", params, SolveRequest.parse(method, **options), comm=MPI.COMM_SELF
+    )
     data = record.to_json()
     # The force is the total over the turn: p pi r^2.
     force = params.p * np.pi * (params.l2 / 2) ** 2
@@ -91,7 +93,12 @@ def test_axisymmetric_patch_test(method: str, options: dict) -> None:
 
 def test_axisymmetric_mortar_patch_test_non_matching() -> None:
     """S4's non-matching, graded meshes: segment-based mortar stays exact in axisymmetric."""
-    sol, _ = run_case("blocks", replace(S4, model=Model.AXISYMMETRIC), "mortar", comm=MPI.COMM_SELF)
+    sol, _ = run_case(
+        "blocks",
+        replace(S4, model=Model.AXISYMMETRIC),
+        SolveRequest.parse("mortar"),
+        comm=MPI.COMM_SELF,
+    )
     assert max(body_stress_deviation(sol, -S4.p).values()) < 1e-8
 
 
@@ -99,7 +106,7 @@ def test_axisymmetric_mortar_patch_test_non_matching() -> None:
 def sphere() -> dict:
     """The sphere on a block (tests/scenes/axi_sphere.toml, 2232 cells), mortar."""
     scene = load_scene_file(SCENES / "axi_sphere.toml", MPI.COMM_SELF)
-    return run_scene(scene, "mortar")[1].to_json()
+    return run_scene(scene, SolveRequest.parse("mortar"))[1].to_json()
 
 
 def test_axisymmetric_sphere_on_a_block_against_3d_hertz(sphere: dict) -> None:
@@ -123,7 +130,7 @@ def test_axisymmetric_sphere_on_a_block_against_3d_hertz(sphere: dict) -> None:
 def test_axisymmetric_flat_punch_against_boussinesq(method: str) -> None:
     """A rigid flat punch: p(r) = P / (2 pi a sqrt(a^2 - r^2)) within 2 % at r <= 0.7 a."""
     scene = load_scene_file(SCENES / "axi_punch.toml", MPI.COMM_SELF)
-    data = run_scene(scene, method)[1].to_json()
+    data = run_scene(scene, SolveRequest.parse(method))[1].to_json()
     pair = data["contacts"][0]
     load = abs(pair["force"][1])
     x = np.array(pair["interface"]["x"])
@@ -160,7 +167,9 @@ def test_sigma_zz_of_each_model() -> None:
     """fields.pvtu's sigma_zz: nu (sxx + syy) in plane strain, 0 in plane stress, sigma_theta."""
     coarse = replace(BLOCK_SCENES["S1"], size1=0.5, size2=0.5)
     for model in Model:
-        sol, _ = run_case("blocks", replace(coarse, model=model), "mortar", comm=MPI.COMM_SELF)
+        sol, _ = run_case(
+            "blocks", replace(coarse, model=model), SolveRequest.parse("mortar"), comm=MPI.COMM_SELF
+        )
         s = sigma_field(sol).x.array.reshape(-1, 4)
         szz = sigma_zz_field(sol).x.array
         if model is Model.PLANE_STRAIN:

@@ -14,7 +14,14 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from contactfx import HertzReference, Obstacle, load_scene_file, run_scene, scene_from_gmsh
+from contactfx import (
+    HertzReference,
+    Obstacle,
+    SolveRequest,
+    load_scene_file,
+    run_scene,
+    scene_from_gmsh,
+)
 from contactfx.errors import SingularSystemError
 from contactfx.results.interface import u_at_points
 from contactfx.results.references import hertz_summary
@@ -45,7 +52,7 @@ def test_rigid_floor_patch_test_is_exact(floor: Scene, method: str, options: dic
     """sigma = -p I in the block and the pressure p on the floor, to 1e-8 of p (measured
     2e-11 to 4e-11 with every multiplier method: the floor is straight, so all of them are
     exact); the force on the floor is the load, along the floor's normal."""
-    _, data = run_scene(floor, method, **options)
+    _, data = run_scene(floor, SolveRequest.parse(method, **options))
     data = data.to_json()
     assert data["patch"]["max"] < 1e-8, data["patch"]
     c = data["contacts"][0]
@@ -60,7 +67,7 @@ def test_rigid_floor_penalty_error_is_its_penetration(floor: Scene) -> None:
     """Penalty leaves the uniform penetration p / eps (the independent reference, to 1e-6),
     which the pinned corner (held at the exact, unpenetrated displacement) resists: the
     block's stress error that this causes is pinned as a regression lock."""
-    _, data = run_scene(floor, "penalty")
+    _, data = run_scene(floor, SolveRequest.parse("penalty"))
     data = data.to_json()
     assert data["penetration"] == pytest.approx(10.0 / data["penalty"], rel=1e-6)
     # Regression lock (measured 2.8697e-4 on rigid_floor.toml's mesh with the default penalty;
@@ -78,7 +85,7 @@ def test_pinned_contact_node_is_not_singular(floor: Scene) -> None:
         replace(floor, dirichlet=(Dirichlet("x0", ux=0.0, uy=0.0),), curve_bodies={})
     )
     for method, exact_pressure in (("nts", True), ("mortar", False)):
-        _, data = run_scene(pinned, method)
+        _, data = run_scene(pinned, SolveRequest.parse(method))
         data = data.to_json()
         patch = data["patch"]
         assert patch["bodies"]["block"] < 1e-8, (method, patch)
@@ -90,7 +97,7 @@ def test_pinned_contact_node_is_not_singular(floor: Scene) -> None:
 
 def indenter_hertz(scene: Scene, method: str, options: dict) -> dict:
     """Solve the rigid indenter; Hertz's a, p0, L2 with the line load P that it carries."""
-    sol, data = run_scene(scene, method, **options)
+    sol, data = run_scene(scene, SolveRequest.parse(method, **options))
     data = data.to_json()
     c = data["contacts"][0]
     assert c["passive"] == "indenter" and c["obstacle"]["shape"] == "circle"
@@ -159,7 +166,9 @@ def test_flat_punch_matches_sadowsky(method: str, options: dict, l1: float, rele
     released (its gap opens by 4e-6 while the edge node takes 338 against NTS's 229); NTS and
     dual mortar keep the whole face closed. The punch carries no horizontal force (a flat
     face), and nothing beyond its edge."""
-    _, data = run_scene(load_scene_file(DEMO_SCENES / "rigid_punch.toml"), method, **options)
+    _, data = run_scene(
+        load_scene_file(DEMO_SCENES / "rigid_punch.toml"), SolveRequest.parse(method, **options)
+    )
     data = data.to_json()
     interior, l1_error = sadowsky_errors(data)
     assert interior < 0.01, interior
@@ -174,8 +183,10 @@ def test_flat_punch_matches_sadowsky(method: str, options: dict, l1: float, rele
 def test_flat_punch_converges_to_sadowsky() -> None:
     """Halving every mesh size: the interior error halves, L1 drops (sqrt(h) at the edge)."""
     path = DEMO_SCENES / "rigid_punch.toml"
-    coarse = sadowsky_errors(run_scene(load_scene_file(path, size_factor=2.0), "nts")[1].to_json())
-    fine = sadowsky_errors(run_scene(load_scene_file(path), "nts")[1].to_json())
+    coarse = sadowsky_errors(
+        run_scene(load_scene_file(path, size_factor=2.0), SolveRequest.parse("nts"))[1].to_json()
+    )
+    fine = sadowsky_errors(run_scene(load_scene_file(path), SolveRequest.parse("nts"))[1].to_json())
     assert fine[0] < 0.6 * coarse[0] and fine[1] < 0.85 * coarse[1], (coarse, fine)
 
 
@@ -194,13 +205,13 @@ def test_block_resting_on_a_rigid_floor_is_held() -> None:
     }
     scene = scene_from_gmsh(path, obstacles=[floor], **kwargs)
     for method in ("nts", "mortar"):
-        _, data = run_scene(scene, method)
+        _, data = run_scene(scene, SolveRequest.parse(method))
         data = data.to_json()
         assert data["patch"]["max"] < 1e-8, data["patch"]
         assert data["contacts"][0]["force_passive"][1] == pytest.approx(-40.0, rel=1e-10)
     wall = Obstacle("wall", "plane", "side", point=(20.0, 0.0), normal=(-1.0, 0.0))
     with pytest.raises(SingularSystemError, match="translation along y") as err:
-        run_scene(scene_from_gmsh(path, obstacles=[wall], **kwargs), "nts")
+        run_scene(scene_from_gmsh(path, obstacles=[wall], **kwargs), SolveRequest.parse("nts"))
     assert "before the first solve" in str(err.value) and "[[obstacle]]" in str(err.value)
 
 
@@ -213,9 +224,9 @@ def test_obstacle_and_body_pair_together_equal_a_roller() -> None:
         replace(roller, dirichlet=roller.dirichlet[:1], obstacles=(floor,), curve_bodies={})
     )
     for method in ("nts", "mortar"):
-        sol_r, data_r = run_scene(roller, method)
+        sol_r, data_r = run_scene(roller, SolveRequest.parse(method))
         data_r = data_r.to_json()
-        sol_f, data_f = run_scene(scene, method)
+        sol_f, data_f = run_scene(scene, SolveRequest.parse(method))
         data_f = data_f.to_json()
         ur, uf = u_at_points(sol_r), u_at_points(sol_f)
         assert np.abs(uf[:, 2:] - ur[:, 2:]).max() < 1e-10 * np.abs(ur[:, 2:]).max()
@@ -238,8 +249,8 @@ def test_two_obstacles_on_one_body_balance(indenter: Scene) -> None:
             curve_bodies={},
         )
     )
-    sol_r, _ = run_scene(indenter, "mortar")
-    sol, data = run_scene(scene, "mortar")
+    sol_r, _ = run_scene(indenter, SolveRequest.parse("mortar"))
+    sol, data = run_scene(scene, SolveRequest.parse("mortar"))
     data = data.to_json()
     top, bottom = data["contacts"]
     assert (top["passive"], bottom["passive"]) == ("indenter", "floor")
@@ -250,8 +261,8 @@ def test_two_obstacles_on_one_body_balance(indenter: Scene) -> None:
 
 def test_coarse_predictor_carries_the_obstacles(indenter: Scene) -> None:
     """The coarse predictor remeshes the .geo with the obstacle: same converged answer."""
-    sol_a, _ = run_scene(indenter, "mortar", predictor="none")
-    sol_b, data_b = run_scene(indenter, "mortar", predictor="coarse")
+    sol_a, _ = run_scene(indenter, SolveRequest.parse("mortar", predictor="none"))
+    sol_b, data_b = run_scene(indenter, SolveRequest.parse("mortar", predictor="coarse"))
     data_b = data_b.to_json()
     assert "predictor" in data_b["times"]
     ua, ub = u_at_points(sol_a), u_at_points(sol_b)

@@ -13,6 +13,7 @@ import pytest
 from conftest import cli
 from mpi4py import MPI
 
+from contactfx import SolveRequest
 from contactfx.api import run_case
 from contactfx.methods.penalty import DEFAULT_FACTOR, penetration
 from contactfx.results.interface import u_at_points
@@ -28,7 +29,9 @@ HERTZ = HertzParams(refine=0.1)
 def test_patch_test_uniform_penetration(active: int) -> None:
     # Exact solution: sigma_yy = -p everywhere, pressure p, and a uniform penetration p / eps.
     eps = 1e7
-    sol, data = run_case("blocks", S4, "penalty", active=active, penalty=eps, comm=MPI.COMM_SELF)
+    sol, data = run_case(
+        "blocks", S4, SolveRequest.parse("penalty", penalty=eps), active=active, comm=MPI.COMM_SELF
+    )
     data = data.to_json()
     p = S4.p
     err = patch_errors(data["interface"], p)
@@ -43,10 +46,12 @@ def test_patch_test_uniform_penetration(active: int) -> None:
 def test_hertz_converges_to_mortar_like_one_over_eps() -> None:
     # The penalty solution differs from the Lagrange (mortar) one on the same mesh by O(1/eps)
     # once the contact zone is settled: ten times eps, a tenth of the difference.
-    ref, _ = run_case("hertz", HERTZ, "mortar", comm=MPI.COMM_SELF)
+    ref, _ = run_case("hertz", HERTZ, SolveRequest.parse("mortar"), comm=MPI.COMM_SELF)
     diffs = []
     for eps in (1e7, 1e8, 1e9):  # about 70, 700, 7000 E / h on this mesh
-        sol, data = run_case("hertz", HERTZ, "penalty", penalty=eps, comm=MPI.COMM_SELF)
+        sol, data = run_case(
+            "hertz", HERTZ, SolveRequest.parse("penalty", penalty=eps), comm=MPI.COMM_SELF
+        )
         data = data.to_json()
         assert data["contact_force"] == pytest.approx(HERTZ.P / 2, rel=1e-9)
         assert np.array_equal(sol.layout.x, ref.layout.x)
@@ -59,9 +64,13 @@ def test_hertz_converges_to_mortar_like_one_over_eps() -> None:
 
 def test_small_penalty_spreads_the_contact() -> None:
     # A soft penalty lets the cylinder sink in: more nodes carry load, the peak drops.
-    stiff, d_stiff = run_case("hertz", HERTZ, "penalty", penalty=1e8, comm=MPI.COMM_SELF)
+    stiff, d_stiff = run_case(
+        "hertz", HERTZ, SolveRequest.parse("penalty", penalty=1e8), comm=MPI.COMM_SELF
+    )
     d_stiff = d_stiff.to_json()
-    soft, d_soft = run_case("hertz", HERTZ, "penalty", penalty=1e3, comm=MPI.COMM_SELF)
+    soft, d_soft = run_case(
+        "hertz", HERTZ, SolveRequest.parse("penalty", penalty=1e3), comm=MPI.COMM_SELF
+    )
     d_soft = d_soft.to_json()
     assert soft.active.sum() > stiff.active.sum()
     assert d_soft["hertz"]["p0"] < 0.8 * d_stiff["hertz"]["p0"]
@@ -77,7 +86,7 @@ def test_cli_json_has_penalty_and_penetration(tmp_path: Path) -> None:
     assert data["method"] == "penalty"
     # Default: DEFAULT_FACTOR * E_max / h, h the median contact weight of the code's own
     # multiplier layout (the mortar weights: about the active element size).
-    sol, _ = run_case("blocks", S4, "penalty", comm=MPI.COMM_SELF)
+    sol, _ = run_case("blocks", S4, SolveRequest.parse("penalty"), comm=MPI.COMM_SELF)
     h = float(np.median(sol.layout.weights))
     assert data["penalty"] == pytest.approx(DEFAULT_FACTOR * max(S4.E1, S4.E2) / h, rel=1e-12)
     assert data["penetration"] == pytest.approx(S4.p / data["penalty"], rel=1e-8)
@@ -86,7 +95,7 @@ def test_cli_json_has_penalty_and_penetration(tmp_path: Path) -> None:
 def test_default_penalty_penetration_is_load_over_stiffness() -> None:
     """The default eps (1e3 E_max / h) carries the uniform S4 pressure with the uniform
     penetration p / eps, measured on the displacement field itself (not on the gap)."""
-    sol, data = run_case("blocks", S4, "penalty", comm=MPI.COMM_SELF)
+    sol, data = run_case("blocks", S4, SolveRequest.parse("penalty"), comm=MPI.COMM_SELF)
     data = data.to_json()
     eps = data["penalty"]
     # Jump of u_y across the interface at the multiplier nodes (x sorted, both bodies).

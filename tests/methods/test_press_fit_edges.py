@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contactfx import run_scene
+from contactfx import SolveRequest, run_scene
 from contactfx.results.interface import pair_interface
 from contactfx.scenes.gmsh_io import scene_from_parts
 from contactfx.scenes.scene_file import parse_scene_file
@@ -25,9 +25,9 @@ PLACEMENTS = [(0.0, 0.3), (0.5, 0.72), (0.25, 0.95)]
 METHODS = [
     ("mortar", "standard"),
     ("mortar", "dual"),
-    ("sts", None),
-    ("nts", None),
-    ("penalty", None),
+    ("sts", "standard"),
+    ("nts", "standard"),
+    ("penalty", "standard"),
 ]
 H = 0.5  # the hub's half length
 
@@ -49,7 +49,7 @@ def scene(request, tmp_path_factory):
 
 @pytest.mark.parametrize("method, basis", METHODS)
 def test_edges_agree_and_no_node_released_inside(scene, method, basis):
-    sol, _ = run_scene(scene, method, **({} if basis is None else {"basis": basis}))
+    sol, _ = run_scene(scene, SolveRequest.parse(method, basis=basis))
     it = pair_interface(sol, 0)
     y, p = np.array(it["y"]), np.array(it["pressure"])
     active = np.array(it["active"])

@@ -20,7 +20,7 @@ from conftest import cli
 from mpi4py import MPI
 
 from contactfx import solve
-from contactfx.api import run_case
+from contactfx.api import run_case, run_scene
 from contactfx.contact import Kernel
 from contactfx.errors import InputError
 from contactfx.options import (
@@ -48,7 +48,10 @@ def test_penalty_on_nts_and_sts_passes_the_patch_test(discretization: str) -> No
     """Uniform pressure p carried with the uniform penetration p / eps, as on mortar."""
     eps, p = 1e7, MATCHING.p
     sol, run = run_case(
-        "blocks", MATCHING, discretization, enforcement="penalty", penalty=eps, comm=MPI.COMM_SELF
+        "blocks",
+        MATCHING,
+        SolveRequest.parse(discretization, enforcement="penalty", penalty=eps),
+        comm=MPI.COMM_SELF,
     )
     data = run.to_json()
     assert (data["method"], data["discretization"], data["enforcement"]) == (
@@ -66,11 +69,14 @@ def test_penalty_on_nts_and_sts_converges_to_the_multipliers_like_one_over_eps(
     discretization: str,
 ) -> None:
     """Ten times eps, a tenth of the distance to the same discretization's multipliers."""
-    ref, _ = run_case("hertz", HERTZ, discretization, comm=MPI.COMM_SELF)
+    ref, _ = run_case("hertz", HERTZ, SolveRequest.parse(discretization), comm=MPI.COMM_SELF)
     diffs = []
     for eps in (1e7, 1e8, 1e9):
         sol, _ = run_case(
-            "hertz", HERTZ, discretization, enforcement="penalty", penalty=eps, comm=MPI.COMM_SELF
+            "hertz",
+            HERTZ,
+            SolveRequest.parse(discretization, enforcement="penalty", penalty=eps),
+            comm=MPI.COMM_SELF,
         )
         assert np.array_equal(sol.active, ref.active)
         diffs.append(np.max(np.abs(sol.pressure - ref.pressure)) / np.max(ref.pressure))
@@ -137,7 +143,7 @@ def test_the_alias_table() -> None:
 
 
 def test_a_request_travels_alone() -> None:
-    """solve takes a ready request, but no option beside it (it would be ignored)."""
+    """solve takes a ready request but no option beside it; run_scene, run_case a request only."""
     scene = build_scene("blocks", MATCHING, comm=MPI.COMM_SELF)
     request = SolveRequest.parse("nts", enforcement="penalty", penalty=1e7)
     sol = solve(scene, request)
@@ -145,8 +151,11 @@ def test_a_request_travels_alone() -> None:
     assert sol.penalty.eps == 1e7
     with pytest.raises(InputError, match="beside a SolveRequest"):
         solve(scene, request, max_iterations=3)
-    with pytest.raises(InputError, match="beside a SolveRequest"):
-        run_case("blocks", MATCHING, request, comm=MPI.COMM_SELF, solver="mumps")
+    # run_scene and run_case take the request only: a method's name is refused at once.
+    with pytest.raises(InputError, match="expected a SolveRequest, not 'nts'"):
+        run_case("blocks", MATCHING, "nts", comm=MPI.COMM_SELF)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"SolveRequest\.parse"):
+        run_scene(scene, "nts")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="unknown solve option tolerance"):
         solve(scene, "nts", tolerance=1e-3)  # type: ignore[call-arg]
 

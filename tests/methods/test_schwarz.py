@@ -26,9 +26,9 @@ def _arr(data: dict, key: str) -> np.ndarray:
 @pytest.fixture(scope="module")
 def s1_pair() -> tuple[dict, dict]:
     """S1 solved by the mortar multipliers and by Schwarz (default: Aitken from 0.5)."""
-    _, mortar = run_case("blocks", BLOCK_SCENES["S1"], "mortar")
+    _, mortar = run_case("blocks", BLOCK_SCENES["S1"], SolveRequest.parse("mortar"))
     mortar = mortar.to_json()
-    _, schwarz = run_case("blocks", BLOCK_SCENES["S1"], "schwarz")
+    _, schwarz = run_case("blocks", BLOCK_SCENES["S1"], SolveRequest.parse("schwarz"))
     schwarz = schwarz.to_json()
     return mortar, schwarz
 
@@ -63,10 +63,10 @@ def test_s1_summary_reports_iterations_and_force(s1_pair) -> None:
 def test_s2_nonmatching_equals_mortar_with_b2_slave(active: int) -> None:
     """Non-matching S2: displacements equal those of mortar with B2 active, either report."""
     params = BLOCK_SCENES["S2"]
-    _m_sol, mortar = run_case("blocks", params, "mortar", active=active)
+    _m_sol, mortar = run_case("blocks", params, SolveRequest.parse("mortar"), active=active)
     mortar = mortar.to_json()
-    ref_sol, _ = run_case("blocks", params, "mortar", active=2)
-    s_sol, schwarz = run_case("blocks", params, "schwarz", active=active)
+    ref_sol, _ = run_case("blocks", params, SolveRequest.parse("mortar"), active=2)
+    s_sol, schwarz = run_case("blocks", params, SolveRequest.parse("schwarz"), active=active)
     schwarz = schwarz.to_json()
     u_ref, u = u_at_points(ref_sol), u_at_points(s_sol)
     scale = np.abs(u_ref[:, 2:]).max()
@@ -89,7 +89,7 @@ def test_s2_nonmatching_equals_mortar_with_b2_slave(active: int) -> None:
 def test_s4_patch_test() -> None:
     """S4 (non-matching, graded): sigma_yy = -p in every cell and pressure = p."""
     params = BLOCK_SCENES["S4"]
-    sol, data = run_case("blocks", params, "schwarz")
+    sol, data = run_case("blocks", params, SolveRequest.parse("schwarz"))
     data = data.to_json()
     dev = body_stress_deviation(sol, -params.p)
     # Measured 1.3e-11 in both bodies; the iteration tolerance is 1e-8.
@@ -102,10 +102,12 @@ def test_aitken_needs_fewer_iterations_than_fixed_relaxation() -> None:
     """Same material (S1): Aitken 14 iterations, fixed 0.5 needs 28 (measured)."""
     params = BLOCK_SCENES["S1"]
     _, fixed = run_case(
-        "blocks", params, "schwarz", schwarz=SchwarzOptions(relaxation=0.5, aitken=False)
+        "blocks",
+        params,
+        SolveRequest.parse("schwarz", schwarz=SchwarzOptions(relaxation=0.5, aitken=False)),
     )
     fixed = fixed.to_json()
-    _, aitken = run_case("blocks", params, "schwarz")
+    _, aitken = run_case("blocks", params, SolveRequest.parse("schwarz"))
     aitken = aitken.to_json()
     assert aitken["iterations"] < 0.75 * fixed["iterations"]
 
@@ -115,8 +117,9 @@ def test_no_relaxation_converges_with_the_stiffer_body_neumann() -> None:
     _, data = run_case(
         "blocks",
         BLOCK_SCENES["S3"],
-        "schwarz",
-        schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=15),
+        SolveRequest.parse(
+            "schwarz", schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=15)
+        ),
     )
     data = data.to_json()
     assert data["iterations"] <= 10
@@ -128,8 +131,9 @@ def test_no_relaxation_same_material_fails_at_the_limit() -> None:
         run_case(
             "blocks",
             BLOCK_SCENES["S1"],
-            "schwarz",
-            schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=30),
+            SolveRequest.parse(
+                "schwarz", schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=30)
+            ),
         )
     last = err.value.history[-1]["residual"]
     # Measured: the relative residual stays near 3e-3 instead of falling below 1e-8.
@@ -143,15 +147,16 @@ def test_stiff_top_on_soft_base_diverges() -> None:
         run_case(
             "blocks",
             params,
-            "schwarz",
-            schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=50),
+            SolveRequest.parse(
+                "schwarz", schwarz=SchwarzOptions(relaxation=1.0, aitken=False, max_iterations=50)
+            ),
         )
 
 
 def test_logs_every_iteration(caplog) -> None:
     """One INFO line per iteration with the residual and the relaxation factor."""
     with caplog.at_level(logging.INFO, logger="contactfx"):
-        _, data = run_case("blocks", BLOCK_SCENES["S4"], "schwarz")
+        _, data = run_case("blocks", BLOCK_SCENES["S4"], SolveRequest.parse("schwarz"))
         data = data.to_json()
     lines = [r.getMessage() for r in caplog.records if r.getMessage().startswith("schwarz ")]
     its = [m for m in lines if "interface residual" in m and "relaxation" in m]

@@ -23,7 +23,7 @@ from conftest import ROOT
 from dolfinx import fem, mesh
 from mpi4py import MPI
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 from contactfx.discretize import elasticity
 from contactfx.discretize.thermal import (
     axisymmetric_thermal_load,
@@ -57,7 +57,7 @@ def test_thermal_stress_by_hand() -> None:
 
 
 def _walls(path: Path, method: str) -> tuple[dict, np.ndarray]:
-    sol, run = run_scene(load_scene_file(path), method)
+    sol, run = run_scene(load_scene_file(path), SolveRequest.parse(method))
     data = run.to_json()
     p = np.concatenate([sol.pressure[pv.rows] for pv in sol.pairs])
     return data, p
@@ -97,7 +97,7 @@ def test_heated_block_between_walls_plane_stress(tmp_path: Path) -> None:
 def test_shrink_fit_drawn_overlapping_matches_lame() -> None:
     """interference = true: the drawn overlap resolved, every node active, the mean
     pressure within 1 % of Lame (measured +0.034 %), the initial overlap the drawn delta."""
-    sol, run = run_scene(load_scene_file(SCENES / "shrink_fit.toml"), "mortar")
+    sol, run = run_scene(load_scene_file(SCENES / "shrink_fit.toml"), SolveRequest.parse("mortar"))
     data = run.to_json()
     (lame,) = data["lame"]
     assert (lame["inner"], lame["outer"], lame["model"]) == ("shaft", "hub", "plane_strain")
@@ -112,7 +112,9 @@ def test_shrink_fit_drawn_overlapping_matches_lame() -> None:
 
 def test_shrink_fit_prescribed_interference_matches_lame() -> None:
     """interference = D on rings drawn touching: the same fit, to 1 % (measured +0.11 %)."""
-    sol, run = run_scene(load_scene_file(SCENES / "shrink_fit_touching.toml"), "mortar")
+    sol, run = run_scene(
+        load_scene_file(SCENES / "shrink_fit_touching.toml"), SolveRequest.parse("mortar")
+    )
     (lame,) = run.to_json()["lame"]
     assert lame["delta"] == 0.002 and lame["error"] < 0.01, lame
     assert sol.active[sol.pairs[0].rows].all()
@@ -220,7 +222,7 @@ def test_heated_disk_between_plates_axisymmetric(tmp_path: Path, method: str) ->
     (= -1), sigma_rr = sigma_theta = 0, u_r = (1 + nu) alpha dT r (a patch test: exact)."""
     (tmp_path / "disk.geo").write_text(AXI_DISK)
     (tmp_path / "disk.toml").write_text(AXI_DISK_SCENE)
-    sol, run = run_scene(load_scene_file(tmp_path / "disk.toml"), method)
+    sol, run = run_scene(load_scene_file(tmp_path / "disk.toml"), SolveRequest.parse(method))
     assert run.patch is not None and run.patch.max < 1e-8, run.patch
     force = sum(np.asarray(c.force) for c in run.contacts if c.passive == "floor")
     # The floor pushes the disk up with E alpha dT over the disc's area pi r^2 (a total

@@ -103,7 +103,9 @@ def blocks(scene: str, method: str, active: int, solver: str) -> Callable[[], An
     """The paper's block scene `scene`: u, interface x and pressure."""
 
     def run() -> tuple[Solution, Arrays]:
-        sol, data = run_case("blocks", BLOCK_SCENES[scene], method, active=active, solver=solver)
+        sol, data = run_case(
+            "blocks", BLOCK_SCENES[scene], SolveRequest.parse(method, solver=solver), active=active
+        )
         data = data.to_json()
         itf = data["interface"]
         return sol, {**u_split(sol), "x": np.asarray(itf["x"]), "p": np.asarray(itf["pressure"])}
@@ -125,7 +127,7 @@ for _scene, _method, _active, _solver in (
 
 def schwarz_s2() -> tuple[Solution, Arrays]:
     """Schwarz on S2 (active body 1): u, pressure and the iteration count."""
-    sol, data = run_case("blocks", BLOCK_SCENES["S2"], "schwarz", active=1)
+    sol, data = run_case("blocks", BLOCK_SCENES["S2"], SolveRequest.parse("schwarz"), active=1)
     data = data.to_json()
     p = np.asarray(data["interface"]["pressure"])
     return sol, {**u_split(sol), "p": p, "its": np.asarray(data["iterations"])}
@@ -141,7 +143,7 @@ def user_scene(path: Path, method: str) -> Callable[[], Any]:
     """A scene file: u, and every pair's arc length, pressure and sigma_nn (active side)."""
 
     def run() -> tuple[Solution, Arrays]:
-        sol, data = run_scene(load_scene_file(path), method)
+        sol, data = run_scene(load_scene_file(path), SolveRequest.parse(method))
         data = data.to_json()
         itf = [c["interface"] for c in data["contacts"]]
         snn = [v for i in itf for v in i["sigma_nn_active"]]
@@ -168,7 +170,7 @@ def obstacle(path: Path, method: str, basis: str) -> Callable[[], Any]:
     """A rigid-obstacle scene: u, pair 0's x and pressure, its force."""
 
     def run() -> tuple[Solution, Arrays]:
-        sol, data = run_scene(load_scene_file(path), method, basis=basis)
+        sol, data = run_scene(load_scene_file(path), SolveRequest.parse(method, basis=basis))
         data = data.to_json()
         c = data["contacts"][0]
         return sol, {
@@ -192,7 +194,7 @@ for _name, _path, _method, _basis in (
 
 def axisymmetric_sphere() -> tuple[Solution, Arrays]:
     """The axisymmetric sphere on a block (2 pi r in every integral): u, pressure, force."""
-    sol, data = run_scene(load_scene_file(SCENES / "axi_sphere.toml"), "mortar")
+    sol, data = run_scene(load_scene_file(SCENES / "axi_sphere.toml"), SolveRequest.parse("mortar"))
     data = data.to_json()
     c = data["contacts"][0]
     return sol, {
@@ -223,7 +225,7 @@ CASES["cli-stacked-blocks"] = Case(stacked_blocks, {"forces": Abs(1e-8 * 10.0 * 
 def hertz_graded() -> tuple[Solution, Arrays]:
     """The graded gmsh Hertz scene, mortar: the pressure profile and the Hertz measures."""
     params = HertzParams(refine=0.08, refine_edge=0.02, slope=0.2)
-    sol, d = run_case("hertz", params, "mortar")
+    sol, d = run_case("hertz", params, SolveRequest.parse("mortar"))
     d = d.to_json()
     h = d["hertz"]
     return sol, {
@@ -380,7 +382,7 @@ def estimate_hertz() -> tuple[Solution, Arrays]:
 
 def estimate_blocks() -> tuple[Solution, Arrays]:
     """Blocks S2 (non-matching meshes), mortar: the estimate and the cell indicators."""
-    sol, _ = run_case("blocks", BLOCK_SCENES["S2"], "mortar", active=2)
+    sol, _ = run_case("blocks", BLOCK_SCENES["S2"], SolveRequest.parse("mortar"), active=2)
     return sol, estimate_arrays(sol)
 
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from contactfx import ContactPair, load_scene_file, run_scene
+from contactfx import ContactPair, SolveRequest, load_scene_file, run_scene
 from contactfx.cli.solve import terminal_summary
 from contactfx.errors import InputError
 from contactfx.scenes import Dirichlet
@@ -41,7 +41,7 @@ def test_sphere_is_measured_from_the_axis_with_or_without_symmetric(tmp_path: Pa
     assert "symmetric = true\n" in text
     without = copy_scene(tmp_path, "axi_sphere", text.replace("symmetric = true\n", ""))
     runs = [
-        run_scene(load_scene_file(path, size_factor=2.0), "mortar")[1].hertz[0]
+        run_scene(load_scene_file(path, size_factor=2.0), SolveRequest.parse("mortar"))[1].hertz[0]
         for path in (SCENES / "axi_sphere.toml", without)
     ]
     for hz in runs:
@@ -71,7 +71,9 @@ def test_point_contact_needs_the_axisymmetric_model(tmp_path: Path) -> None:
         load_scene_file(copy_scene(tmp_path, "oring_axi", ring))
     sphere = (SCENES / "oring_axi.toml").read_text().replace('contact = "line"\n', "")
     with pytest.raises(InputError, match=r"stops at r = 9.5 \(a ring's contact: give contact"):
-        run_scene(load_scene_file(copy_scene(tmp_path, "oring_axi", sphere)), "mortar")
+        run_scene(
+            load_scene_file(copy_scene(tmp_path, "oring_axi", sphere)), SolveRequest.parse("mortar")
+        )
 
 
 @pytest.mark.serial
@@ -80,7 +82,7 @@ def test_oring_against_hertz_line_contact_per_unit_circumference() -> None:
     with the line load q = P / (2 pi r_c), E* = E / (1 - nu^2): a and p0 within 0.5 %
     (measured +0.48 %, +0.38 %; pinned with the L2 error 4.40 %). Before: `contact` was no
     key of a Hertz reference (refused)."""
-    _, run = run_scene(load_scene_file(SCENES / "oring_axi.toml"), "mortar")
+    _, run = run_scene(load_scene_file(SCENES / "oring_axi.toml"), SolveRequest.parse("mortar"))
     (hz,) = run.hertz
     force = run.contacts[0].axial_force
     assert hz.P == pytest.approx(abs(force), rel=1e-6)  # along the centre's normal
@@ -105,7 +107,7 @@ def hub_runs(tmp_path: Path) -> list:
     fine = geo.replace("nr = {6,", "nr = {12,").replace("ny = {30,", "ny = {60,")
     assert fine != geo
     paths = [SCENES / "long_hub_axi.toml", copy_scene(tmp_path, "long_hub_axi", geo=fine)]
-    return [run_scene(load_scene_file(p), "mortar")[1] for p in paths]
+    return [run_scene(load_scene_file(p), SolveRequest.parse("mortar"))[1] for p in paths]
 
 
 @pytest.mark.serial
@@ -144,11 +146,13 @@ def test_axisymmetric_forces_are_axial_and_per_radian() -> None:
     gives the axial force and the radial pressure's resultant per radian, which on the
     hub's cylindrical interface (r = b = 1, length 6) is -p_mean b L on the shaft. The
     terminal names them (before: `force (-474.0 * 2 pi, 0)`, a radial total over the turn)."""
-    _, sphere = run_scene(load_scene_file(SCENES / "axi_sphere.toml", size_factor=4.0), "mortar")
+    _, sphere = run_scene(
+        load_scene_file(SCENES / "axi_sphere.toml", size_factor=4.0), SolveRequest.parse("mortar")
+    )
     c = sphere.to_json()["contacts"][0]
     assert c["force"][0] is None and c["axial_force"] == pytest.approx(100.0, rel=1e-9)
     assert sphere.contact_force == pytest.approx(100.0, rel=1e-9)
-    _, run = run_scene(load_scene_file(SCENES / "long_hub_axi.toml"), "mortar")
+    _, run = run_scene(load_scene_file(SCENES / "long_hub_axi.toml"), SolveRequest.parse("mortar"))
     c = run.to_json()["contacts"][0]
     assert c["force"][0] is None and c["force_passive"][0] is None
     assert c["radial_force_per_radian"] == pytest.approx(-run.lame[0].p_mean * 1.0 * 6.0, rel=1e-9)
@@ -226,7 +230,7 @@ def test_python_scene_takes_probes() -> None:
         model="axisymmetric",
         probes=[probe],
     )
-    (value,) = run_scene(scene, "mortar")[1].probes
+    (value,) = run_scene(scene, SolveRequest.parse("mortar"))[1].probes
     assert value.value == pytest.approx(79.0059, rel=1e-3)
     with pytest.raises(InputError, match="type 'pressure' takes `at`"):
         Probe("pressure")

@@ -9,7 +9,7 @@ import pytest
 from conftest import ROOT
 from matplotlib.figure import Figure
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 from contactfx.results.figures import plot_pair, round_off_band
 from contactfx.scenes import Units
 
@@ -43,7 +43,9 @@ def test_patch_test_chart_is_flat_and_in_the_scenes_units(
 ) -> None:
     """The inclined patch test (pressure 10 everywhere, to 1e-9): no '1e-8+1e1' offset axis,
     limits +-5 % of the traction, and the axes say length/stress (the scene names no units)."""
-    _, run = run_scene(load_scene_file(SCENES / "inclined_patch.toml"), "mortar")
+    _, run = run_scene(
+        load_scene_file(SCENES / "inclined_patch.toml"), SolveRequest.parse("mortar")
+    )
     assert run.units == Units()
     ax, bx = chart_axes(run, tmp_path, monkeypatch)
     for a in (ax, bx):
@@ -62,7 +64,7 @@ def test_units_named_by_the_scene_file_reach_the_charts(
     (tmp_path / "inclined_patch.geo").write_text((SCENES / "inclined_patch.geo").read_text())
     scene_file = tmp_path / "s.toml"
     scene_file.write_text('units = { length = "mm", stress = "N/mm^2" }\n' + toml)
-    _, run = run_scene(load_scene_file(scene_file), "mortar")
+    _, run = run_scene(load_scene_file(scene_file), SolveRequest.parse("mortar"))
     assert run.units == Units("mm", "N/mm^2")
     ax, bx = chart_axes(run, tmp_path, monkeypatch)
     assert "N/mm^2" in ax.get_ylabel() and "(mm)" in bx.get_xlabel()

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 from contactfx.contact.geometry import Surface
 from contactfx.options import Method
 from contactfx.results.references import exact_pressure, hertz_summary
@@ -115,7 +115,9 @@ def test_full_model_l2_error_measured_from_the_true_centre(tmp_path: Path) -> No
     Measured: 0.013754 reported, 0.013756 from the true centre (the old nodal mean of s
     reported 0.362); on 0.02 | 0.06 and 0.03 | 0.12 meshes they agree to 2e-3 and 8e-3.
     """
-    _, run = run_scene(load_scene_file(graded_rotated_hertz(tmp_path, 0.01, 0.04)), "mortar")
+    _, run = run_scene(
+        load_scene_file(graded_rotated_hertz(tmp_path, 0.01, 0.04)), SolveRequest.parse("mortar")
+    )
     hz, itf = run.hertz[0], run.contacts[0].interface
     x, y, p = (np.asarray(itf[k], dtype=float) for k in ("x", "y", "pressure"))
     r = np.column_stack([x, y]) @ np.array([math.cos(math.pi / 6), math.sin(math.pi / 6)])

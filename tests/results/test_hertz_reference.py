@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
-from contactfx import load_scene_file, run_scene
+from contactfx import SolveRequest, load_scene_file, run_scene
 from contactfx.errors import InputError
 
 SCENES = ROOT / "tests" / "scenes"
@@ -36,7 +36,7 @@ def test_rotated_displacement_controlled_hertz_against_its_computed_load() -> No
     """P omitted: P is the pair's normal force; a, p0 and L2 match Hertz for that load."""
     scene = load_scene_file(SCENES / "rotated_hertz.toml")
     assert scene.references[0].P is None
-    _, data = run_scene(scene, "mortar")
+    _, data = run_scene(scene, SolveRequest.parse("mortar"))
     data = data.to_json()
     hz, force = data["hertz"], data["contacts"][0]["force"]
     # Full model, frictionless on a 30-degree flat block: the force is the rotated normal's.
@@ -55,8 +55,12 @@ def test_half_model_without_p_takes_twice_its_force(tmp_path: Path) -> None:
     """Symmetric: P = 2 x the half model's force along the centre's normal = the applied 100
     to 1e-5 (the centre's nodal normal is its end segment's, tilted by h/(2R) = 2e-4 rad:
     measured 99.99975), so the reference is the one with P = 100 given."""
-    given = run_scene(load_scene_file(SCENES / "two_cylinders.toml"), "mortar")[1].hertz[0]
-    computed = run_scene(load_scene_file(without_p(tmp_path, "two_cylinders")), "mortar")[1]
+    given = run_scene(load_scene_file(SCENES / "two_cylinders.toml"), SolveRequest.parse("mortar"))[
+        1
+    ].hertz[0]
+    computed = run_scene(
+        load_scene_file(without_p(tmp_path, "two_cylinders")), SolveRequest.parse("mortar")
+    )[1]
     hz = computed.hertz[0]
     assert hz.P == pytest.approx(100.0, rel=1e-5) and hz.P_source.startswith("computed")
     assert given.P == 100.0 and given.P_source == "given"

@@ -25,7 +25,7 @@ from conftest import ROOT
 from matplotlib.figure import Figure
 from mpi4py import MPI
 
-from contactfx import run_case
+from contactfx import SolveRequest, run_case
 from contactfx.results import RunSummary
 from contactfx.results.figures import plot_interface, plot_pair
 from contactfx.scenes import HertzParams
@@ -48,7 +48,9 @@ def l2_over_zone(x: np.ndarray, v: np.ndarray, a: float, p0: float) -> float:
 def hertz_levels() -> list[RunSummary]:
     """The Hertz summaries at study levels f = 2 and f = 1 (the default mesh)."""
     return [
-        run_case("hertz", hertz_at(HertzParams(), f), "mortar", comm=MPI.COMM_SELF)[1]
+        run_case(
+            "hertz", hertz_at(HertzParams(), f), SolveRequest.parse("mortar"), comm=MPI.COMM_SELF
+        )[1]
         for f in (2.0, 1.0)
     ]
 
@@ -85,7 +87,9 @@ def test_uniform_stress_is_resolved_exactly_in_the_contact_frame() -> None:
     """The patch test S4 (flat, non-matching): mortar's columns exact to round-off."""
     from contactfx.scenes import BLOCK_SCENES
 
-    _, data = run_case("blocks", BLOCK_SCENES["S4"], "mortar", comm=MPI.COMM_SELF)
+    _, data = run_case(
+        "blocks", BLOCK_SCENES["S4"], SolveRequest.parse("mortar"), comm=MPI.COMM_SELF
+    )
     data = data.to_json()
     for key, value in data["patch"]["pairs"][0].items():
         assert value < 1e-8, (key, value)
@@ -159,7 +163,9 @@ def test_frictionless_ring_fit_reports_no_shear() -> None:
     (the active side's end nodes) and 4e-7."""
     from contactfx import load_scene_file, run_scene
 
-    _, run = run_scene(load_scene_file(ROOT / "demos" / "scenes" / "shaft_hub.toml"), "mortar")
+    _, run = run_scene(
+        load_scene_file(ROOT / "demos" / "scenes" / "shaft_hub.toml"), SolveRequest.parse("mortar")
+    )
     itf = run.contacts[0].interface
     p = column(itf, "pressure").mean()
     for side in ("active", "passive"):

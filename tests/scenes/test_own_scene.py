@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, cli
 
-from contactfx import Scene, load_scene_file, run_scene, scene_from_gmsh
+from contactfx import Scene, SolveRequest, load_scene_file, run_scene, scene_from_gmsh
 from contactfx.errors import GeometryError, InputError, MeshError, SingularSystemError
 from contactfx.scenes import ContactPair, Dirichlet, Material, Pressure
 
@@ -32,7 +32,7 @@ def inclined(request: pytest.FixtureRequest) -> Scene:
 def test_inclined_patch_test_mortar_exact(inclined: Scene) -> None:
     """Mortar: pressure, sigma_nn = -p and sigma_nt = 0 on both sides, sigma = -p I in both
     bodies, to 1e-8 of p (measured 1.2e-9 to 1.5e-9, set by the point supports' values)."""
-    _, data = run_scene(inclined, "mortar")
+    _, data = run_scene(inclined, SolveRequest.parse("mortar"))
     data = data.to_json()
     patch = data["patch"]
     assert patch["max"] < 1e-8, patch
@@ -66,7 +66,7 @@ def test_inclined_patch_test_nts_sts_fail_by_their_known_size(
 ) -> None:
     """NTS and STS do not pass the patch test on non-matching meshes: errors of 14-43 % of p,
     each of a known size (to rel 1e-3) with body 2 or body 1 active."""
-    _, data = run_scene(inclined, method)
+    _, data = run_scene(inclined, SolveRequest.parse(method))
     data = data.to_json()
     scene_file = request.node.callspec.params["inclined"]
     assert data["patch"]["max"] == pytest.approx(KNOWN_INCLINED[scene_file, method], rel=1e-3)
@@ -75,7 +75,7 @@ def test_inclined_patch_test_nts_sts_fail_by_their_known_size(
 def test_two_cylinders_match_hertz() -> None:
     """R1 = 40, R2 = 60, dissimilar materials: a and p0 within 1 % of Hertz (R = 24)."""
     scene = load_scene_file(SCENES / "two_cylinders.toml")
-    _, data = run_scene(scene, "mortar")
+    _, data = run_scene(scene, SolveRequest.parse("mortar"))
     data = data.to_json()
     hz = data["hertz"]
     assert hz["a_exact"] == pytest.approx(1.1026159230931443, rel=1e-12)
@@ -87,7 +87,7 @@ def test_two_cylinders_match_hertz() -> None:
 def test_three_bodies_two_pairs_balance_and_hertz() -> None:
     """A cylinder between two blocks: each pair balances to 1e-8, carries P/2, and matches
     Hertz (a, p0 within 1 %)."""
-    _, data = run_scene(load_scene_file(THREE_BODIES), "mortar")
+    _, data = run_scene(load_scene_file(THREE_BODIES), SolveRequest.parse("mortar"))
     data = data.to_json()
     assert len(data["contacts"]) == 2
     for c in data["contacts"]:
@@ -102,7 +102,7 @@ def test_three_bodies_two_pairs_balance_and_hertz() -> None:
 @pytest.mark.parametrize("method", ["nts", "sts", "penalty"])
 def test_every_method_on_the_three_body_scene(method: str) -> None:
     """All methods run on several pairs at once and carry the load through both pairs."""
-    _, data = run_scene(load_scene_file(THREE_BODIES), method)
+    _, data = run_scene(load_scene_file(THREE_BODIES), SolveRequest.parse(method))
     data = data.to_json()
     assert len(data["contacts"]) == 2
     for c in data["contacts"]:
@@ -114,14 +114,16 @@ def test_schwarz_refuses_curved_pairs_clearly() -> None:
     """Schwarz iterates on u_y of a straight line: a curved pair gets a clear InputError."""
     scene = load_scene_file(SCENES / "two_cylinders.toml")
     with pytest.raises(InputError, match="straight horizontal"):
-        run_scene(scene, "schwarz")
+        run_scene(scene, SolveRequest.parse("schwarz"))
     with pytest.raises(InputError, match="two bodies with one contact pair"):
-        run_scene(load_scene_file(THREE_BODIES), "schwarz")
+        run_scene(load_scene_file(THREE_BODIES), SolveRequest.parse("schwarz"))
 
 
 def test_interface_along_the_normal_has_every_key() -> None:
     """contacts[k].interface holds x, y, s, pressure, gap and both sigma_nn, sigma_nt."""
-    _, data = run_scene(load_scene_file(SCENES / "two_cylinders.toml"), "mortar")
+    _, data = run_scene(
+        load_scene_file(SCENES / "two_cylinders.toml"), SolveRequest.parse("mortar")
+    )
     data = data.to_json()
     itf = data["contacts"][0]["interface"]
     keys = {
@@ -266,7 +268,7 @@ def test_from_gmsh_model_in_python() -> None:
         )
     finally:
         gmsh.finalize()
-    _, data = run_scene(scene, "mortar")
+    _, data = run_scene(scene, SolveRequest.parse("mortar"))
     data = data.to_json()
     assert data["contacts"][0]["force"][1] == pytest.approx(3.0, rel=1e-10)
 
@@ -301,7 +303,7 @@ def test_bad_scene_input(
     _blocks_geo(tmp_path / "b.geo", **geo_kw)
     path = _toml(tmp_path / "s.toml", "b.geo", **toml_kw)
     with pytest.raises(error, match=needle):
-        run_scene(load_scene_file(path), "mortar")
+        run_scene(load_scene_file(path), SolveRequest.parse("mortar"))
 
 
 def test_bad_scene_file_cli_one_line(tmp_path: Path) -> None:

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, cli
 
-from contactfx import Obstacle, load_scene_file, run_scene, scene_from_gmsh
+from contactfx import Obstacle, SolveRequest, load_scene_file, run_scene, scene_from_gmsh
 from contactfx.errors import GeometryError, InputError
 
 SCENES = ROOT / "tests" / "scenes"
@@ -40,9 +40,9 @@ def test_polyline_walked_the_wrong_way_says_to_reverse_it(tmp_path: Path) -> Non
     ends = [X0 - 10 * T, X0 + 10 * T]
     wrong = polyline_floor(tmp_path, [list(p) for p in ends])
     with pytest.raises(GeometryError, match="reverse its points"):
-        run_scene(load_scene_file(wrong), "mortar")
+        run_scene(load_scene_file(wrong), SolveRequest.parse("mortar"))
     right = polyline_floor(tmp_path, [list(p) for p in ends[::-1]])
-    _, run = run_scene(load_scene_file(right), "mortar")
+    _, run = run_scene(load_scene_file(right), SolveRequest.parse("mortar"))
     assert run.patch is not None and run.patch.max < 1e-8
 
 
@@ -81,7 +81,9 @@ def test_advice_names_the_python_classes_too() -> None:
     from contactfx.errors import SingularSystemError
 
     with pytest.raises(SingularSystemError) as err:
-        run_scene(load_scene_file(SCENES / "disk_between_plates.toml"), "mortar")
+        run_scene(
+            load_scene_file(SCENES / "disk_between_plates.toml"), SolveRequest.parse("mortar")
+        )
     assert "[[dirichlet]]" in str(err.value) and "Dirichlet in Python" in str(err.value)
 
 
