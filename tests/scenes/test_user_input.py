@@ -133,7 +133,7 @@ def test_load_paths_refuses_an_overflowed_system_in_one_line() -> None:
     first = replace(scene.bodies[0], material=Material(1e308, 0.3))
     scene = replace(scene, bodies=(first, *scene.bodies[1:]))
     with pytest.raises(InputError, match="overflows double precision"):
-        run_scene(scene, "mortar")
+        run_scene(scene, SolveRequest.parse("mortar"))
 
 
 @pytest.mark.serial
