@@ -18,7 +18,9 @@ def _toctree_entries(page: Path) -> list[str]:
     text = page.read_text()
     entries = []
     for block in re.findall(r"```\{toctree\}\n(.*?)```", text, re.S):
-        entries += [ln.strip() for ln in block.splitlines() if ln.strip() and not ln.startswith(":")]
+        entries += [
+            ln.strip() for ln in block.splitlines() if ln.strip() and not ln.startswith(":")
+        ]
     return entries
 
 
