@@ -16,6 +16,7 @@ from mpi4py import MPI
 from .errors import InputError
 from .methods.active_set import ActiveSetOptions
 from .methods.autosolve import prepare_solver
+from .methods.friction import refuse_friction
 from .methods.multipliers import solve_contact
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.solution import Solution
@@ -80,6 +81,7 @@ def solve_request(
     initial: Solution | None = None,
 ) -> Solution:
     """Run the method of `request` on `scene` (see `solve`)."""
+    refuse_friction(scene, request)
     timers = timers or Timers()
     aso = ActiveSetOptions(request.max_iterations)
     # The penalty and Schwarz modules are imported when they run (first-answer time of a

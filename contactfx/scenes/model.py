@@ -19,7 +19,7 @@ from mpi4py import MPI
 
 from ..errors import InputError, MeshError
 from ..meshes import GridLines
-from .fits import LameReference, check_interference, check_thermal
+from .fits import LameReference, check_friction, check_interference, check_thermal
 from .obstacle import Obstacle
 from .probe import Probe
 
@@ -98,15 +98,18 @@ class ContactPair:
     an interference fit drawn overlapping (the overlap is the fit, the solve resolves it);
     a number D > 0 for bodies drawn touching, with the overlap D prescribed along the normal
     (the gap g becomes g - D).
+    `mu`: Coulomb's friction coefficient (0, the default: frictionless, today's model exactly).
     """
 
     active: str
     passive: str
     interference: bool | float = False
+    mu: float = 0.0
 
     def __post_init__(self) -> None:
         where = f"contact '{self.active}' on '{self.passive}'"
         object.__setattr__(self, "interference", check_interference(self.interference, where))
+        object.__setattr__(self, "mu", check_friction(self.mu, where))
 
     @property
     def prescribed_overlap(self) -> float:

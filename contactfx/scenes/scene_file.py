@@ -138,6 +138,13 @@ def _interference(where: str, value: Any) -> bool | float:
     return d
 
 
+def _friction(where: str, value: Any) -> float:
+    mu = _number(where, value)
+    if mu < 0:
+        raise InputError(f"{where}: must be a number >= 0, 0 for frictionless (got {value!r})")
+    return mu
+
+
 def _material(body: str, table: Any) -> Material:
     e = _section(f"bodies.{body}", table, "bodies")
     thermal = {k: _number(f"bodies.{body}.{k}", e[k]) for k in ("alpha", "dT") if k in e}
@@ -249,6 +256,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
                 _string(f"contact {k}.active", e["active"]),
                 _string(f"contact {k}.passive", e["passive"]),
                 fit,
+                _friction(f"contact {k}.mu", e.get("mu", 0.0)),
             )
         )
     bcs = []

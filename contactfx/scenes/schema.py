@@ -87,6 +87,13 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
             "true: a fit drawn overlapping; D > 0: an overlap D prescribed along the normal",
             "true on bodies that do not overlap; D <= 0",
         ),
+        Key(
+            "mu",
+            "number",
+            "0",
+            "Coulomb friction coefficient (0: frictionless)",
+            "mu < 0; mu > 0 where friction is not solved yet (docs/friction.md)",
+        ),
     ),
     "dirichlet": (
         Key("group", _GROUP, None, "curve or point group"),

@@ -1,0 +1,70 @@
+"""Coulomb friction's input: `mu` on a [[contact]] pair, `ContactPair(mu=...)`, `--mu`.
+
+No solver carries the tangential multipliers yet: a pair with mu > 0 is refused in one line
+(never solved frictionless), and mu = 0 (the default) is today's model.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import ROOT, cli
+
+from contactfx import ContactPair, load_scene_file, run_scene
+from contactfx.errors import InputError
+
+SCENES = ROOT / "tests" / "scenes"
+
+
+def stacked(tmp_path: Path, mu: str) -> Path:
+    """stacked_blocks.toml with `mu = <mu>` on its first pair."""
+    toml = (SCENES / "stacked_blocks.toml").read_text()
+    (tmp_path / "stacked_blocks.geo").write_text((SCENES / "stacked_blocks.geo").read_text())
+    head, sep, tail = toml.partition('passive = "b1_top"\n')
+    path = tmp_path / "friction.toml"
+    path.write_text(head + sep + f"mu = {mu}\n" + tail)
+    return path
+
+
+def test_contact_pair_mu() -> None:
+    """mu defaults to 0 and is stored as a float; negative, NaN or non-numbers are refused."""
+    assert ContactPair("a", "b").mu == 0.0
+    assert ContactPair("a", "b", mu=1).mu == 1.0 and isinstance(
+        ContactPair("a", "b", mu=1).mu, float
+    )
+    for bad in (-0.1, float("nan"), float("inf"), "0.3", True):
+        with pytest.raises(InputError, match="mu must be a number >= 0"):
+            ContactPair("a", "b", mu=bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("mu", "expected"),
+    [
+        ("-0.2", "contact 0.mu: must be a number >= 0"),
+        ('"high"', "contact 0.mu: expected a number"),
+    ],
+)
+def test_scene_file_bad_mu_is_one_line(tmp_path: Path, mu: str, expected: str) -> None:
+    """A negative or non-numeric mu: one line, exit 2, before anything is meshed."""
+    proc = cli("solve", str(stacked(tmp_path, mu)))
+    assert proc.returncode == 2, proc.stderr
+    assert expected in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_frictional_pair_is_refused_not_solved_frictionless(tmp_path: Path) -> None:
+    """mu > 0 is read onto its pair, and the solve refuses it in one line (every method)."""
+    scene = load_scene_file(stacked(tmp_path, "0.3"))
+    assert [p.mu for p in scene.contacts] == [0.3, 0.0, 0.0]
+    for method in ("mortar", "nts", "penalty", "schwarz"):
+        with pytest.raises(InputError, match=r"contact 0 \('b2_bottom' on 'b1_top'\) has mu = 0.3"):
+            run_scene(scene, method)
+
+
+def test_builtin_mu_option_is_refused_in_one_line() -> None:
+    """--mu reaches the built-in scene's pair; with mu > 0 the CLI says so, exit 2."""
+    proc = cli("solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1")
+    assert proc.returncode == 2, proc.stderr
+    assert "has mu = 0.2: Coulomb friction is not solved yet" in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
