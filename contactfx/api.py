@@ -16,7 +16,7 @@ from mpi4py import MPI
 from .errors import InputError
 from .methods.active_set import ActiveSetOptions
 from .methods.autosolve import prepare_solver
-from .methods.friction import refuse_friction
+from .methods.friction import frictional_pairs, refuse_friction
 from .methods.multipliers import solve_contact
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.solution import Solution
@@ -94,6 +94,10 @@ def solve_request(
         from .methods.schwarz import solve_schwarz
 
         return solve_schwarz(scene, request, timers)
+    if frictional_pairs(scene):
+        from .methods.friction import solve_friction
+
+        return solve_friction(scene, request, timers, aso)
     # `auto` chooses on the fine system before the predictor, whose mesh follows the choice.
     prepared = None
     if request.solver.kind is SolverKind.AUTO:

@@ -1,17 +1,50 @@
-"""Which frictional scenes can be solved: a pair with mu > 0 is refused in one line until then.
+"""Coulomb friction by multipliers: a tangential row beside each normal row, three sets.
 
-Coulomb friction is chosen per contact pair (`ContactPair.mu`). Its building blocks (the
-complementarity rows of contact/friction.py, the tangential rows of the nts and mortar
-kernels, the references of results/friction_references.py) are in; no solver path carries the
-tangential multipliers yet (docs/friction.md), so a frictional pair is refused rather than
-solved frictionless. With every mu = 0 nothing here changes the model.
+Each contact row j carries a normal multiplier lambda_n (a pressure) and a tangential one
+lambda_t (the traction on the active body is -lambda_t t, t = (n_y, -n_x) of the passive
+surface). A set of the primal-dual active set (Hueber, Stadler and Wohlmuth 2008) fixes each
+row's law, and the saddle point [[K, B_n^T, B_t^T], [B_n', C_nn, 0], [B_t', C_tn, C_tt]] is
+linear on it (multipliers mu_n = -lambda_n, mu_t = +lambda_t, so K u + B^T mu = f):
+
+    open:  lambda_n = 0, lambda_t = 0                 (B rows off, C = 1)
+    stick: weighted gap 0, weighted slip increment 0  (B_n, B_t rows on)
+    slip:  weighted gap 0, lambda_t = mu s lambda_n   (B_n row on; mu_t + mu s mu_n = 0: C_tn)
+
+C_tn makes the system unsymmetric: it is factored by LU (MUMPS). The next set is
+contact/friction.py's classification of the solution, with the complementarity constants
+c_n = c_t = E_max / h (tractions against E times a strain: no user constant, no units). The
+loop is the one of active_set.py: the normal set is its `active`, and a change of a row's
+stick/slip status or slip direction keeps it going (`Step.changed`, `SetHistory.visit`'s key).
+The slip increment is measured from the undeformed state (one load step).
+
+Supported: nts and mortar (standard and dual basis) with Lagrange multipliers on the direct
+saddle-point path, every model, pairs between bodies. Refused in one line (`refuse_friction`):
+sts, penalty, Schwarz, an iterative or condensed solver, rigid obstacles in a frictional scene.
+With every mu = 0 nothing here runs: the frictionless path is unchanged.
 """
 
 from __future__ import annotations
 
-from ..errors import InputError
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from ..contact import ContactOperator, contact_operator
+from ..contact.friction import FrictionResult, Status, classify, ncp
+from ..contact.sparse import CSR
+from ..discretize.coupling import global_dirichlet_dofs, petsc_constraint
+from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
+from ..errors import InputError, SolverError
+from ..linalg.blocks import diagonal_matrix
+from ..options import Basis, Discretization, Enforcement, SolverKind
 from ..request import SolveRequest
 from ..scenes import Scene
+from ..timers import Timers
+from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .solution import Solution, finish
+
+SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
 
 
 def frictional_pairs(scene: Scene) -> list[int]:
@@ -20,14 +53,210 @@ def frictional_pairs(scene: Scene) -> list[int]:
 
 
 def refuse_friction(scene: Scene, request: SolveRequest) -> None:
-    """InputError naming the first frictional pair: no method solves friction yet."""
+    """InputError naming the first frictional pair if `request` cannot solve friction."""
     pairs = frictional_pairs(scene)
     if not pairs:
         return
     k = pairs[0]
     pair = scene.contacts[k]
-    raise InputError(
-        f"contact {k} ('{pair.active}' on '{pair.passive}') has mu = {pair.mu:g}: Coulomb "
-        f"friction is not solved yet by any method ({request.discretization.value} with "
-        f"{request.enforcement.value} included); set mu = 0 for frictionless contact"
+    why = ""
+    if request.enforcement is not Enforcement.MULTIPLIERS:
+        why = f"the {request.enforcement.value} enforcement"
+    elif request.discretization is Discretization.STS:
+        why = "sts"
+    elif request.solver.kind not in (SolverKind.DIRECT, SolverKind.AUTO):
+        why = f"the {request.solver.name} solver"
+    elif scene.obstacles:
+        why = "a scene with rigid obstacles"
+    if why:
+        raise InputError(
+            f"contact {k} ('{pair.active}' on '{pair.passive}') has mu = {pair.mu:g}: Coulomb "
+            f"friction is not solved with {why}; it is solved by {SUPPORTED} (or set mu = 0)"
+        )
+
+
+def tangent_constraint(
+    scene: Scene, setup: ContactSetup, basis: Basis, kernel: object
+) -> tuple[PETSc.Mat, np.ndarray]:
+    """This rank's rows of B_t and the weighted slip that prescribed displacements add.
+
+    B_t: the tangential rows of the same kernel, in the layout's order (owned rows).
+    """
+    el = setup.elasticity
+    V = el.V
+    ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+    options: dict[str, object] = {"direction": "tangent"}
+    if basis is Basis.DUAL:
+        options["basis"] = basis
+    ops = []
+    for p in setup.pairs:
+        assert p.passive is not None  # obstacles are refused with friction
+        ops.append(contact_operator(kernel, p.active.surface, p.passive.surface, ndofs, **options))  # type: ignore[arg-type]
+    Bt = CSR.vstack([o.B for o in ops]) if len(ops) > 1 else ops[0].B
+    op = ContactOperator(Bt, np.zeros(Bt.shape[0]), setup.operator.weights)
+    dofs = np.vstack(
+        [p.active.surface.dofs for p in setup.pairs]
+        + [p.passive.surface.dofs for p in setup.pairs if p.passive is not None]
     )
+    shift = prescribed_gap_shift(scene, el, op, dofs)
+    dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
+    B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
+    return B, shift[setup.order][setup.layout.mine]
+
+
+def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
+    """A distributed vector holding this rank's `values`."""
+    v = PETSc.Vec().createMPI((len(values), PETSc.DETERMINE), comm=comm)  # type: ignore[arg-type]
+    v.array[:] = values
+    return v
+
+
+class FrictionIteration:
+    """Frictional saddle-point solves on a set, and the three-set update (the loop's Iteration)."""
+
+    label = "friction"
+    probing = False
+
+    def __init__(
+        self, scene: Scene, setup: ContactSetup, Bt: PETSc.Mat, shift_t: np.ndarray
+    ) -> None:
+        self.setup, self.Bt, self.shift_t = setup, Bt, shift_t
+        layout = setup.layout
+        self.mu = np.array([scene.contacts[int(k)].mu for k in layout.pair[layout.mine]])
+        self.c = setup.e_max / setup.h
+        m = len(layout.mine)
+        # The first set sticks wherever friction acts; the sign of a slip row is its tau's.
+        self.stick = self.mu > 0.0
+        self.sign = np.ones(m)
+        self.ut_prev = np.zeros(m)  # the weighted slip at the previous load step
+        self.u = fem.Function(setup.elasticity.V, name="u")
+        self.lam_t = np.zeros(m)
+        self.slip = np.zeros(m)
+        self.status = np.zeros(m, dtype=np.int64)
+        self.offset = layout.offset
+
+    def key(self, active: np.ndarray) -> np.ndarray:
+        """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
+        return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+
+    def solve(self, active: np.ndarray, it: int) -> Step:
+        """One LU solve of the frictional saddle point on `active` and the friction sets."""
+        setup, comm = self.setup, self.setup.comm
+        el = setup.elasticity
+        on = np.asarray(active, dtype=float)
+        stick = active & self.stick
+        slip = active & ~self.stick
+        # Row blocks: the normal rows where in contact, the tangential rows where sticking.
+        Bn_a, Bt_a = setup.B.copy(), self.Bt.copy()
+        Bn_a.diagonalScale(L=_vec(comm, on))
+        Bt_a.diagonalScale(L=_vec(comm, stick.astype(float)))
+        BnT, BtT = setup.B.copy().transpose(), self.Bt.copy().transpose()
+        Cnn = diagonal_matrix(setup.B.getComm(), 1.0 - on, self.offset)
+        Ctn = diagonal_matrix(
+            setup.B.getComm(), np.where(slip, self.mu * self.sign, 0.0), self.offset
+        )
+        Ctt = diagonal_matrix(setup.B.getComm(), 1.0 - stick, self.offset)
+        nest = PETSc.Mat().createNest(
+            [[el.K, BnT, BtT], [Bn_a, Cnn, None], [Bt_a, Ctn, Ctt]],  # type: ignore[list-item]
+            comm=setup.B.getComm(),
+        )
+        rows, _ = nest.getNestISs()
+        A = nest.convert("aij", PETSc.Mat())
+        b = A.createVecRight()
+        parts = (
+            el.f.array_r,
+            np.where(active, -setup.g, 0.0),
+            np.where(stick, self.ut_prev - self.shift_t, 0.0),
+        )
+        for iset, values in zip(rows, parts, strict=True):
+            sub = b.getSubVector(iset)
+            sub.array[:] = values
+            b.restoreSubVector(iset, sub)
+        x = b.duplicate()
+        ksp = PETSc.KSP().create(A.getComm())
+        ksp.setOperators(A)
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.solve(b, x)
+        if ksp.getConvergedReason() < 0:  # type: ignore[operator]
+            raise SolverError(
+                f"the frictional saddle point's LU failed ({ksp.getConvergedReason()})"
+            )
+        out = []
+        for iset in rows:
+            sub = x.getSubVector(iset)
+            out.append(sub.array_r.copy())
+            x.restoreSubVector(iset, sub)
+        for obj in (ksp, A, nest, Bn_a, Bt_a, BnT, BtT, Cnn, Ctn, Ctt, b, x):
+            obj.destroy()
+        u, mu_n, mu_t = out
+        self.u.x.petsc_vec.array[:] = u
+        self.u.x.scatter_forward()
+        lam_n, lam_t = np.where(active, -mu_n, 0.0), np.where(active, mu_t, 0.0)
+        gap = setup.normalized_gap(self.u)
+        y = self.Bt.createVecLeft()
+        self.Bt.mult(self.u.x.petsc_vec, y)
+        ut = y.array_r + self.shift_t
+        y.destroy()
+        w = setup.w
+        inc = (ut - self.ut_prev) / w
+        status = classify(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
+        tau = lam_t + self.c * inc
+        new_active = status != Status.OPEN
+        new_stick = status == Status.STICK
+        new_sign = np.where(status == Status.SLIP, np.where(tau >= 0.0, 1.0, -1.0), self.sign)
+        changed = (
+            new_active
+            & active
+            & ((new_stick != self.stick) | (~new_stick & (new_sign != self.sign)))
+        )
+        n_changed = comm.allreduce(int(changed.sum()))
+        self.stick = np.where(new_active, new_stick, self.stick)
+        self.sign = new_sign
+        cn, ct = ncp(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
+        lam_max = comm.allreduce(float(np.abs(lam_n).max(initial=0.0)), op=MPI.MAX)
+        resid = np.sqrt(comm.allreduce(float(np.sum(w * (cn**2 + ct**2)))))
+        resid /= max(lam_max * np.sqrt(comm.allreduce(float(w.sum()))), 1e-300)
+        self.lam_t, self.slip, self.status = lam_t, ut / w, status
+        n_stick = comm.allreduce(int(np.sum(status == Status.STICK)))
+        n_slip = comm.allreduce(int(np.sum(status == Status.SLIP)))
+        record: dict[str, float] = {"stick": n_stick, "slip": n_slip, "friction_changed": n_changed}
+        text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, complementarity {resid:.2e}, "
+        return Step(lam_n, gap, new_active, float(resid), record, text, True, n_changed)
+
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
+        """The update's set (no probes on the frictional path)."""
+        return None
+
+
+def solve_friction(
+    scene: Scene, request: SolveRequest, timers: Timers, aso: ActiveSetOptions
+) -> Solution:
+    """Solve `scene` with Coulomb friction on its pairs (`refuse_friction` has passed)."""
+    kernel = request.discretization.kernel
+    setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
+    try:
+        with timers("contact"):
+            Bt, shift_t = tangent_constraint(scene, setup, request.basis, kernel)
+        iteration = FrictionIteration(scene, setup, Bt, shift_t)
+        active = setup.initial_active(aso.penetration_tol * setup.h)
+        try:
+            step, active, history = run_active_set(setup, iteration, active, aso, timers)
+        finally:
+            Bt.destroy()
+        sol = finish(
+            setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
+        )
+    finally:
+        setup.destroy()
+    sol.basis = request.basis
+    status = np.where(active, iteration.status, Status.OPEN)
+    comm = setup.comm
+    sol.friction = FrictionResult(
+        mu=np.concatenate(comm.allgather(iteration.mu)),
+        shear=np.concatenate(comm.allgather(np.where(active, iteration.lam_t, 0.0))),
+        slip=np.concatenate(comm.allgather(iteration.slip)),
+        status=np.concatenate(comm.allgather(status)),
+    )
+    return sol

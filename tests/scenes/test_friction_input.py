@@ -1,13 +1,14 @@
 """Coulomb friction's input: `mu` on a [[contact]] pair, `ContactPair(mu=...)`, `--mu`.
 
-No solver carries the tangential multipliers yet: a pair with mu > 0 is refused in one line
-(never solved frictionless), and mu = 0 (the default) is today's model.
+A pair with mu > 0 that a method cannot solve with friction is refused in one line (never
+solved frictionless); mu = 0 (the default) is today's model.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import ROOT, cli
 
@@ -53,18 +54,22 @@ def test_scene_file_bad_mu_is_one_line(tmp_path: Path, mu: str, expected: str) -
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
 
 
-def test_frictional_pair_is_refused_not_solved_frictionless(tmp_path: Path) -> None:
-    """mu > 0 is read onto its pair, and the solve refuses it in one line (every method)."""
+def test_frictional_pair_is_read_and_solved_or_refused(tmp_path: Path) -> None:
+    """mu > 0 is read onto its pair; mortar solves it with friction, sts, penalty and Schwarz
+    refuse it in one line."""
     scene = load_scene_file(stacked(tmp_path, "0.3"))
     assert [p.mu for p in scene.contacts] == [0.3, 0.0, 0.0]
-    for method in ("mortar", "nts", "penalty", "schwarz"):
+    sol, _ = run_scene(scene, "mortar")
+    assert sol.friction is not None
+    np.testing.assert_array_equal(np.unique(sol.friction.mu), [0.0, 0.3])
+    for method in ("sts", "penalty", "schwarz"):
         with pytest.raises(InputError, match=r"contact 0 \('b2_bottom' on 'b1_top'\) has mu = 0.3"):
             run_scene(scene, method)
 
 
-def test_builtin_mu_option_is_refused_in_one_line() -> None:
-    """--mu reaches the built-in scene's pair; with mu > 0 the CLI says so, exit 2."""
-    proc = cli("solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1")
+def test_builtin_mu_option_reaches_the_pair() -> None:
+    """--mu reaches the built-in scene's pair: with sts the CLI refuses friction, exit 2."""
+    proc = cli("solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1", "--method", "sts")
     assert proc.returncode == 2, proc.stderr
-    assert "has mu = 0.2: Coulomb friction is not solved yet" in proc.stderr, proc.stderr
+    assert "has mu = 0.2: Coulomb friction is not solved with sts" in proc.stderr, proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1

@@ -1,0 +1,149 @@
+"""Coulomb friction by multipliers on the direct saddle-point path (methods/friction.py).
+
+A block (1 x 1, 6 x 6 quads) pressed by p = 10 on a wider base (8 x 4 quads, non-matching
+interface nodes), its top edge pushed sideways by a prescribed u_x. Coulomb's law is checked
+at every node (slip: |shear| = mu p; stick: no slip and |shear| < mu p), full slip carries
+Q = mu P, a vanishing mu gives the frictionless solver's pressures (an independent path: the
+frictionless loop solves a symmetric system with its own probes and reuse), the mirrored push
+the mirrored answer, and what is not supported is refused in one line.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import ROOT
+
+from contactfx import ContactPair, Obstacle, scene_from_gmsh, solve
+from contactfx.contact.friction import Status
+from contactfx.errors import InputError
+from contactfx.methods.solution import Solution
+from contactfx.scenes import Dirichlet, Material, Pressure, Scene
+
+GEO = ROOT / "tests" / "scenes" / "friction_blocks.geo"
+MU, P = 0.3, 10.0
+CASES = [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")]
+
+
+def pushed(mu: float, push: float, model: str = "plane_strain") -> Scene:
+    """The block pressed by P on the base and its top edge moved by `push` along x."""
+    return scene_from_gmsh(
+        GEO,
+        bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
+        contacts=[ContactPair("block_bottom", "base_top", mu=mu)],
+        dirichlet=[Dirichlet("base_bottom", ux=0.0, uy=0.0), Dirichlet("block_top", ux=push)],
+        loads=[Pressure("block_top", P)],
+        model=model,
+    )
+
+
+def forces(sol: Solution) -> tuple[float, float]:
+    """(P, Q): the normal and tangential force the multipliers carry (sum of w lambda)."""
+    assert sol.friction is not None
+    w = sol.layout.weights
+    return float(w @ sol.pressure), float(w @ sol.friction.shear)
+
+
+def check_coulomb(sol: Solution, mu: float) -> None:
+    """Coulomb's law at every node, to round-off of the largest pressure."""
+    fr = sol.friction
+    assert fr is not None
+    p, q, status = sol.pressure, fr.shear, fr.status
+    scale = p.max()
+    slip, stick, open_ = (status == s for s in (Status.SLIP, Status.STICK, Status.OPEN))
+    np.testing.assert_array_equal(open_, ~sol.active)
+    assert np.all(p[open_] == 0.0) and np.all(q[open_] == 0.0)
+    assert np.all(p[~open_] > 0.0)
+    assert np.abs(np.abs(q[slip]) - mu * p[slip]).max(initial=0.0) < 1e-6 * scale
+    assert np.all(np.abs(q[stick]) < mu * p[stick])
+    # A sticking node has not slipped (the slip increment of the one load step).
+    assert np.abs(fr.slip[stick]).max(initial=0.0) < 1e-12
+
+
+@pytest.mark.parametrize(("method", "basis"), CASES)
+def test_full_slip_carries_mu_p(method: str, basis: str) -> None:
+    """Pushed far, every contact node slips with |shear| = mu p and Q = mu P; the push tips
+    the block (the moment Q h against P's lever) about its leading edge: the trailing nodes
+    open."""
+    sol = solve(pushed(MU, 0.05), method, basis=basis)
+    check_coulomb(sol, MU)
+    assert sol.friction is not None
+    status = sol.friction.status
+    assert np.all(status[sol.active] == Status.SLIP)
+    x = sol.layout.x[:, 0]
+    assert np.any(status == Status.OPEN)
+    assert x[status == Status.OPEN].max() < x[sol.active].min()  # the trailing edge lifts
+    p_total, q_total = forces(sol)
+    assert p_total == pytest.approx(P, rel=1e-10)  # the block's vertical equilibrium
+    assert q_total == pytest.approx(MU * p_total, rel=1e-10)
+    # The friction on the block opposes the push: its traction -q t, t = +x on the base's top.
+    assert q_total > 0.0
+
+
+@pytest.mark.parametrize(("method", "basis"), CASES)
+def test_small_push_sticks_inside_and_mirrors(method: str, basis: str) -> None:
+    """A small push: the middle sticks, the edges may slip, Q < mu P; the mirrored push
+    (the meshes are mirror-symmetric about x = 1) gives the mirrored shear."""
+    sol = solve(pushed(MU, 0.002), method, basis=basis)
+    check_coulomb(sol, MU)
+    assert sol.friction is not None
+    assert np.sum(sol.friction.status == Status.STICK) >= 3
+    p_total, q_total = forces(sol)
+    assert 0.0 < q_total < 0.5 * MU * p_total
+    back = solve(pushed(MU, -0.002), method, basis=basis)
+    assert back.friction is not None
+    x = sol.layout.x[:, 0]
+    mirror = np.array([np.argmin(np.abs(back.layout.x[:, 0] - (2.0 - xi))) for xi in x])
+    np.testing.assert_allclose(back.pressure[mirror], sol.pressure, rtol=0, atol=1e-9 * P)
+    np.testing.assert_allclose(
+        back.friction.shear[mirror], -sol.friction.shear, rtol=0, atol=1e-9 * P
+    )
+
+
+@pytest.mark.parametrize(("method", "basis"), CASES)
+def test_vanishing_mu_gives_the_frictionless_pressures(method: str, basis: str) -> None:
+    """mu = 1e-12 runs the frictional path; its pressures are the frictionless solver's."""
+    frictionless = solve(pushed(0.0, 0.002), method, basis=basis)
+    assert frictionless.friction is None  # mu = 0: the frictional path is not entered
+    tiny = solve(pushed(1e-12, 0.002), method, basis=basis)
+    assert tiny.friction is not None
+    np.testing.assert_array_equal(tiny.active, frictionless.active)
+    scale = frictionless.pressure.max()
+    np.testing.assert_allclose(tiny.pressure, frictionless.pressure, rtol=0, atol=1e-9 * scale)
+    assert np.abs(tiny.friction.shear).max() < 1e-9 * scale
+
+
+@pytest.mark.parametrize(
+    ("method", "options", "words"),
+    [
+        ("sts", {}, "not solved with sts"),
+        ("penalty", {}, "not solved with the penalty enforcement"),
+        ("schwarz", {}, "not solved with the schwarz enforcement"),
+        ("mortar", {"solver": "condensed", "basis": "dual"}, "not solved with the condensed"),
+        ("mortar", {"solver": "fieldsplit"}, "not solved with the fieldsplit solver"),
+    ],
+)
+def test_unsupported_friction_is_refused_in_one_line(
+    method: str, options: dict[str, str], words: str
+) -> None:
+    """Never solved frictionless: the refusal names the pair and what does solve friction."""
+    with pytest.raises(InputError, match=words) as err:
+        solve(pushed(MU, 0.002), method, **options)  # type: ignore[arg-type]
+    text = str(err.value)
+    assert "contact 0 ('block_bottom' on 'base_top') has mu = 0.3" in text
+    assert "nts or mortar (standard or dual) with multipliers" in text and "\n" not in text
+
+
+def test_friction_beside_an_obstacle_is_refused() -> None:
+    """Rigid obstacles have no tangential rows yet: a frictional scene with one is refused."""
+    base = pushed(MU, 0.002)
+    scene = scene_from_gmsh(
+        GEO,
+        bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
+        contacts=list(base.contacts),
+        dirichlet=list(base.dirichlet),
+        loads=list(base.loads),
+        obstacles=[Obstacle("wall", "plane", "block_right", point=(1.6, 0.0), normal=(-1.0, 0.0))],
+    )
+    with pytest.raises(InputError, match="not solved with a scene with rigid obstacles"):
+        solve(scene, "mortar")
