@@ -18,9 +18,10 @@ from contactfx import ContactPair, Obstacle, scene_from_gmsh, solve
 from contactfx.contact.friction import Status
 from contactfx.errors import InputError
 from contactfx.methods.solution import Solution
-from contactfx.scenes import Dirichlet, Material, Pressure, Scene
+from contactfx.scenes import Dirichlet, Material, Pressure, Scene, Traction
 
 GEO = ROOT / "tests" / "scenes" / "friction_blocks.geo"
+PATCH = ROOT / "tests" / "scenes" / "friction_patch.geo"
 MU, P = 0.3, 10.0
 CASES = [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")]
 
@@ -58,6 +59,45 @@ def check_coulomb(sol: Solution, mu: float) -> None:
     assert np.all(np.abs(q[stick]) < mu * p[stick])
     # A sticking node has not slipped (the slip increment of the one load step).
     assert np.abs(fr.slip[stick]).max(initial=0.0) < 1e-12
+
+
+def patch(tau: float, delta: float, E: float = 1000.0) -> Scene:
+    """The frictional patch test: sigma = [[0, tau], [tau, -P]] in both blocks (nu = 0, so
+    no lateral strain), imposed by consistent tractions on the free faces; the block's top
+    edge is moved by the uniform shear strain's u_x plus a rigid slip `delta`."""
+    gamma = 2.0 * tau / E  # tau / G with G = E / 2 at nu = 0
+    sides = (("base_right", 1), ("base_left", -1), ("block_right", 1), ("block_left", -1))
+    return scene_from_gmsh(
+        PATCH,
+        bodies={"base": Material(E, 0.0), "block": Material(E, 0.0)},
+        contacts=[ContactPair("block_bottom", "base_top", mu=MU)],
+        dirichlet=[
+            Dirichlet("base_bottom", ux=0.0, uy=0.0),
+            Dirichlet("block_top", ux=2.0 * gamma + delta),
+        ],
+        loads=[Pressure("block_top", P)] + [Traction(g, (0.0, s * tau)) for g, s in sides],
+    )
+
+
+@pytest.mark.parametrize("basis", ["standard", "dual"])
+@pytest.mark.parametrize(
+    ("tau", "delta", "status"),
+    [(2.0, 0.0, Status.STICK), (MU * P, 0.01, Status.SLIP), (-MU * P, -0.01, Status.SLIP)],
+)
+def test_patch_test_is_exact_in_stick_and_slip(
+    basis: str, tau: float, delta: float, status: Status
+) -> None:
+    """Non-matching interface nodes (spacing 1/6 on 1/4): the uniform state is the discrete
+    solution, pressure P and shear tau (the traction on the block's bottom is (-tau, P)) at
+    every node to 1e-8; stick where |tau| < mu P and no slip, slip by delta where the top
+    is moved by delta with tau = mu P."""
+    sol = solve(patch(tau, delta), "mortar", basis=basis)
+    fr = sol.friction
+    assert fr is not None
+    np.testing.assert_array_equal(fr.status, status)
+    np.testing.assert_allclose(sol.pressure, P, rtol=1e-8)
+    np.testing.assert_allclose(fr.shear, tau, rtol=1e-8)
+    np.testing.assert_allclose(fr.slip, delta, rtol=0, atol=1e-10)
 
 
 @pytest.mark.parametrize(("method", "basis"), CASES)
