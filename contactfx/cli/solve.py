@@ -38,7 +38,13 @@ def terminal_summary(run: RunSummary) -> list[str]:
         f"total {run.times['total']:.2f} s"
     ]
     for k, c in enumerate(run.contacts):
-        lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}")
+        status = c.interface.get("status")
+        counts = (
+            f", {status.count('stick')} stick, {status.count('slip')} slip"
+            if status is not None
+            else ""
+        )
+        lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}{counts}")
     if run.patch is not None:
         lines.append(
             f"patch test: max stress/pressure error {run.patch.max:.2e} "

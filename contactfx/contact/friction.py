@@ -77,6 +77,7 @@ class FrictionResult:
     shear: np.ndarray
     slip: np.ndarray
     status: np.ndarray
+    tangent: CSR  # the tangential rows B_t in the same order: -B_t^T shear is their force
 
 
 def _state(

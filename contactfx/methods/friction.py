@@ -77,7 +77,7 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
 
 def tangent_constraint(
     scene: Scene, setup: ContactSetup, basis: Basis, kernel: object
-) -> tuple[PETSc.Mat, np.ndarray]:
+) -> tuple[PETSc.Mat, np.ndarray, CSR]:
     """This rank's rows of B_t and the weighted slip that prescribed displacements add.
 
     B_t: the tangential rows of the same kernel, in the layout's order (owned rows).
@@ -101,7 +101,7 @@ def tangent_constraint(
     shift = prescribed_gap_shift(scene, el, op, dofs)
     dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
     B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
-    return B, shift[setup.order][setup.layout.mine]
+    return B, shift[setup.order][setup.layout.mine], Bt.rows(setup.order)
 
 
 def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
@@ -238,7 +238,7 @@ def solve_friction(
     setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
     try:
         with timers("contact"):
-            Bt, shift_t = tangent_constraint(scene, setup, request.basis, kernel)
+            Bt, shift_t, tangent = tangent_constraint(scene, setup, request.basis, kernel)
         iteration = FrictionIteration(scene, setup, Bt, shift_t)
         active = setup.initial_active(aso.penetration_tol * setup.h)
         try:
@@ -258,5 +258,6 @@ def solve_friction(
         shear=np.concatenate(comm.allgather(np.where(active, iteration.lam_t, 0.0))),
         slip=np.concatenate(comm.allgather(iteration.slip)),
         status=np.concatenate(comm.allgather(status)),
+        tangent=tangent,
     )
     return sol

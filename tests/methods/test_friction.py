@@ -187,3 +187,25 @@ def test_friction_beside_an_obstacle_is_refused() -> None:
     )
     with pytest.raises(InputError, match="not solved with a scene with rigid obstacles"):
         solve(scene, "mortar")
+
+
+def test_summary_carries_the_shear_and_the_statuses() -> None:
+    """The JSON's pair: its force includes the shear's (-B_t^T lambda_t: the block is held
+    back by mu P against the push, the base pushed forward by as much), and the interface
+    gains shear, slip and status; the terminal line counts stick and slip nodes."""
+    from contactfx import run_scene
+    from contactfx.cli.solve import terminal_summary
+
+    sol, run = run_scene(pushed(MU, 0.05), "mortar")
+    pair = run.to_json()["contacts"][0]
+    assert pair["force"][0] == pytest.approx(-MU * P, rel=1e-10)
+    assert pair["force"][1] == pytest.approx(P, rel=1e-10)
+    assert pair["force_passive"][0] == pytest.approx(MU * P, rel=1e-10)
+    itf = pair["interface"]
+    assert set(itf["status"]) == {"open", "slip"}
+    assert itf["status"].count("slip") == int(sol.active.sum())
+    assert len(itf["shear"]) == len(itf["slip"]) == len(itf["pressure"])
+    n_slip = itf["status"].count("slip")
+    assert any(f"0 stick, {n_slip} slip" in line for line in terminal_summary(run))
+    frictionless = run_scene(pushed(0.0, 0.05), "mortar")[1].to_json()["contacts"][0]
+    assert not {"shear", "slip", "status"} & frictionless["interface"].keys()
