@@ -25,6 +25,7 @@ from .request import RequestOptions, SolveRequest
 from .results.records import RunSummary
 from .results.summary import summary
 from .scenes import BlockParams, HertzParams, Scene, build_scene
+from .scenes.steps import step_scenes
 from .timers import Timers
 
 TIME_KEYS = ("mesh", "assemble", "search", "contact", "solve")
@@ -84,6 +85,11 @@ def solve_request(
     refuse_friction(scene, request)
     timers = timers or Timers()
     aso = ActiveSetOptions(request.max_iterations)
+    if scene.steps and not frictional_pairs(scene):
+        # Frictionless, each step's answer is its loads' alone: one solve per step.
+        sols = [solve_request(s, request, timers, initial) for s in step_scenes(scene)]
+        sols[-1].steps = sols
+        return sols[-1]
     # The penalty and Schwarz modules are imported when they run (first-answer time of a
     # plain solve: docs/scale.md).
     if request.enforcement is Enforcement.PENALTY:

@@ -15,7 +15,7 @@ contact/friction.py's classification of the solution, with the complementarity c
 c_n = c_t = E_max / h (tractions against E times a strain: no user constant, no units). The
 loop is the one of active_set.py: the normal set is its `active`, and a change of a row's
 stick/slip status or slip direction keeps it going (`Step.changed`, `SetHistory.visit`'s key).
-The slip increment is measured from the undeformed state (one load step).
+The slip increment is measured from the previous load step (quasi-static).
 
 Supported: nts and mortar (standard and dual basis) with Lagrange multipliers on the direct
 saddle-point path, every model, pairs between bodies. Refused in one line (`refuse_friction`):
@@ -24,6 +24,9 @@ With every mu = 0 nothing here runs: the frictionless path is unchanged.
 """
 
 from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import fem
@@ -40,9 +43,12 @@ from ..linalg.blocks import diagonal_matrix
 from ..options import Basis, Discretization, Enforcement, SolverKind
 from ..request import SolveRequest
 from ..scenes import Scene
+from ..scenes.steps import step_scenes
 from ..timers import Timers
 from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
 from .solution import Solution, finish
+
+log = logging.getLogger("contactfx")
 
 SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
 
@@ -230,10 +236,43 @@ class FrictionIteration:
         return None
 
 
+@dataclass(frozen=True)
+class StepState:
+    """What a converged load step hands the next (owned rows): its sets and tangential motion."""
+
+    active: np.ndarray
+    sign: np.ndarray
+    ut: np.ndarray  # the weighted tangential displacement B_t u (+ prescribed) at its end
+
+
 def solve_friction(
     scene: Scene, request: SolveRequest, timers: Timers, aso: ActiveSetOptions
 ) -> Solution:
-    """Solve `scene` with Coulomb friction on its pairs (`refuse_friction` has passed)."""
+    """Solve `scene` with Coulomb friction on its pairs, step by step.
+
+    `refuse_friction` has passed. Each load step's slip increment is measured from the step
+    before (quasi-static).
+    """
+    sols: list[Solution] = []
+    state: StepState | None = None
+    for k, step_scene in enumerate(step_scenes(scene)):
+        sol, state = _solve_step(step_scene, request, timers, aso, state)
+        if scene.steps and scene.comm.rank == 0:
+            log.info("step %d: %d iterations", k + 1, sol.iterations)
+        sols.append(sol)
+    if scene.steps:
+        sols[-1].steps = sols
+    return sols[-1]
+
+
+def _solve_step(
+    scene: Scene,
+    request: SolveRequest,
+    timers: Timers,
+    aso: ActiveSetOptions,
+    before: StepState | None,
+) -> tuple[Solution, StepState]:
+    """One load step of `solve_friction`, from the state the step before left."""
     kernel = request.discretization.kernel
     setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
     try:
@@ -241,6 +280,14 @@ def solve_friction(
             Bt, shift_t, tangent = tangent_constraint(scene, setup, request.basis, kernel)
         iteration = FrictionIteration(scene, setup, Bt, shift_t)
         active = setup.initial_active(aso.penetration_tol * setup.h)
+        if before is not None:
+            if len(before.active) != len(active):
+                raise SolverError("the contact rows changed between load steps")
+            active = active | before.active
+            # A new step starts from stick wherever friction acts (as the first step does):
+            # the increment is small, and starting from the last step's slip made an
+            # unloading step cycle (tests/methods/test_friction.py, the pull back).
+            iteration.sign, iteration.ut_prev = before.sign.copy(), before.ut.copy()
         try:
             step, active, history = run_active_set(setup, iteration, active, aso, timers)
         finally:
@@ -260,4 +307,5 @@ def solve_friction(
         status=np.concatenate(comm.allgather(status)),
         tangent=tangent,
     )
-    return sol
+    after = StepState(active, iteration.sign, iteration.slip * setup.w)
+    return sol, after

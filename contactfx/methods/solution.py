@@ -170,6 +170,7 @@ class Solution:
     solver_choice: SolverChoice | None = None  # what the `auto` solver ran and why
     cache: Cache = field(default_factory=Cache, repr=False)
     friction: FrictionResult | None = None  # the tangential side where some pair has mu > 0
+    steps: list[Solution] = field(default_factory=list, repr=False)  # each load step's
 
     @property
     def iterations(self) -> int:

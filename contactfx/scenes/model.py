@@ -125,11 +125,15 @@ class ContactPair:
 
 @dataclass(frozen=True)
 class Dirichlet:
-    """Prescribed displacement components on a named curve or point group (None = free)."""
+    """Prescribed displacement components on a named curve or point group (None = free).
+
+    `name`: what a load step's factor calls it (scenes/steps.py); None: in full in every step.
+    """
 
     group: str
     ux: float | None = None
     uy: float | None = None
+    name: str | None = None
 
     def components(self) -> list[tuple[int, float]]:
         """(component, value) pairs that are prescribed."""
@@ -138,18 +142,23 @@ class Dirichlet:
 
 @dataclass(frozen=True)
 class Pressure:
-    """Normal pressure on a named curve group, positive pushing into the body."""
+    """Normal pressure on a named curve group, positive pushing into the body.
+
+    `name`: as Dirichlet's.
+    """
 
     group: str
     p: float
+    name: str | None = None
 
 
 @dataclass(frozen=True)
 class Traction:
-    """Traction vector (force per unit length) on a named curve group."""
+    """Traction vector (force per unit length) on a named curve group (`name`: as Dirichlet's)."""
 
     group: str
     t: tuple[float, float]
+    name: str | None = None
 
 
 Load = Pressure | Traction
@@ -327,6 +336,8 @@ class Scene:
     # The lines of a structured mesh (its coarser grids: a geometric multigrid's levels).
     grid: GridLines | None = field(default=None, compare=False, repr=False)
     probes: tuple[Probe, ...] = ()  # values read off the solution (results/probes.py)
+    # Load steps in order: factors on named loads (scenes/steps.py); () is one step in full.
+    steps: tuple[Mapping[str, float], ...] = ()
 
     @property
     def comm(self) -> MPI.Comm:

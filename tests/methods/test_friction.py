@@ -45,8 +45,9 @@ def forces(sol: Solution) -> tuple[float, float]:
     return float(w @ sol.pressure), float(w @ sol.friction.shear)
 
 
-def check_coulomb(sol: Solution, mu: float) -> None:
-    """Coulomb's law at every node, to round-off of the largest pressure."""
+def check_coulomb(sol: Solution, mu: float, before: Solution | None = None) -> None:
+    """Coulomb's law at every node, to round-off of the largest pressure (`before`: the
+    previous load step's solution, from which the slip increment is measured)."""
     fr = sol.friction
     assert fr is not None
     p, q, status = sol.pressure, fr.shear, fr.status
@@ -57,8 +58,9 @@ def check_coulomb(sol: Solution, mu: float) -> None:
     assert np.all(p[~open_] > 0.0)
     assert np.abs(np.abs(q[slip]) - mu * p[slip]).max(initial=0.0) < 1e-6 * scale
     assert np.all(np.abs(q[stick]) < mu * p[stick])
-    # A sticking node has not slipped (the slip increment of the one load step).
-    assert np.abs(fr.slip[stick]).max(initial=0.0) < 1e-12
+    # A sticking node has not slipped in this step.
+    start = 0.0 if before is None or before.friction is None else before.friction.slip
+    assert np.abs((fr.slip - start)[stick]).max(initial=0.0) < 1e-12
 
 
 def patch(tau: float, delta: float, E: float = 1000.0) -> Scene:
@@ -209,3 +211,52 @@ def test_summary_carries_the_shear_and_the_statuses() -> None:
     assert any(f"0 stick, {n_slip} slip" in line for line in terminal_summary(run))
     frictionless = run_scene(pushed(0.0, 0.05), "mortar")[1].to_json()["contacts"][0]
     assert not {"shear", "slip", "status"} & frictionless["interface"].keys()
+
+
+def stepped(mu: float, pushes: list[float]) -> Scene:
+    """The pushed block, pressed in a first step, then its top moved by push x 0.05 in steps."""
+    return scene_from_gmsh(
+        GEO,
+        bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
+        contacts=[ContactPair("block_bottom", "base_top", mu=mu)],
+        dirichlet=[
+            Dirichlet("base_bottom", ux=0.0, uy=0.0),
+            Dirichlet("block_top", ux=0.05, name="push"),
+        ],
+        loads=[Pressure("block_top", P, name="press")],
+        steps=[{"press": 1.0}] + [{"push": f} for f in pushes],
+    )
+
+
+@pytest.mark.parametrize(("method", "basis"), CASES)
+def test_pushed_in_steps_sticks_until_mu_p_then_slips(method: str, basis: str) -> None:
+    """Q grows with the push while the middle sticks (each step's slip measured from the
+    step before: Q linear in the push while nothing new slips), and reaches mu P when every
+    contact node slips; pulled back, the shear depends on the path."""
+    sol = solve(stepped(MU, [0.04, 0.2, 1.0, 0.5]), method, basis=basis)
+    assert len(sol.steps) == 5 and sol.steps[-1] is sol
+    qs = []
+    for before, step in zip([None, *sol.steps[:-1]], sol.steps, strict=True):
+        check_coulomb(step, MU, before)
+        p_total, q_total = forces(step)
+        assert p_total == pytest.approx(P, rel=1e-10)
+        qs.append(q_total)
+    assert abs(qs[0]) < 1e-10 * P  # pressed alone: no shear (the meshes are mirror-symmetric)
+    assert 0.0 < qs[1] < qs[2] < MU * P
+    assert qs[3] == pytest.approx(MU * P, rel=1e-10)
+    assert sol.steps[3].friction is not None
+    assert np.all(sol.steps[3].friction.status[sol.steps[3].active] == Status.SLIP)
+    # Unloading to half the push: the shear falls back, unlike a first push to that place,
+    # which ends sliding further (friction remembers the path).
+    direct = solve(stepped(MU, [0.5]), method, basis=basis)
+    assert forces(sol)[1] < 0.8 * forces(direct)[1]
+
+
+def test_frictionless_steps_end_with_the_loads_in_full() -> None:
+    """mu = 0: each step solves its own loads; the last, with every load in full, is the
+    scene without steps, bit for bit."""
+    sol = solve(stepped(0.0, [0.3, 1.0]), "mortar")
+    assert len(sol.steps) == 3 and sol.friction is None
+    plain = solve(pushed(0.0, 0.05), "mortar")
+    np.testing.assert_array_equal(sol.pressure, plain.pressure)
+    np.testing.assert_array_equal(sol.u.x.array, plain.u.x.array)

@@ -6,6 +6,7 @@ solved frictionless); mu = 0 (the default) is today's model.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -72,4 +73,50 @@ def test_builtin_mu_option_reaches_the_pair() -> None:
     proc = cli("solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1", "--method", "sts")
     assert proc.returncode == 2, proc.stderr
     assert "has mu = 0.2: Coulomb friction is not solved with sts" in proc.stderr, proc.stderr
+    assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_load_steps_in_the_json_and_on_the_terminal(tmp_path: Path) -> None:
+    """[[step]] tables: one JSON entry per step (the press alone carries no shear, the last
+    push slides the block: Q = mu P), the top-level keys are the last step's, and the
+    terminal prints each step's forces, stick/slip counts and iterations."""
+    out = tmp_path / "run.json"
+    proc = cli("solve", str(SCENES / "friction_push.toml"), "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(out.read_text())
+    steps = data["steps"]
+    assert len(steps) == 3
+    forces = [s["contacts"][0]["force"] for s in steps]
+    assert all(f[1] == pytest.approx(10.0, rel=1e-10) for f in forces)
+    assert abs(forces[0][0]) < 1e-9
+    assert -0.3 * 10.0 < forces[1][0] < 0.0
+    assert forces[2][0] == pytest.approx(-0.3 * 10.0, rel=1e-10)
+    assert data["contacts"][0]["force"] == forces[2]
+    assert data["contacts"][0]["interface"] == steps[2]["contacts"][0]["interface"]
+    assert "stick" in steps[1]["contacts"][0]["interface"]["status"]
+    lines = [line for line in proc.stdout.splitlines() if "step 3, pair 0" in line]
+    assert len(lines) == 1 and "0 stick" in lines[0] and "iterations" in lines[0]
+
+
+@pytest.mark.parametrize(
+    ("step", "expected"),
+    [
+        ("[[step]]\npull = 1.0\n", "step 0: no load is named 'pull' (named loads: press, push)"),
+        ('[[step]]\npush = "full"\n', "step 0.push: expected a number (a factor), got 'full'"),
+        ("step = [1.0]\n", "step 0: expected a table of load names and factors (got 1.0)"),
+    ],
+)
+def test_bad_step_is_one_line(tmp_path: Path, step: str, expected: str) -> None:
+    """A step naming an unknown load, or not a table of numbers: one line, exit 2."""
+    toml = (SCENES / "friction_push.toml").read_text()
+    head = toml.partition("[[step]]")[0]
+    if not step.startswith("[[step]]"):  # a top-level key must come before the tables
+        head = step + head
+        step = ""
+    (tmp_path / "friction_blocks.geo").write_text((SCENES / "friction_blocks.geo").read_text())
+    path = tmp_path / "bad.toml"
+    path.write_text(head + step)
+    proc = cli("solve", str(path))
+    assert proc.returncode == 2, proc.stderr
+    assert expected in proc.stderr, proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
