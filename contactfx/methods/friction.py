@@ -36,7 +36,7 @@ from petsc4py import PETSc
 from ..contact import ContactOperator, contact_operator
 from ..contact.friction import FrictionResult, Status, classify, ncp
 from ..contact.sparse import CSR
-from ..discretize.coupling import global_dirichlet_dofs, petsc_constraint
+from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
 from ..errors import InputError, SolverError
 from ..linalg.blocks import diagonal_matrix
@@ -83,10 +83,12 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
 
 def tangent_constraint(
     scene: Scene, setup: ContactSetup, basis: Basis, kernel: object
-) -> tuple[PETSc.Mat, np.ndarray, CSR]:
+) -> tuple[PETSc.Mat, np.ndarray, CSR, np.ndarray]:
     """This rank's rows of B_t and the weighted slip that prescribed displacements add.
 
-    B_t: the tangential rows of the same kernel, in the layout's order (owned rows).
+    B_t: the tangential rows of the same kernel, in the layout's order (owned rows); also
+    all of them as a CSR, and which owned rows have a free tangential dof (a node on a
+    symmetry line or the axis has none: it cannot slip, its row carries no shear).
     """
     el = setup.elasticity
     V = el.V
@@ -107,7 +109,8 @@ def tangent_constraint(
     shift = prescribed_gap_shift(scene, el, op, dofs)
     dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
     B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
-    return B, shift[setup.order][setup.layout.mine], Bt.rows(setup.order)
+    mine = setup.order[setup.layout.mine]
+    return B, shift[mine], Bt.rows(setup.order), constrained_rows(op, dirichlet)[mine]
 
 
 def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
@@ -124,9 +127,14 @@ class FrictionIteration:
     probing = False
 
     def __init__(
-        self, scene: Scene, setup: ContactSetup, Bt: PETSc.Mat, shift_t: np.ndarray
+        self,
+        scene: Scene,
+        setup: ContactSetup,
+        Bt: PETSc.Mat,
+        shift_t: np.ndarray,
+        free_t: np.ndarray,
     ) -> None:
-        self.setup, self.Bt, self.shift_t = setup, Bt, shift_t
+        self.setup, self.Bt, self.shift_t, self.free_t = setup, Bt, shift_t, free_t
         layout = setup.layout
         self.mu = np.array([scene.contacts[int(k)].mu for k in layout.pair[layout.mine]])
         self.c = setup.e_max / setup.h
@@ -150,8 +158,9 @@ class FrictionIteration:
         setup, comm = self.setup, self.setup.comm
         el = setup.elasticity
         on = np.asarray(active, dtype=float)
-        stick = active & self.stick
-        slip = active & ~self.stick
+        # A row without a free tangential dof neither sticks nor slips: lambda_t = 0.
+        stick = active & self.stick & self.free_t
+        slip = active & ~self.stick & self.free_t
         # Row blocks: the normal rows where in contact, the tangential rows where sticking.
         Bn_a, Bt_a = setup.B.copy(), self.Bt.copy()
         Bn_a.diagonalScale(L=_vec(comm, on))
@@ -206,7 +215,7 @@ class FrictionIteration:
         ut = y.array_r + self.shift_t
         y.destroy()
         w = setup.w
-        inc = (ut - self.ut_prev) / w
+        inc = np.where(self.free_t, (ut - self.ut_prev) / w, 0.0)  # fixed rows: no slip
         status = classify(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
         tau = lam_t + self.c * inc
         new_active = status != Status.OPEN
@@ -277,8 +286,8 @@ def _solve_step(
     setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
     try:
         with timers("contact"):
-            Bt, shift_t, tangent = tangent_constraint(scene, setup, request.basis, kernel)
-        iteration = FrictionIteration(scene, setup, Bt, shift_t)
+            Bt, shift_t, tangent, free_t = tangent_constraint(scene, setup, request.basis, kernel)
+        iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t)
         active = setup.initial_active(aso.penetration_tol * setup.h)
         if before is not None:
             if len(before.active) != len(active):

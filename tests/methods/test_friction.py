@@ -23,6 +23,12 @@ from contactfx.scenes import Dirichlet, Material, Pressure, Scene, Traction
 GEO = ROOT / "tests" / "scenes" / "friction_blocks.geo"
 PATCH = ROOT / "tests" / "scenes" / "friction_patch.geo"
 MU, P = 0.3, 10.0
+# Rollers: the base on its bottom, both left edges on a symmetry line (or the axis).
+SUPPORTS = [
+    Dirichlet("base_bottom", uy=0.0),
+    Dirichlet("base_left", ux=0.0),
+    Dirichlet("block_left", ux=0.0),
+]
 CASES = [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")]
 
 
@@ -260,3 +266,60 @@ def test_frictionless_steps_end_with_the_loads_in_full() -> None:
     plain = solve(pushed(0.0, 0.05), "mortar")
     np.testing.assert_array_equal(sol.pressure, plain.pressure)
     np.testing.assert_array_equal(sol.u.x.array, plain.u.x.array)
+
+
+@pytest.mark.parametrize("model", ["plane_strain", "plane_stress", "axisymmetric"])
+@pytest.mark.parametrize("basis", ["standard", "dual"])
+def test_pressed_alike_blocks_stick_without_shear(model: str, basis: str) -> None:
+    """Two blocks of one material pressed uniformly (axisymmetric: two stacked cylinders)
+    expand alike: the uniform state sticks everywhere with no shear, the pressure P exact."""
+    scene = scene_from_gmsh(
+        PATCH,
+        bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
+        contacts=[ContactPair("block_bottom", "base_top", mu=MU)],
+        dirichlet=SUPPORTS,
+        loads=[Pressure("block_top", P)],
+        model=model,
+    )
+    sol = solve(scene, "mortar", basis=basis)
+    fr = sol.friction
+    assert fr is not None
+    np.testing.assert_array_equal(fr.status, Status.STICK)
+    np.testing.assert_allclose(sol.pressure, P, rtol=1e-8)
+    assert np.abs(fr.shear).max() < 1e-8 * P
+
+
+@pytest.mark.parametrize("basis", ["standard", "dual"])
+def test_axisymmetric_friction_along_the_meridian(basis: str) -> None:
+    """Stacked cylinders of different Poisson ratios expand differently under the press:
+    friction along the meridian (r) holds the middle and lets the rim slip outwards or
+    inwards; Coulomb's law holds at every node, and a vanishing mu gives back the
+    frictionless pressures."""
+
+    def scene(mu: float) -> Scene:
+        return scene_from_gmsh(
+            PATCH,
+            bodies={"base": Material(1000.0, 0.0), "block": Material(1000.0, 0.45)},
+            contacts=[ContactPair("block_bottom", "base_top", mu=mu)],
+            dirichlet=SUPPORTS,
+            loads=[Pressure("block_top", P)],
+            model="axisymmetric",
+        )
+
+    sol = solve(scene(0.1), "mortar", basis=basis)
+    check_coulomb(sol, 0.1)
+    assert sol.friction is not None
+    status = sol.friction.status
+    assert np.any(status == Status.STICK) and np.any(status == Status.SLIP)
+    # The block (nu = 0.45) expands more: its slipping rim moves outwards (+r) and friction
+    # on it points inwards, so the multiplier (traction -lambda_t t, t = +r) is positive.
+    # The row on the axis is left out: there the standard basis's row weighs the next node's
+    # radial motion with the axis's (it slips inwards by 1e-5 with |shear| = mu p).
+    r = sol.layout.x[:, 0]
+    slip, stick = (status == Status.SLIP) & (r > 0.0), (status == Status.STICK) & (r > 0.0)
+    assert np.all(sol.friction.slip[slip] > 0.0) and np.all(sol.friction.shear[slip] > 0.0)
+    assert r[slip].min() > r[stick].max()
+    tiny = solve(scene(1e-12), "mortar", basis=basis)
+    plain = solve(scene(0.0), "mortar", basis=basis)
+    scale = plain.pressure.max()
+    np.testing.assert_allclose(tiny.pressure, plain.pressure, rtol=0, atol=1e-9 * scale)
