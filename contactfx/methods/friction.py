@@ -38,7 +38,7 @@ from ..contact.friction import FrictionResult, Status, classify, ncp
 from ..contact.sparse import CSR
 from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
-from ..errors import InputError, SolverError
+from ..errors import InputError, SingularSystemError, SolverError
 from ..linalg.blocks import diagonal_matrix
 from ..options import Basis, Discretization, Enforcement, SolverKind
 from ..request import SolveRequest
@@ -283,7 +283,10 @@ def _solve_step(
 ) -> tuple[Solution, StepState]:
     """One load step of `solve_friction`, from the state the step before left."""
     kernel = request.discretization.kernel
-    setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
+    try:
+        setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
+    except SingularSystemError as err:
+        raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
     try:
         with timers("contact"):
             Bt, shift_t, tangent, free_t = tangent_constraint(scene, setup, request.basis, kernel)

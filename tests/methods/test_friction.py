@@ -16,7 +16,7 @@ from conftest import ROOT
 
 from contactfx import ContactPair, Obstacle, scene_from_gmsh, solve
 from contactfx.contact.friction import Status
-from contactfx.errors import InputError
+from contactfx.errors import InputError, SingularSystemError
 from contactfx.methods.solution import Solution
 from contactfx.scenes import Dirichlet, Material, Pressure, Scene, Traction
 
@@ -323,3 +323,16 @@ def test_axisymmetric_friction_along_the_meridian(basis: str) -> None:
     plain = solve(scene(0.0), "mortar", basis=basis)
     scale = plain.pressure.max()
     np.testing.assert_allclose(tiny.pressure, plain.pressure, rtol=0, atol=1e-9 * scale)
+
+
+def test_a_body_held_sideways_by_friction_alone_is_refused() -> None:
+    """Not solved yet: the floating-body check counts only normal rows, and says so."""
+    scene = scene_from_gmsh(
+        GEO,
+        bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
+        contacts=[ContactPair("block_bottom", "base_top", mu=MU)],
+        dirichlet=[Dirichlet("base_bottom", ux=0.0, uy=0.0)],
+        loads=[Pressure("block_top", P), Traction("block_top", (1.0, 0.0))],
+    )
+    with pytest.raises(SingularSystemError, match=r"translation along x.*friction does not hold"):
+        solve(scene, "mortar")

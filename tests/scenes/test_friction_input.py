@@ -120,3 +120,12 @@ def test_bad_step_is_one_line(tmp_path: Path, step: str, expected: str) -> None:
     assert proc.returncode == 2, proc.stderr
     assert expected in proc.stderr, proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_mu_zero_is_the_frictionless_scene_bit_for_bit(tmp_path: Path) -> None:
+    """`mu = 0` written out is the scene without the key: same pressures and displacement."""
+    plain = run_scene(load_scene_file(SCENES / "stacked_blocks.toml"), "mortar")[0]
+    zero = run_scene(load_scene_file(stacked(tmp_path, "0.0")), "mortar")[0]
+    assert zero.friction is None
+    np.testing.assert_array_equal(zero.pressure, plain.pressure)
+    np.testing.assert_array_equal(zero.u.x.array, plain.u.x.array)
