@@ -50,6 +50,9 @@ from .solution import Solution, finish
 
 log = logging.getLogger("contactfx")
 
+# The first set's band of normalized gaps, relative to the contact element size.
+START_BAND = 0.1
+
 SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
 
 
@@ -291,7 +294,9 @@ def _solve_step(
         with timers("contact"):
             Bt, shift_t, tangent, free_t = tangent_constraint(scene, setup, request.basis, kernel)
         iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t)
-        active = setup.initial_active(aso.penetration_tol * setup.h)
+        # The first set: the rows within h / 10 of touching (no predictor on this path; a
+        # curved contact touching at one node would leave the body free to rotate).
+        active = setup.initial_active(START_BAND * setup.h)
         if before is not None:
             if len(before.active) != len(active):
                 raise SolverError("the contact rows changed between load steps")
