@@ -16,6 +16,7 @@ from mpi4py import MPI
 from .errors import InputError
 from .methods.active_set import ActiveSetOptions
 from .methods.autosolve import prepare_solver, warn_if_stretched
+from .methods.friction import frictional_pairs, refuse_friction
 from .methods.multipliers import solve_contact
 from .methods.predictor import coarse_initial_set, coarse_margin, predict
 from .methods.solution import Solution
@@ -24,6 +25,7 @@ from .request import RequestOptions, SolveRequest
 from .results.records import RunSummary
 from .results.summary import summary
 from .scenes import BlockParams, HertzParams, Scene, build_scene
+from .scenes.steps import step_scenes
 from .timers import Timers
 
 TIME_KEYS = ("mesh", "assemble", "search", "contact", "solve")
@@ -80,8 +82,14 @@ def solve_request(
     initial: Solution | None = None,
 ) -> Solution:
     """Run the method of `request` on `scene` (see `solve`)."""
+    refuse_friction(scene, request)
     timers = timers or Timers()
     aso = ActiveSetOptions(request.max_iterations)
+    if scene.steps and not frictional_pairs(scene):
+        # Frictionless, each step's answer is its loads' alone: one solve per step.
+        sols = [solve_request(s, request, timers, initial) for s in step_scenes(scene)]
+        sols[-1].steps = sols
+        return sols[-1]
     # The penalty and Schwarz modules are imported when they run (first-answer time of a
     # plain solve: docs/scale.md).
     if request.enforcement is Enforcement.PENALTY:
@@ -92,6 +100,10 @@ def solve_request(
         from .methods.schwarz import solve_schwarz
 
         return solve_schwarz(scene, request, timers)
+    if frictional_pairs(scene):
+        from .methods.friction import solve_friction
+
+        return solve_friction(scene, request, timers, aso)
     # `auto` chooses on the fine system before the predictor, whose mesh follows the choice.
     prepared = None
     if request.solver.kind is SolverKind.AUTO:

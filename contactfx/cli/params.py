@@ -46,6 +46,7 @@ BLOCK_KEYS = (
     "size2",
     "grading1",
     "grading2",
+    "mu",
 )
 HERTZ_KEYS = (
     "R",
@@ -61,6 +62,7 @@ HERTZ_KEYS = (
     "width",
     "height",
     "h_far",
+    "mu",
 )
 
 PARAM_HELP = {
@@ -77,6 +79,7 @@ PARAM_HELP = {
     "size2": "blocks: element size in B2 (cm, default 0.125)",
     "grading1": "blocks: element-size ratio of neighbours along x in B1 (1 = uniform)",
     "grading2": "blocks: element-size ratio of neighbours along x in B2 (1 = uniform)",
+    "mu": "Coulomb friction coefficient on the contact pair (default 0: frictionless)",
     "R": "hertz: cylinder radius (cm, default 60)",
     "P": "hertz: load per unit thickness, full model (MPa*cm, default 100)",
     "refine": "hertz: element size on the contact zone (cm, default 0.02)",

@@ -15,7 +15,7 @@ from ..errors import InputError
 from ..methods.solution import Solution
 from ..options import Enforcement
 from ..request import SolveRequest
-from ..results.records import RunSummary
+from ..results.records import ContactSummary, RunSummary
 from ..timers import Timers
 from .params import build_from_args, is_scene_file, request_from_args
 
@@ -30,6 +30,14 @@ def half_width_failure(run: RunSummary, pair: int) -> str:
     return f"no half-width fits the pressures of the {n} active nodes"
 
 
+def _counts(c: ContactSummary) -> str:
+    """A frictional pair's stick and slip node counts ("" for a frictionless scene)."""
+    status = c.interface.get("status")
+    if status is None:
+        return ""
+    return f", {status.count('stick')} stick, {status.count('slip')} slip"
+
+
 def terminal_summary(run: RunSummary) -> list[str]:
     """What a user came for, last: each pair's force, and the errors against references."""
     lines = [
@@ -37,8 +45,13 @@ def terminal_summary(run: RunSummary) -> list[str]:
         f"{run.multipliers} multipliers, {run.iterations} iterations, "
         f"total {run.times['total']:.2f} s"
     ]
+    for n, step in enumerate(run.steps, start=1):
+        for k, c in enumerate(step.contacts):
+            lines.append(
+                f"step {n}, pair {k}: {c.force_text()}{_counts(c)}, {step.iterations} iterations"
+            )
     for k, c in enumerate(run.contacts):
-        lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}")
+        lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}{_counts(c)}")
     if run.patch is not None:
         lines.append(
             f"patch test: max stress/pressure error {run.patch.max:.2e} "

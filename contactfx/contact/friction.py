@@ -64,6 +64,22 @@ class FrictionRows:
     dt: np.ndarray  # (m, 4)
 
 
+@dataclass(frozen=True)
+class FrictionResult:
+    """The tangential side of a frictional solve, per multiplier (global layout order).
+
+    shear: lambda_t (the traction on the active body is -shear t, t = (n_y, -n_x) of the
+    passive surface); slip: the tangential slip (weighted slip / weight, the active body's
+    motion along t relative to the passive one); status: contact/friction.Status values.
+    """
+
+    mu: np.ndarray
+    shear: np.ndarray
+    slip: np.ndarray
+    status: np.ndarray
+    tangent: CSR  # the tangential rows B_t in the same order: -B_t^T shear is their force
+
+
 def _state(
     lam_n: np.ndarray,
     lam_t: np.ndarray,

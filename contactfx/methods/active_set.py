@@ -24,7 +24,7 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from mpi4py import MPI
@@ -83,9 +83,20 @@ class SetHistory:
             out[idx] = vals
         return out
 
-    def visit(self, active: np.ndarray, it: int, n_active: int, probing: bool) -> None:
-        """A set about to be solved; raise if a final answer was given on it before (a cycle)."""
-        key = self.to_global(active).tobytes()
+    def visit(
+        self,
+        active: np.ndarray,
+        it: int,
+        n_active: int,
+        probing: bool,
+        full: np.ndarray | None = None,
+    ) -> None:
+        """A set about to be solved; raise if a final answer was given on it before (a cycle).
+
+        `full` (owned rows): the whole set where a row has more states than in or out of
+        contact (friction's stick, slip and slip direction); None: `active` is the set.
+        """
+        key = self.to_global(active if full is None else full).tobytes()
         repeat = probing and key == self.last  # the same set again, now with probes
         self.last = key
         if key in self.seen and not repeat:
@@ -174,6 +185,7 @@ class Step:
     record: dict[str, float] = field(default_factory=dict)  # extra history columns
     text: str = ""  # extra words for the log line
     final: bool = True  # the solve reached the final tolerance (not a loop's loose answer)
+    changed: int = 0  # rows (all ranks) whose other set changed: friction's stick/slip
 
 
 @dataclass(frozen=True)
@@ -200,6 +212,15 @@ class Iteration(Protocol):
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The set to solve next instead of `step.new_active` (None: take the update)."""
+        ...
+
+
+@runtime_checkable
+class KeyedIteration(Protocol):
+    """An Iteration whose rows have more states than the contact set (friction)."""
+
+    def key(self, active: np.ndarray) -> np.ndarray:
+        """The whole set of the owned rows about to be solved (cycle detection)."""
         ...
 
 
@@ -233,7 +254,8 @@ def run_active_set(
         carried = None if prev is None else ~prev[0] | setup.loaded(*prev)
         setup.check_held_by(active, f"in the active set of iteration {it}", carried)
         try:
-            state.visit(active, it, n_active, iteration.probing)
+            full = iteration.key(active) if isinstance(iteration, KeyedIteration) else None
+            state.visit(active, it, n_active, iteration.probing, full)
         except ActiveSetError:
             held_by_last(setup, prev, "when the active set started to cycle")
             raise
@@ -256,7 +278,7 @@ def run_active_set(
             "solve_time": t_solve,
         }
         history.append(record)
-        stationary = entered == 0 and left == 0
+        stationary = entered == 0 and left == 0 and step.changed == 0
         proposal = None if stationary else iteration.next_set(active, step, entered)
         after = ""
         if proposal is not None:

@@ -10,6 +10,7 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
+from ..contact.friction import FrictionResult
 from ..contact.geometry import arc_length, nodal_normals
 from ..contact.search import project
 from ..contact.sparse import CSR
@@ -203,6 +204,8 @@ class Solution:
     reference_linear_iterations: int | None = None  # of the fresh solve (reference timing)
     solver_choice: SolverChoice | None = None  # what the `auto` solver ran and why
     cache: Cache = field(default_factory=Cache, repr=False)
+    friction: FrictionResult | None = None  # the tangential side where some pair has mu > 0
+    steps: list[Solution] = field(default_factory=list, repr=False)  # each load step's
 
     @property
     def iterations(self) -> int:

@@ -30,6 +30,9 @@ from .records import ContactSummary
 from .stress import nodal_stress, surface_stress
 
 # The numeric columns of every pair's `interface` (plus the boolean `active`), in order.
+# How the JSON names contact/friction.Status values.
+STATUS_NAMES = ("open", "stick", "slip")
+
 INTERFACE_FIELDS = (
     "x",
     "y",
@@ -191,6 +194,11 @@ def _pair_interface(sol: Solution, k: int) -> dict[str, Any]:
     cols = dict(zip(INTERFACE_FIELDS, values, strict=True))
     out: dict[str, Any] = {key: none_if_nan(np.asarray(v)[order]) for key, v in cols.items()}
     out["active"] = [bool(a) for a in sol.active[rows][order]]
+    fr = sol.friction
+    if fr is not None:  # a frictional scene: the tangential side (frictionless: no keys)
+        out["shear"] = fr.shear[rows][order].tolist()
+        out["slip"] = fr.slip[rows][order].tolist()
+        out["status"] = [STATUS_NAMES[int(v)] for v in fr.status[rows][order]]
     return out
 
 
@@ -199,6 +207,8 @@ def pair_forces(sol: Solution, k: int) -> tuple[np.ndarray, np.ndarray]:
     pv = sol.pairs[k]
     # B^T lambda: the multipliers' nodal forces (compression positive pushes the bodies apart).
     nodal = pv.B.transpose_matmul(sol.pressure[pv.rows])
+    if sol.friction is not None:  # the shear's force on the bodies: -B_t^T lambda_t
+        nodal -= sol.friction.tangent.rows(pv.rows).transpose_matmul(sol.friction.shear[pv.rows])
     fa = np.array([nodal[pv.active.surface.dofs[:, c]].sum() for c in (0, 1)])
     if pv.motion is not None:  # a rigid obstacle: its force is its columns' share
         return fa, pv.motion.transpose_matmul(sol.pressure[pv.rows])

@@ -188,6 +188,18 @@ class MethodExtras:
         return out
 
 
+@dataclass(frozen=True)
+class StepSummary:
+    """One load step of a run: its iterations and every pair's results at its end."""
+
+    iterations: int
+    contacts: tuple[ContactSummary, ...]
+
+    def to_json(self) -> dict[str, Any]:
+        """The step's entry of the JSON's `steps`."""
+        return {"iterations": self.iterations, "contacts": [c.to_json() for c in self.contacts]}
+
+
 @dataclass(frozen=True, kw_only=True)
 class RunSummary:
     """One run: sizes, iterations, costs, every pair's results and the references' errors."""
@@ -218,6 +230,7 @@ class RunSummary:
     estimate: EstimateSummary | None = None
     lame: tuple[LameErrors, ...] = ()  # one per Lame reference
     probes: tuple[ProbeResult, ...] = ()  # one per probe of the scene
+    steps: tuple[StepSummary, ...] = ()  # one per [[step]] (none without steps)
 
     @property
     def contact_force(self) -> float:
@@ -263,6 +276,8 @@ class RunSummary:
             out["lame"] = [r.to_json() for r in self.lame]
         if self.probes:
             out["probes"] = [p.to_json() for p in self.probes]
+        if self.steps:
+            out["steps"] = [s.to_json() for s in self.steps]
         out["solver"] = self.solver
         if self.solver_choice is not None:
             out["solver_choice"] = self.solver_choice

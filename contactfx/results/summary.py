@@ -22,6 +22,7 @@ from .records import (
     PatchErrors,
     ProbeResult,
     RunSummary,
+    StepSummary,
 )
 from .references import hertz_summary, uniform_stress_errors
 
@@ -118,4 +119,5 @@ def summary(
         patch=patch[-1] if patch else None,
         lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
         probes=tuple(probe_value(sol, p) for p in scene.probes),
+        steps=tuple(StepSummary(s.iterations, contacts_summary(s)) for s in sol.steps),
     )

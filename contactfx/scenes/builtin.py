@@ -50,6 +50,7 @@ class BlockParams:
     grading1: float = 1.0
     grading2: float = 1.0
     model: Model = Model.PLANE_STRAIN  # axisymmetric: two stacked cylinders (x = r)
+    mu: float = 0.0  # Coulomb friction on the pair (0: frictionless)
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,7 @@ class HertzParams:
     h_far: float | None = None  # largest element size (cm); None: R / 6
     # Axisymmetric: a (hemi)sphere on a cylindrical block, P the total force (MPa*cm^2).
     model: Model = Model.PLANE_STRAIN
+    mu: float = 0.0  # Coulomb friction on the pair (0: frictionless)
 
 
 #: The Hertz scene's meshers (`--mesh`).
@@ -215,7 +217,7 @@ def _two_body_scene(
         Body("body1", Material(params.E1, params.nu1)),
         Body("body2", Material(params.E2, params.nu2)),
     )
-    pair = ContactPair(f"contact{active}", f"contact{3 - active}")
+    pair = ContactPair(f"contact{active}", f"contact{3 - active}", mu=params.mu)
     # Rollers, as in the paper: u_x = 0 on the symmetry axis, u_y = 0 on the base only.
     supports = (Dirichlet("symmetry", ux=0.0), Dirichlet("support", uy=0.0))
     assert data.cell_tags is not None  # both meshers tag every cell with its body

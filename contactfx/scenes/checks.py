@@ -13,6 +13,7 @@ from mpi4py import MPI
 
 from ..errors import InputError, MeshError
 from .model import Body, HertzReference, LameReference, Model, Scene
+from .steps import check_steps, load_names
 
 
 def _global_count(scene: Scene, local: int) -> int:
@@ -217,4 +218,5 @@ def check_scene(scene: Scene) -> Scene:
     curve_bodies.update(_check_obstacles(scene, curve_bodies))
     _check_conditions(scene)
     _check_overlaps(scene)
-    return replace(scene, curve_bodies=curve_bodies)
+    steps = check_steps(scene.steps, load_names(scene))
+    return replace(scene, curve_bodies=curve_bodies, steps=steps)

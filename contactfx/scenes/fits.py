@@ -44,6 +44,15 @@ def check_thermal(alpha: float | None, dT: float | None, where: str) -> None:
         )
 
 
+def check_friction(value: object, where: str) -> float:
+    """The pair's Coulomb coefficient as stored: a finite number >= 0 (InputError otherwise)."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not _finite(value):
+        raise InputError(f"{where}: mu must be a number >= 0 (got {value!r})")
+    if value < 0:
+        raise InputError(f"{where}: mu must be a number >= 0, 0 for frictionless (got {value!r})")
+    return float(value)
+
+
 def check_interference(value: bool | float, where: str) -> bool | float:
     """The pair's interference as stored: a bool, or D > 0 as a float (InputError otherwise)."""
     if isinstance(value, bool):

@@ -278,6 +278,7 @@ class SceneParts:
     model: Model = Model.PLANE_STRAIN
     units: Units = field(default_factory=Units)
     probes: tuple[Probe, ...] = ()
+    steps: tuple[Mapping[str, float], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -350,6 +351,7 @@ def scene_from_parts(
         model=parts.model,
         units=parts.units,
         probes=parts.probes,
+        steps=parts.steps,
     )
     return check_scene(scene)
 
@@ -384,6 +386,7 @@ def scene_from_gmsh(
     obstacles: list[Obstacle] | None = None,
     model: Model | str = Model.PLANE_STRAIN,
     probes: list[Probe] | None = None,
+    steps: list[Mapping[str, float]] | None = None,
 ) -> Scene:
     """A Scene from a gmsh model (the gmsh module's current model) or a .msh/.geo path.
 
@@ -402,6 +405,8 @@ def scene_from_gmsh(
         obstacles: Rigid obstacles (Obstacle), each against one curve group of a body.
         model: plane_strain (default), plane_stress or axisymmetric (x = r >= 0, y the axis).
         probes: Values read off the solution (Probe), printed and in the JSON.
+        steps: Load steps in order, each {load name: factor} on named loads (a named load
+            keeps its last factor, 0 before its first; unnamed loads act in full).
 
     Returns:
         The checked Scene; a .geo scene can be remeshed (coarse predictor, studies).
@@ -425,5 +430,6 @@ def scene_from_gmsh(
         tuple(obstacles or ()),
         Model.parse(model),
         probes=tuple(probes or ()),
+        steps=tuple(steps or ()),
     )
     return scene_from_parts(model_or_path, parts, comm)

@@ -19,7 +19,7 @@ from mpi4py import MPI
 
 from ..errors import InputError, MeshError
 from ..meshes import GridLines
-from .fits import LameReference, check_interference, check_thermal
+from .fits import LameReference, check_friction, check_interference, check_thermal
 from .obstacle import Obstacle
 from .probe import Probe
 
@@ -109,15 +109,18 @@ class ContactPair:
     an interference fit drawn overlapping (the overlap is the fit, the solve resolves it);
     a number D > 0 for bodies drawn touching, with the overlap D prescribed along the normal
     (the gap g becomes g - D).
+    `mu`: Coulomb's friction coefficient (0, the default: frictionless, today's model exactly).
     """
 
     active: str
     passive: str
     interference: bool | float = False
+    mu: float = 0.0
 
     def __post_init__(self) -> None:
         where = f"contact '{self.active}' on '{self.passive}'"
         object.__setattr__(self, "interference", check_interference(self.interference, where))
+        object.__setattr__(self, "mu", check_friction(self.mu, where))
 
     @property
     def prescribed_overlap(self) -> float:
@@ -133,11 +136,15 @@ class ContactPair:
 
 @dataclass(frozen=True)
 class Dirichlet:
-    """Prescribed displacement components on a named curve or point group (None = free)."""
+    """Prescribed displacement components on a named curve or point group (None = free).
+
+    `name`: what a load step's factor calls it (scenes/steps.py); None: in full in every step.
+    """
 
     group: str
     ux: float | None = None
     uy: float | None = None
+    name: str | None = None
 
     def components(self) -> list[tuple[int, float]]:
         """(component, value) pairs that are prescribed."""
@@ -146,18 +153,23 @@ class Dirichlet:
 
 @dataclass(frozen=True)
 class Pressure:
-    """Normal pressure on a named curve group, positive pushing into the body."""
+    """Normal pressure on a named curve group, positive pushing into the body.
+
+    `name`: as Dirichlet's.
+    """
 
     group: str
     p: float
+    name: str | None = None
 
 
 @dataclass(frozen=True)
 class Traction:
-    """Traction vector (force per unit length) on a named curve group."""
+    """Traction vector (force per unit length) on a named curve group (`name`: as Dirichlet's)."""
 
     group: str
     t: tuple[float, float]
+    name: str | None = None
 
 
 Load = Pressure | Traction
@@ -335,6 +347,8 @@ class Scene:
     # The lines of a structured mesh (its coarser grids: a geometric multigrid's levels).
     grid: GridLines | None = field(default=None, compare=False, repr=False)
     probes: tuple[Probe, ...] = ()  # values read off the solution (results/probes.py)
+    # Load steps in order: factors on named loads (scenes/steps.py); () is one step in full.
+    steps: tuple[Mapping[str, float], ...] = ()
 
     @property
     def comm(self) -> MPI.Comm:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import os
 import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +37,7 @@ from .model import (
 from .obstacle import OBSTACLE_SHAPES, Shape
 from .probe import Probe, ProbeKind
 from .schema import SECTIONS, TYPE_ERRORS, allowed, required
+from .steps import check_steps
 
 # The allowed keys of each section, from the one table the reference page is generated from.
 TOP_KEYS = allowed("")
@@ -137,6 +139,26 @@ def _interference(where: str, value: Any) -> bool | float:
     if d <= 0:
         raise InputError(f"{where}: must be true, false or a number > 0 (got {value!r})")
     return d
+
+
+def _name(where: str, e: dict[str, Any]) -> str | None:
+    """A load's optional name (what a [[step]] calls it)."""
+    return _string(where, e["name"]) if "name" in e else None
+
+
+def _steps(
+    doc: dict[str, Any], bcs: list[Dirichlet], loads: list[Load]
+) -> tuple[Mapping[str, float], ...]:
+    """The [[step]] tables, checked against the loads' names (before anything is meshed)."""
+    names = {x.name for x in (*bcs, *loads) if x.name is not None}
+    return check_steps(_entries(doc, "step"), names)
+
+
+def _friction(where: str, value: Any) -> float:
+    mu = _number(where, value)
+    if mu < 0:
+        raise InputError(f"{where}: must be a number >= 0, 0 for frictionless (got {value!r})")
+    return mu
 
 
 def _material(body: str, table: Any) -> Material:
@@ -250,6 +272,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
                 _string(f"contact {k}.active", e["active"]),
                 _string(f"contact {k}.passive", e["passive"]),
                 fit,
+                _friction(f"contact {k}.mu", e.get("mu", 0.0)),
             )
         )
     bcs = []
@@ -258,12 +281,22 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         comps = {c: _number(f"dirichlet {k}.{c}", e[c]) for c in ("ux", "uy") if c in e}
         if not comps:
             raise InputError(f"dirichlet {k} on '{e['group']}': give ux and/or uy")
-        bcs.append(Dirichlet(_string(f"dirichlet {k}.group", e["group"]), **comps))
+        bcs.append(
+            Dirichlet(
+                _string(f"dirichlet {k}.group", e["group"]),
+                **comps,
+                name=_name(f"dirichlet {k}.name", e),
+            )
+        )
     loads: list[Load] = []
     for k, entry in enumerate(_entries(doc, "pressure")):
         e = _section(f"pressure {k}", entry, "pressure")
         loads.append(
-            Pressure(_string(f"pressure {k}.group", e["group"]), _number(f"pressure {k}.p", e["p"]))
+            Pressure(
+                _string(f"pressure {k}.group", e["group"]),
+                _number(f"pressure {k}.p", e["p"]),
+                _name(f"pressure {k}.name", e),
+            )
         )
     for k, entry in enumerate(_entries(doc, "traction")):
         e = _section(f"traction {k}", entry, "traction")
@@ -274,6 +307,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
             Traction(
                 _string(f"traction {k}.group", e["group"]),
                 (_number(f"traction {k}.t", t[0]), _number(f"traction {k}.t", t[1])),
+                _name(f"traction {k}.name", e),
             )
         )
     refs = [_reference(k, e, model) for k, e in enumerate(_entries(doc, "reference"))]
@@ -290,6 +324,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         model,
         units,
         tuple(probes),
+        _steps(doc, bcs, loads),
     )
     return mesh, parts
 

@@ -76,6 +76,14 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("traction", "tables", "none", "traction vectors on curve groups"),
         Key("reference", "tables", "none", "analytic references the run is checked against"),
         Key("probe", "tables", "none", "values read off a pair: printed and in the JSON"),
+        Key(
+            "step",
+            "tables",
+            "one step, every load in full",
+            "load steps in order, each NAME = factor on named loads (a named load keeps its "
+            "last factor, 0 before its first; a load without a name acts in full)",
+            "an unknown load name; a factor that is not a number",
+        ),
     ),
     "bodies": (
         Key("E", "number", None, "Young's modulus", "E <= 0"),
@@ -93,19 +101,29 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
             "true: a fit drawn overlapping; D > 0: an overlap D prescribed along the normal",
             "true on bodies that do not overlap; D <= 0",
         ),
+        Key(
+            "mu",
+            "number",
+            "0",
+            "Coulomb friction coefficient (0: frictionless)",
+            "mu < 0; mu > 0 with sts, penalty, schwarz, a condensed solver (docs/friction.md)",
+        ),
     ),
     "dirichlet": (
         Key("group", _GROUP, None, "curve or point group"),
         Key("ux", "number", "free", "prescribed x displacement", "neither ux nor uy"),
         Key("uy", "number", "free", "prescribed y displacement", "neither ux nor uy"),
+        Key("name", "string", "none", "what a [[step]] calls it (its factor there)"),
     ),
     "pressure": (
         Key("group", _GROUP, None, "curve group"),
         Key("p", "number", None, "normal pressure, positive pushing into the body"),
+        Key("name", "string", "none", "what a [[step]] calls it (its factor there)"),
     ),
     "traction": (
         Key("group", _GROUP, None, "curve group"),
         Key("t", "vector", None, "traction vector [tx, ty], force per unit length"),
+        Key("name", "string", "none", "what a [[step]] calls it (its factor there)"),
     ),
     "reference.hertz": (
         Key(

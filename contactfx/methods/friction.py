@@ -1,0 +1,328 @@
+"""Coulomb friction by multipliers: a tangential row beside each normal row, three sets.
+
+Each contact row j carries a normal multiplier lambda_n (a pressure) and a tangential one
+lambda_t (the traction on the active body is -lambda_t t, t = (n_y, -n_x) of the passive
+surface). A set of the primal-dual active set (Hueber, Stadler and Wohlmuth 2008) fixes each
+row's law, and the saddle point [[K, B_n^T, B_t^T], [B_n', C_nn, 0], [B_t', C_tn, C_tt]] is
+linear on it (multipliers mu_n = -lambda_n, mu_t = +lambda_t, so K u + B^T mu = f):
+
+    open:  lambda_n = 0, lambda_t = 0                 (B rows off, C = 1)
+    stick: weighted gap 0, weighted slip increment 0  (B_n, B_t rows on)
+    slip:  weighted gap 0, lambda_t = mu s lambda_n   (B_n row on; mu_t + mu s mu_n = 0: C_tn)
+
+C_tn makes the system unsymmetric: it is factored by LU (MUMPS). The next set is
+contact/friction.py's classification of the solution, with the complementarity constants
+c_n = c_t = E_max / h (tractions against E times a strain: no user constant, no units). The
+loop is the one of active_set.py: the normal set is its `active`, and a change of a row's
+stick/slip status or slip direction keeps it going (`Step.changed`, `SetHistory.visit`'s key).
+The slip increment is measured from the previous load step (quasi-static).
+
+Supported: nts and mortar (standard and dual basis) with Lagrange multipliers on the direct
+saddle-point path, every model, pairs between bodies. Refused in one line (`refuse_friction`):
+sts, penalty, Schwarz, an iterative or condensed solver, rigid obstacles in a frictional scene.
+With every mu = 0 nothing here runs: the frictionless path is unchanged.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from ..contact import ContactOperator, contact_operator
+from ..contact.friction import FrictionResult, Status, classify, ncp
+from ..contact.sparse import CSR
+from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
+from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
+from ..errors import InputError, SingularSystemError, SolverError
+from ..linalg.blocks import diagonal_matrix
+from ..options import Basis, Discretization, Enforcement, SolverKind
+from ..request import SolveRequest
+from ..scenes import Scene
+from ..scenes.steps import step_scenes
+from ..timers import Timers
+from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .solution import Solution, finish
+
+log = logging.getLogger("contactfx")
+
+# The first set's band of normalized gaps, relative to the contact element size.
+START_BAND = 0.1
+
+SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
+
+
+def frictional_pairs(scene: Scene) -> list[int]:
+    """Indices (into `scene.contacts`) of the pairs with mu > 0."""
+    return [k for k, pair in enumerate(scene.contacts) if pair.mu > 0.0]
+
+
+def refuse_friction(scene: Scene, request: SolveRequest) -> None:
+    """InputError naming the first frictional pair if `request` cannot solve friction."""
+    pairs = frictional_pairs(scene)
+    if not pairs:
+        return
+    k = pairs[0]
+    pair = scene.contacts[k]
+    why = ""
+    if request.enforcement is not Enforcement.MULTIPLIERS:
+        why = f"the {request.enforcement.value} enforcement"
+    elif request.discretization is Discretization.STS:
+        why = "sts"
+    elif request.solver.kind not in (SolverKind.DIRECT, SolverKind.AUTO):
+        why = f"the {request.solver.name} solver"
+    elif scene.obstacles:
+        why = "a scene with rigid obstacles"
+    if why:
+        raise InputError(
+            f"contact {k} ('{pair.active}' on '{pair.passive}') has mu = {pair.mu:g}: Coulomb "
+            f"friction is not solved with {why}; it is solved by {SUPPORTED} (or set mu = 0)"
+        )
+
+
+def tangent_constraint(
+    scene: Scene, setup: ContactSetup, basis: Basis, kernel: object
+) -> tuple[PETSc.Mat, np.ndarray, CSR, np.ndarray]:
+    """This rank's rows of B_t and the weighted slip that prescribed displacements add.
+
+    B_t: the tangential rows of the same kernel, in the layout's order (owned rows); also
+    all of them as a CSR, and which owned rows have a free tangential dof (a node on a
+    symmetry line or the axis has none: it cannot slip, its row carries no shear).
+    """
+    el = setup.elasticity
+    V = el.V
+    ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+    options: dict[str, object] = {"direction": "tangent"}
+    if basis is Basis.DUAL:
+        options["basis"] = basis
+    ops = []
+    for p in setup.pairs:
+        assert p.passive is not None  # obstacles are refused with friction
+        ops.append(contact_operator(kernel, p.active.surface, p.passive.surface, ndofs, **options))  # type: ignore[arg-type]
+    Bt = CSR.vstack([o.B for o in ops]) if len(ops) > 1 else ops[0].B
+    op = ContactOperator(Bt, np.zeros(Bt.shape[0]), setup.operator.weights)
+    dofs = np.vstack(
+        [p.active.surface.dofs for p in setup.pairs]
+        + [p.passive.surface.dofs for p in setup.pairs if p.passive is not None]
+    )
+    shift = prescribed_gap_shift(scene, el, op, dofs)
+    dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
+    B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
+    mine = setup.order[setup.layout.mine]
+    return B, shift[mine], Bt.rows(setup.order), constrained_rows(op, dirichlet)[mine]
+
+
+def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
+    """A distributed vector holding this rank's `values`."""
+    v = PETSc.Vec().createMPI((len(values), PETSc.DETERMINE), comm=comm)  # type: ignore[arg-type]
+    v.array[:] = values
+    return v
+
+
+class FrictionIteration:
+    """Frictional saddle-point solves on a set, and the three-set update (the loop's Iteration)."""
+
+    label = "friction"
+    probing = False
+
+    def __init__(
+        self,
+        scene: Scene,
+        setup: ContactSetup,
+        Bt: PETSc.Mat,
+        shift_t: np.ndarray,
+        free_t: np.ndarray,
+    ) -> None:
+        self.setup, self.Bt, self.shift_t, self.free_t = setup, Bt, shift_t, free_t
+        layout = setup.layout
+        self.mu = np.array([scene.contacts[int(k)].mu for k in layout.pair[layout.mine]])
+        self.c = setup.e_max / setup.h
+        m = len(layout.mine)
+        # The first set sticks wherever friction acts; the sign of a slip row is its tau's.
+        self.stick = self.mu > 0.0
+        self.sign = np.ones(m)
+        self.ut_prev = np.zeros(m)  # the weighted slip at the previous load step
+        self.u = fem.Function(setup.elasticity.V, name="u")
+        self.lam_t = np.zeros(m)
+        self.slip = np.zeros(m)
+        self.status = np.zeros(m, dtype=np.int64)
+        self.offset = layout.offset
+
+    def key(self, active: np.ndarray) -> np.ndarray:
+        """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
+        return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+
+    def solve(self, active: np.ndarray, it: int) -> Step:
+        """One LU solve of the frictional saddle point on `active` and the friction sets."""
+        setup, comm = self.setup, self.setup.comm
+        el = setup.elasticity
+        on = np.asarray(active, dtype=float)
+        # A row without a free tangential dof neither sticks nor slips: lambda_t = 0.
+        stick = active & self.stick & self.free_t
+        slip = active & ~self.stick & self.free_t
+        # Row blocks: the normal rows where in contact, the tangential rows where sticking.
+        Bn_a, Bt_a = setup.B.copy(), self.Bt.copy()
+        Bn_a.diagonalScale(L=_vec(comm, on))
+        Bt_a.diagonalScale(L=_vec(comm, stick.astype(float)))
+        BnT, BtT = setup.B.copy().transpose(), self.Bt.copy().transpose()
+        Cnn = diagonal_matrix(setup.B.getComm(), 1.0 - on, self.offset)
+        Ctn = diagonal_matrix(
+            setup.B.getComm(), np.where(slip, self.mu * self.sign, 0.0), self.offset
+        )
+        Ctt = diagonal_matrix(setup.B.getComm(), 1.0 - stick, self.offset)
+        nest = PETSc.Mat().createNest(
+            [[el.K, BnT, BtT], [Bn_a, Cnn, None], [Bt_a, Ctn, Ctt]],  # type: ignore[list-item]
+            comm=setup.B.getComm(),
+        )
+        rows, _ = nest.getNestISs()
+        A = nest.convert("aij", PETSc.Mat())
+        b = A.createVecRight()
+        parts = (
+            el.f.array_r,
+            np.where(active, -setup.g, 0.0),
+            np.where(stick, self.ut_prev - self.shift_t, 0.0),
+        )
+        for iset, values in zip(rows, parts, strict=True):
+            sub = b.getSubVector(iset)
+            sub.array[:] = values
+            b.restoreSubVector(iset, sub)
+        x = b.duplicate()
+        ksp = PETSc.KSP().create(A.getComm())
+        ksp.setOperators(A)
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.solve(b, x)
+        if ksp.getConvergedReason() < 0:  # type: ignore[operator]
+            raise SolverError(
+                f"the frictional saddle point's LU failed ({ksp.getConvergedReason()})"
+            )
+        out = []
+        for iset in rows:
+            sub = x.getSubVector(iset)
+            out.append(sub.array_r.copy())
+            x.restoreSubVector(iset, sub)
+        for obj in (ksp, A, nest, Bn_a, Bt_a, BnT, BtT, Cnn, Ctn, Ctt, b, x):
+            obj.destroy()
+        u, mu_n, mu_t = out
+        self.u.x.petsc_vec.array[:] = u
+        self.u.x.scatter_forward()
+        lam_n, lam_t = np.where(active, -mu_n, 0.0), np.where(active, mu_t, 0.0)
+        gap = setup.normalized_gap(self.u)
+        y = self.Bt.createVecLeft()
+        self.Bt.mult(self.u.x.petsc_vec, y)
+        ut = y.array_r + self.shift_t
+        y.destroy()
+        w = setup.w
+        inc = np.where(self.free_t, (ut - self.ut_prev) / w, 0.0)  # fixed rows: no slip
+        status = classify(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
+        tau = lam_t + self.c * inc
+        new_active = status != Status.OPEN
+        new_stick = status == Status.STICK
+        new_sign = np.where(status == Status.SLIP, np.where(tau >= 0.0, 1.0, -1.0), self.sign)
+        changed = (
+            new_active
+            & active
+            & ((new_stick != self.stick) | (~new_stick & (new_sign != self.sign)))
+        )
+        n_changed = comm.allreduce(int(changed.sum()))
+        self.stick = np.where(new_active, new_stick, self.stick)
+        self.sign = new_sign
+        cn, ct = ncp(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
+        lam_max = comm.allreduce(float(np.abs(lam_n).max(initial=0.0)), op=MPI.MAX)
+        resid = np.sqrt(comm.allreduce(float(np.sum(w * (cn**2 + ct**2)))))
+        resid /= max(lam_max * np.sqrt(comm.allreduce(float(w.sum()))), 1e-300)
+        self.lam_t, self.slip, self.status = lam_t, ut / w, status
+        n_stick = comm.allreduce(int(np.sum(status == Status.STICK)))
+        n_slip = comm.allreduce(int(np.sum(status == Status.SLIP)))
+        record: dict[str, float] = {"stick": n_stick, "slip": n_slip, "friction_changed": n_changed}
+        text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, complementarity {resid:.2e}, "
+        return Step(lam_n, gap, new_active, float(resid), record, text, True, n_changed)
+
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
+        """The update's set (no probes on the frictional path)."""
+        return None
+
+
+@dataclass(frozen=True)
+class StepState:
+    """What a converged load step hands the next (owned rows): its sets and tangential motion."""
+
+    active: np.ndarray
+    sign: np.ndarray
+    ut: np.ndarray  # the weighted tangential displacement B_t u (+ prescribed) at its end
+
+
+def solve_friction(
+    scene: Scene, request: SolveRequest, timers: Timers, aso: ActiveSetOptions
+) -> Solution:
+    """Solve `scene` with Coulomb friction on its pairs, step by step.
+
+    `refuse_friction` has passed. Each load step's slip increment is measured from the step
+    before (quasi-static).
+    """
+    sols: list[Solution] = []
+    state: StepState | None = None
+    for k, step_scene in enumerate(step_scenes(scene)):
+        sol, state = _solve_step(step_scene, request, timers, aso, state)
+        if scene.steps and scene.comm.rank == 0:
+            log.info("step %d: %d iterations", k + 1, sol.iterations)
+        sols.append(sol)
+    if scene.steps:
+        sols[-1].steps = sols
+    return sols[-1]
+
+
+def _solve_step(
+    scene: Scene,
+    request: SolveRequest,
+    timers: Timers,
+    aso: ActiveSetOptions,
+    before: StepState | None,
+) -> tuple[Solution, StepState]:
+    """One load step of `solve_friction`, from the state the step before left."""
+    kernel = request.discretization.kernel
+    try:
+        setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
+    except SingularSystemError as err:
+        raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
+    try:
+        with timers("contact"):
+            Bt, shift_t, tangent, free_t = tangent_constraint(scene, setup, request.basis, kernel)
+        iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t)
+        # The first set: the rows within h / 10 of touching (no predictor on this path; a
+        # curved contact touching at one node would leave the body free to rotate).
+        active = setup.initial_active(START_BAND * setup.h)
+        if before is not None:
+            if len(before.active) != len(active):
+                raise SolverError("the contact rows changed between load steps")
+            active = active | before.active
+            # A new step starts from stick wherever friction acts (as the first step does):
+            # the increment is small, and starting from the last step's slip made an
+            # unloading step cycle (tests/methods/test_friction.py, the pull back).
+            iteration.sign, iteration.ut_prev = before.sign.copy(), before.ut.copy()
+        try:
+            step, active, history = run_active_set(setup, iteration, active, aso, timers)
+        finally:
+            Bt.destroy()
+        sol = finish(
+            setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
+        )
+    finally:
+        setup.destroy()
+    sol.basis = request.basis
+    status = np.where(active, iteration.status, Status.OPEN)
+    comm = setup.comm
+    sol.friction = FrictionResult(
+        mu=np.concatenate(comm.allgather(iteration.mu)),
+        shear=np.concatenate(comm.allgather(np.where(active, iteration.lam_t, 0.0))),
+        slip=np.concatenate(comm.allgather(iteration.slip)),
+        status=np.concatenate(comm.allgather(status)),
+        tangent=tangent,
+    )
+    after = StepState(active, iteration.sign, iteration.slip * setup.w)
+    return sol, after
