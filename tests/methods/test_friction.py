@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from contactfx import ContactPair, Obstacle, scene_from_gmsh, solve
+from contactfx import ContactPair, Obstacle, SolveRequest, scene_from_gmsh, solve
 from contactfx.contact.friction import Status
 from contactfx.errors import InputError, SingularSystemError
 from contactfx.methods.solution import Solution
@@ -205,7 +205,7 @@ def test_summary_carries_the_shear_and_the_statuses() -> None:
     from contactfx import run_scene
     from contactfx.cli.solve import terminal_summary
 
-    sol, run = run_scene(pushed(MU, 0.05), "mortar")
+    sol, run = run_scene(pushed(MU, 0.05), SolveRequest.parse("mortar"))
     pair = run.to_json()["contacts"][0]
     assert pair["force"][0] == pytest.approx(-MU * P, rel=1e-10)
     assert pair["force"][1] == pytest.approx(P, rel=1e-10)
@@ -216,7 +216,9 @@ def test_summary_carries_the_shear_and_the_statuses() -> None:
     assert len(itf["shear"]) == len(itf["slip"]) == len(itf["pressure"])
     n_slip = itf["status"].count("slip")
     assert any(f"0 stick, {n_slip} slip" in line for line in terminal_summary(run))
-    frictionless = run_scene(pushed(0.0, 0.05), "mortar")[1].to_json()["contacts"][0]
+    frictionless = run_scene(pushed(0.0, 0.05), SolveRequest.parse("mortar"))[1].to_json()[
+        "contacts"
+    ][0]
     assert not {"shear", "slip", "status"} & frictionless["interface"].keys()
 
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, cli
 
-from contactfx import ContactPair, load_scene_file, run_scene
+from contactfx import ContactPair, SolveRequest, load_scene_file, run_scene
 from contactfx.errors import InputError
 
 SCENES = ROOT / "tests" / "scenes"
@@ -60,12 +60,12 @@ def test_frictional_pair_is_read_and_solved_or_refused(tmp_path: Path) -> None:
     refuse it in one line."""
     scene = load_scene_file(stacked(tmp_path, "0.3"))
     assert [p.mu for p in scene.contacts] == [0.3, 0.0, 0.0]
-    sol, _ = run_scene(scene, "mortar")
+    sol, _ = run_scene(scene, SolveRequest.parse("mortar"))
     assert sol.friction is not None
     np.testing.assert_array_equal(np.unique(sol.friction.mu), [0.0, 0.3])
     for method in ("sts", "penalty", "schwarz"):
         with pytest.raises(InputError, match=r"contact 0 \('b2_bottom' on 'b1_top'\) has mu = 0.3"):
-            run_scene(scene, method)
+            run_scene(scene, SolveRequest.parse(method))
 
 
 def test_builtin_mu_option_reaches_the_pair() -> None:
@@ -124,8 +124,10 @@ def test_bad_step_is_one_line(tmp_path: Path, step: str, expected: str) -> None:
 
 def test_mu_zero_is_the_frictionless_scene_bit_for_bit(tmp_path: Path) -> None:
     """`mu = 0` written out is the scene without the key: same pressures and displacement."""
-    plain = run_scene(load_scene_file(SCENES / "stacked_blocks.toml"), "mortar")[0]
-    zero = run_scene(load_scene_file(stacked(tmp_path, "0.0")), "mortar")[0]
+    plain = run_scene(
+        load_scene_file(SCENES / "stacked_blocks.toml"), SolveRequest.parse("mortar")
+    )[0]
+    zero = run_scene(load_scene_file(stacked(tmp_path, "0.0")), SolveRequest.parse("mortar"))[0]
     assert zero.friction is None
     np.testing.assert_array_equal(zero.pressure, plain.pressure)
     np.testing.assert_array_equal(zero.u.x.array, plain.u.x.array)
