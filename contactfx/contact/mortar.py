@@ -51,6 +51,7 @@ import numpy as np
 
 from .geometry import Surface, chains, nodal_normals, radial_weight, segment_lengths
 from .operator import (
+    FRAMES,
     REACH,
     ContactOperator,
     assemble,
@@ -363,6 +364,13 @@ def mortar_matrices(
     return D, M
 
 
+def _frame_normals(active: Surface, seg: np.ndarray, frame: str) -> np.ndarray | None:
+    """The active normals that set the rows' frame (None: the passive surface's frame)."""
+    if frame not in FRAMES:
+        raise ValueError(f"unknown frame {frame!r} (known: {', '.join(FRAMES)})")
+    return active.normals[seg] if frame == "bisector" else None
+
+
 def contact_operator(
     active: Surface,
     passive: Surface,
@@ -370,11 +378,14 @@ def contact_operator(
     basis: str = "standard",
     ends: bool = True,
     direction: str = "normal",
+    frame: str = "passive",
 ) -> ContactOperator:
     """Mortar operator: exact Gauss integration on sub-segments, normal of the paired segment.
 
     direction="tangent": the same D/M weights with the paired segment's tangent (the weighted
     slip rows of friction; `gap` is then the weighted tangential offset, not a gap).
+    frame="bisector": the normal (or tangent) of the bisector of the paired segment and the
+    active one (operator.bisector_normals; friction's frame).
     """
     # Row j = int phi_j n . (x_active - x_passive), phi = N_j (standard) or psi_j (dual).
     seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis, ends)
@@ -390,6 +401,8 @@ def contact_operator(
         act_coef=na,
         pas_nodes=passive.segments[seg_p],
         pas_coef=linear_shape(eta),
-        normal=row_directions(passive.normals[seg_p], direction),
+        normal=row_directions(
+            passive.normals[seg_p], direction, _frame_normals(active, seg_a, frame)
+        ),
         group=GAUSS_POINTS,
     )

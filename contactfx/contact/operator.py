@@ -106,8 +106,36 @@ def tangents(normals: np.ndarray) -> np.ndarray:
     return np.stack([normals[:, 1], -normals[:, 0]], axis=1)
 
 
-def row_directions(normals: np.ndarray, direction: str) -> np.ndarray:
-    """The normals themselves (the gap rows) or their tangents (the slip rows of friction)."""
+#: Frames of a contact operator's rows: the passive surface's, or the bisector of both.
+FRAMES = ("passive", "bisector")
+
+
+def bisector_normals(passive_normals: np.ndarray, active_normals: np.ndarray) -> np.ndarray:
+    """Unit normals of the bisector of two facing surfaces, oriented as the passive ones.
+
+    On curved surfaces the passive normal is tilted from the interface the two press into by
+    half the angle between them. Friction needs that interface's frame: along the passive
+    tangent, the closing of the initial gap reads as slip, and a pressure along the passive
+    normal carries a shear, so mirrored cylinders pressed with friction locked in a shear
+    that the physics (their mirror symmetry) rules out (docs/friction.md, Cattaneo-Mindlin).
+    The bisector is the same whichever side is active, and the passive normal on flat faces.
+    """
+    n = passive_normals - active_normals
+    return n / np.linalg.norm(n, axis=1)[:, None]
+
+
+def row_directions(
+    normals: np.ndarray,
+    direction: str,
+    active_normals: np.ndarray | None = None,
+) -> np.ndarray:
+    """The normals themselves (the gap rows) or their tangents (the slip rows of friction).
+
+    `active_normals` (the facing active surface's outward normals at the same points): the
+    frame is the bisector's (`bisector_normals`), not the passive surface's.
+    """
+    if active_normals is not None:
+        normals = bisector_normals(normals, active_normals)
     if direction == "normal":
         return normals
     if direction == "tangent":

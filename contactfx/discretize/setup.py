@@ -219,8 +219,13 @@ def prepare_contact(
     penetration_tol: float,
     timers: Timers,
     basis: Basis = Basis.STANDARD,
+    frame: str = "passive",
 ) -> ContactSetup:
-    """Assemble K and f, build every pair's operator and B, and check the geometry."""
+    """Assemble K and f, build every pair's operator and B, and check the geometry.
+
+    frame: the rows' normals, the passive surface's or (friction, pairs between bodies) the
+    bisector of both surfaces' (contact/operator.bisector_normals).
+    """
     comm = scene.comm
     el, ndofs, gathered = assemble_and_gather(scene, timers)
     V = el.V
@@ -228,7 +233,10 @@ def prepare_contact(
     with timers("search"):
         obstacles = gather_obstacles(scene, V)
     with timers("contact"):
-        pairs = all_pairs(gathered, obstacles, kernel, ndofs, **({"basis": basis} if dual else {}))
+        framed: dict[str, object] = {} if frame == "passive" else {"frame": frame}
+        pairs = all_pairs(
+            gathered, obstacles, kernel, ndofs, **({"basis": basis} if dual else {}), **framed
+        )
         for p in pairs:
             if p.passive is None:
                 check_obstacle_geometry(p)
@@ -263,7 +271,7 @@ def prepare_contact(
     if dual:
         # A dual (sign-changing) weighting averages the gap with negative weights: check
         # for overlap with the standard, positive weights (geometry, not the multipliers).
-        std = stack(all_pairs(gathered, obstacles, kernel, ndofs))[1]
+        std = stack(all_pairs(gathered, obstacles, kernel, ndofs, **framed))[1]
         g_all = (std.gap[order] + shift[order]) / std.weights[order]
     h = contact_size(w_all, layout.x, scene.model)
     pairs = check_overlaps(pairs, layout, g_all, penetration_tol * h)

@@ -53,6 +53,11 @@ log = logging.getLogger("contactfx")
 # The first set's band of normalized gaps, relative to the contact element size.
 START_BAND = 0.1
 
+# The rows' frame: the bisector of the two surfaces (contact/operator.bisector_normals). In
+# the passive surface's frame, mirrored cylinders pressed with friction locked in a shear that
+# their symmetry rules out, and the pushed stick zone sat off-centre (docs/friction.md).
+FRAME = "bisector"
+
 SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
 
 
@@ -96,7 +101,7 @@ def tangent_constraint(
     el = setup.elasticity
     V = el.V
     ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-    options: dict[str, object] = {"direction": "tangent"}
+    options: dict[str, object] = {"direction": "tangent", "frame": FRAME}
     if basis is Basis.DUAL:
         options["basis"] = basis
     ops = []
@@ -287,7 +292,9 @@ def _solve_step(
     """One load step of `solve_friction`, from the state the step before left."""
     kernel = request.discretization.kernel
     try:
-        setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, request.basis)
+        setup = prepare_contact(
+            scene, kernel, aso.penetration_tol, timers, request.basis, frame=FRAME
+        )
     except SingularSystemError as err:
         raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
     try:
