@@ -51,11 +51,11 @@ import numpy as np
 
 from .geometry import Surface, chains, nodal_normals, radial_weight, segment_lengths
 from .operator import (
-    FRAMES,
     REACH,
     ContactOperator,
     assemble,
     end_rows,
+    frame_normals,
     gauss_unit,
     linear_shape,
     row_directions,
@@ -364,13 +364,6 @@ def mortar_matrices(
     return D, M
 
 
-def _frame_normals(active: Surface, seg: np.ndarray, frame: str) -> np.ndarray | None:
-    """The active normals that set the rows' frame (None: the passive surface's frame)."""
-    if frame not in FRAMES:
-        raise ValueError(f"unknown frame {frame!r} (known: {', '.join(FRAMES)})")
-    return active.normals[seg] if frame == "bisector" else None
-
-
 def contact_operator(
     active: Surface,
     passive: Surface,
@@ -382,10 +375,8 @@ def contact_operator(
 ) -> ContactOperator:
     """Mortar operator: exact Gauss integration on sub-segments, normal of the paired segment.
 
-    direction="tangent": the same D/M weights with the paired segment's tangent (the weighted
-    slip rows of friction; `gap` is then the weighted tangential offset, not a gap).
-    frame="bisector": the normal (or tangent) of the bisector of the paired segment and the
-    active one (operator.bisector_normals; friction's frame).
+    direction="tangent": the same D/M weights with the paired segment's tangent (friction's
+    slip rows; `gap` the weighted tangential offset). frame="bisector": operator.FRAMES.
     """
     # Row j = int phi_j n . (x_active - x_passive), phi = N_j (standard) or psi_j (dual).
     seg_a, seg_p, xi, eta, w, phi, rows = _multiplier_points(active, passive, basis, ends)
@@ -402,7 +393,7 @@ def contact_operator(
         pas_nodes=passive.segments[seg_p],
         pas_coef=linear_shape(eta),
         normal=row_directions(
-            passive.normals[seg_p], direction, _frame_normals(active, seg_a, frame)
+            passive.normals[seg_p], direction, frame_normals(active, seg_a, frame)
         ),
         group=GAUSS_POINTS,
     )

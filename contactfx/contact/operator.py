@@ -106,7 +106,8 @@ def tangents(normals: np.ndarray) -> np.ndarray:
     return np.stack([normals[:, 1], -normals[:, 0]], axis=1)
 
 
-#: Frames of a contact operator's rows: the passive surface's, or the bisector of both.
+#: Frames of a contact operator's rows: the passive surface's, or the bisector of both (the
+#: passive and the facing active segment's; friction's, `bisector_normals`).
 FRAMES = ("passive", "bisector")
 
 
@@ -122,6 +123,13 @@ def bisector_normals(passive_normals: np.ndarray, active_normals: np.ndarray) ->
     """
     n = passive_normals - active_normals
     return n / np.linalg.norm(n, axis=1)[:, None]
+
+
+def frame_normals(active: Surface, seg: np.ndarray, frame: str) -> np.ndarray | None:
+    """The active normals on segments `seg` that set a bisector frame; None: the passive one."""
+    if frame not in FRAMES:
+        raise ValueError(f"unknown frame {frame!r} (known: {', '.join(FRAMES)})")
+    return active.normals[seg] if frame == "bisector" else None
 
 
 def row_directions(
