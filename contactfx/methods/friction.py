@@ -4,7 +4,8 @@ Each contact row j carries a normal multiplier lambda_n (a pressure) and a tange
 lambda_t (the traction on the active body is -lambda_t t, t = (n_y, -n_x) of the bisector of
 the two surfaces, FRAME). A set of the primal-dual active set (Hueber, Stadler and Wohlmuth
 2008) fixes each row's law, and the saddle point
-[[K, B_n^T, B_t^T], [B_n', C_nn, 0], [B_t', C_tn, C_tt]] is linear on it (multipliers mu_n = -lambda_n, mu_t = +lambda_t, so K u + B^T mu = f):
+[[K, B_n^T, B_t^T], [B_n', C_nn, 0], [B_t', C_tn, C_tt]] is linear on it (multipliers
+mu_n = -lambda_n, mu_t = +lambda_t, so K u + B^T mu = f):
 
     open:  lambda_n = 0, lambda_t = 0                 (B rows off, C = 1)
     stick: weighted gap 0, weighted slip increment 0  (B_n, B_t rows on)
