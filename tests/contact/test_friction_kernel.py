@@ -184,3 +184,26 @@ def test_tangential_rows_on_a_tilted_line():
             u = np.zeros(nd)
             u[active.dofs] = 0.01 * move
             np.testing.assert_allclose(slip.B @ u, 0.01 * expect * slip.weights, atol=1e-15)
+
+
+@pytest.mark.parametrize(("kernel", "options"), KERNELS)
+def test_bisector_frame_of_mirrored_arcs(kernel, options):
+    """Two arcs mirrored about y = 0 (y = -+x^2 / 2, R = 1, segments h = 0.075): closing the
+    gap (the active arc moved by d towards the passive one) reads as a slip of d times the
+    tilt of the rows' tangent from the interface (x). In the bisector frame that tilt is at
+    most half a segment's turn (h / 2R), whichever arc is active; in the passive arc's frame
+    it is the slope, about 0.25 at the ends."""
+    x = np.linspace(-0.3, 0.3, 9)
+    lower = polyline(x, -0.5 * x**2, True, 0)
+    upper = polyline(x, 0.5 * x**2, False, 2 * len(x))
+    nd, d, h = 4 * len(x), 0.01, 0.075
+    for active, passive in ((upper, lower), (lower, upper)):
+        tangent = {"direction": "tangent", **options}
+        bis = contact_operator(kernel, active, passive, nd, frame="bisector", **tangent)
+        own = contact_operator(kernel, active, passive, nd, **tangent)
+        close = np.zeros(nd)
+        close[active.dofs[:, 1]] = d * np.sign(passive.normals[0, 1]) * -1.0
+        assert np.all(np.abs(bis.B @ close) <= d * h / 2 * bis.weights + 1e-16)
+        assert np.max(np.abs(own.B @ close) / np.maximum(own.weights, 1e-300)) > 0.2 * d
+    with pytest.raises(ValueError, match="unknown frame"):
+        contact_operator(kernel, upper, lower, nd, frame="active", **options)
