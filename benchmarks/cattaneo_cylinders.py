@@ -9,8 +9,10 @@ contactfx.results.friction_references.cattaneo_errors. The table of docs/frictio
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/cattaneo_cylinders.py 0.004 0.03 0.01
     OPENBLAS_NUM_THREADS=1 python benchmarks/cattaneo_cylinders.py 0.0012 0.0037 0.0008
+    OPENBLAS_NUM_THREADS=1 python benchmarks/cattaneo_cylinders.py 0.002 0.03 0.01
 
-(arguments: h, press, push; the second about a minute on one loaded core).
+(arguments: h, press, push; the second about a minute on one loaded core). Rows in the
+bisector frame (docs/friction.md).
 """
 
 from __future__ import annotations
