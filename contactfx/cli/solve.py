@@ -156,8 +156,8 @@ def run(args: argparse.Namespace) -> int:
         if args.out is not None:
             written = write_contact_surfaces(record, args.out)
             written += [
-                plot_pair(record, k, args.out / f"interface_pair{k}.png")
-                for k in range(len(record.contacts))
+                plot_pair(record, k, args.out / f"interface_pair{k}.png", pv.pair.mu)
+                for k, pv in enumerate(sol.pairs)
             ]
             if record.interface is not None:
                 written.append(plot_interface(record, args.out / "interface.png"))

@@ -228,8 +228,30 @@ def plot_interface(run: RunSummary, path: Path, title: str = "") -> Path:
     return path
 
 
-def plot_pair(run: RunSummary, k: int, path: Path) -> Path:
-    """Chart pair k along s: pressure, -sigma_nn and sigma_nt of both bodies (and Hertz)."""
+def stick_spans(s: np.ndarray, status: Sequence[str]) -> list[tuple[float, float]]:
+    """The runs of consecutive `stick` nodes along s, each as (first s, last s).
+
+    `s` sorted (the interface columns are); a lone stick node is a span of zero length.
+    """
+    spans: list[tuple[float, float]] = []
+    start: float | None = None
+    for i, st in enumerate(status):
+        if st == "stick" and start is None:
+            start = float(s[i])
+        if st != "stick" and start is not None:
+            spans.append((start, float(s[i - 1])))
+            start = None
+    if start is not None:
+        spans.append((start, float(s[len(status) - 1])))
+    return spans
+
+
+def plot_pair(run: RunSummary, k: int, path: Path, mu: float = 0.0) -> Path:
+    """Chart pair k along s: pressure, -sigma_nn and sigma_nt of both bodies (and Hertz).
+
+    A frictional pair (`mu` > 0 and the interface's `shear` and `status` columns) also gets
+    |shear| and mu p on the traction axes, with its stick zones shaded.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -273,6 +295,8 @@ def plot_pair(run: RunSummary, k: int, path: Path) -> Path:
         ax.set_xlim(*zoom)
     if active.any():
         ax.axvspan(s[active].min(), s[active].max(), color="0.9", zorder=0, label="active set")
+    if mu > 0.0 and "shear" in itf and "status" in itf:
+        _draw_friction(ax, s, arr("pressure"), arr("shear"), itf["status"], mu)
     # Traction scale of the chart: a curve uniform to round-off against it is drawn flat.
     scale = float(np.nanmax(np.abs(arr("pressure")), initial=0.0))
     for a_ in (ax, bx):
@@ -294,6 +318,19 @@ def plot_pair(run: RunSummary, k: int, path: Path) -> Path:
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def _draw_friction(
+    ax: Any, s: np.ndarray, p: np.ndarray, shear: np.ndarray, status: Sequence[str], mu: float
+) -> None:
+    """|shear| and the Coulomb bound mu p along s, the stick zones shaded (one legend entry)."""
+    ax.plot(s, np.abs(shear), "b.-", ms=3, lw=1, label="|shear| (multipliers)")
+    ax.plot(s, mu * p, "g--", lw=1, label=f"mu p (mu = {mu:g})")
+    for i, (lo, hi) in enumerate(stick_spans(s, status)):
+        span = ax.axvspan(lo, hi, color="tab:blue", alpha=0.15, zorder=0)
+        span.set_gid("stick")
+        if i == 0:
+            span.set_label("stick")
 
 
 def plot_hertz_profiles(runs: Sequence[tuple[str, RunSummary]], path: Path) -> Path:

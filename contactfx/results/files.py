@@ -75,7 +75,37 @@ def field_grid(sol: Solution, cell_fields: tuple[fem.Function, ...] = ()) -> Any
     grid.cell_data["E"] = E.x.array[E.function_space.dofmap.list[:ncells, 0]]
     for f in cell_fields:
         grid.cell_data[f.name] = f.x.array[f.function_space.dofmap.list[:ncells, 0]]
+    if sol.friction is not None:
+        status, shear = contact_point_fields(sol)
+        grid.point_data["contact_status"] = status
+        grid.point_data["shear"] = shear
     return grid
+
+
+# contact_status off the contact surfaces (docs/usage.md): the multiplier nodes carry
+# contact/friction.Status (0 open, 1 stick, 2 slip).
+NOT_CONTACT = -1
+
+
+def contact_point_fields(sol: Solution) -> tuple[np.ndarray, np.ndarray]:
+    """Each of this rank's points: its friction status and shear (frictional solves only).
+
+    The points are V's local dof blocks (those of `field_grid`). A point that carries no
+    multiplier gets status NOT_CONTACT and shear NaN; a node of two pairs shows the last.
+    """
+    fr = sol.friction
+    assert fr is not None, "contact_point_fields needs a frictional solution"
+    imap = sol.fields.V.dofmap.index_map
+    gblocks = imap.local_to_global(np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32))
+    status = np.full(len(gblocks), NOT_CONTACT, dtype=np.int32)
+    shear = np.full(len(gblocks), np.nan)
+    order = np.argsort(gblocks)
+    for pv in sol.pairs:
+        at = np.searchsorted(gblocks, pv.gblock, sorter=order).clip(max=len(order) - 1)
+        here = gblocks[order[at]] == pv.gblock  # the pair's nodes this rank holds
+        status[order[at[here]]] = fr.status[pv.rows[here]]
+        shear[order[at[here]]] = fr.shear[pv.rows[here]]
+    return status, shear
 
 
 def write_fields(

@@ -124,6 +124,7 @@ def test_every_out_file_opens_with_pyvista_and_holds_u_sigma_e(tmp_path: Path) -
     assert sum(n.endswith(".vtp") for n in got) == len(data["contacts"]) == 3
     assert sum(n.endswith(".png") for n in got) == 3  # one chart per pair
     check_fields(got["fields.pvtu"], data)
+    assert "point:contact_status" not in got["fields.pvtu"]  # frictionless: no status field
     vtp = got["contact0_b2_bottom.vtp"]
     np.testing.assert_allclose(vtp["point:pressure"][vtp["point:active"] == 1], P, rtol=1e-8)
 
@@ -153,3 +154,38 @@ def test_the_json_gets_the_mode_of_any_new_file(tmp_path: Path, umask: int) -> N
     mode = (tmp_path / "r.json").stat().st_mode & 0o777
     assert mode == 0o666 & ~umask == (tmp_path / "other.txt").stat().st_mode & 0o777
     assert json.loads((tmp_path / "r.json").read_text()) == {"a": 1}
+
+
+@pytest.mark.serial
+def test_a_frictional_solve_writes_each_contact_nodes_status_and_shear(tmp_path: Path) -> None:
+    """fields.pvtu of a pushed block (mortar, mu = 0.3): `contact_status` is -1 off the
+    contact surface and each multiplier node's Status (0 open, 1 stick, 2 slip) on it,
+    `shear` its tangential multiplier; the push leaves both stick and slip nodes."""
+    from contactfx import ContactPair, scene_from_gmsh, solve
+    from contactfx.contact.friction import Status
+    from contactfx.results.files import write_fields
+    from contactfx.scenes import Dirichlet, Material, Pressure
+
+    scene = scene_from_gmsh(
+        ROOT / "tests" / "scenes" / "friction_blocks.geo",
+        bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
+        contacts=[ContactPair("block_bottom", "base_top", mu=0.3)],
+        dirichlet=[Dirichlet("base_bottom", ux=0.0, uy=0.0), Dirichlet("block_top", ux=0.002)],
+        loads=[Pressure("block_top", P)],
+    )
+    sol = solve(scene, "mortar")
+    fr = sol.friction
+    assert fr is not None
+    assert (fr.status == Status.STICK).any() and (fr.status == Status.SLIP).any()
+    write_fields(sol, tmp_path / "out")
+    f = read_in_child([tmp_path / "out" / "fields.pvtu"], tmp_path)["fields.pvtu"]
+    status, shear = f["point:contact_status"], f["point:shear"]
+    on = status >= 0
+    assert on.sum() == len(fr.status)  # one point per multiplier node, every other -1
+    assert set(np.unique(status[~on])) == {-1} and np.isnan(shear[~on]).all()
+    for k in (Status.OPEN, Status.STICK, Status.SLIP):
+        assert (status == k).sum() == (fr.status == k).sum()
+    for xy, st, q in zip(sol.layout.x, fr.status, fr.shear, strict=True):
+        here = on & (np.abs(f["points"][:, :2] - xy).max(axis=1) < 1e-12)
+        assert here.sum() == 1 and status[here][0] == st
+        assert shear[here][0] == pytest.approx(q, abs=1e-12 * P)
