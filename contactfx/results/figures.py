@@ -295,7 +295,8 @@ def plot_pair(run: RunSummary, k: int, path: Path, mu: float = 0.0) -> Path:
         ax.set_xlim(*zoom)
     if active.any():
         ax.axvspan(s[active].min(), s[active].max(), color="0.9", zorder=0, label="active set")
-    if mu > 0.0 and "shear" in itf and "status" in itf:
+    frictional = mu > 0.0 and "shear" in itf and "status" in itf
+    if frictional:
         _draw_friction(ax, s, arr("pressure"), arr("shear"), itf["status"], mu)
     # Traction scale of the chart: a curve uniform to round-off against it is drawn flat.
     scale = float(np.nanmax(np.abs(arr("pressure")), initial=0.0))
@@ -305,7 +306,8 @@ def plot_pair(run: RunSummary, k: int, path: Path, mu: float = 0.0) -> Path:
         if band is not None:
             a_.set_ylim(*band)
     units = run.units
-    ax.set_ylabel(f"normal traction ({units.stress}, compression > 0)")
+    what = "normal traction, |shear|" if frictional else "normal traction"
+    ax.set_ylabel(f"{what} ({units.stress}, compression > 0)")
     bx.set_ylabel(f"sigma_nt ({units.stress})")
     bx.set_xlabel(f"s, arc length along the active surface ({units.length})")
     on = f"obstacle '{c.passive}'" if c.obstacle is not None else c.passive

@@ -106,6 +106,7 @@ def test_a_frictional_pairs_chart_draws_shear_mu_p_and_the_stick_zone(
     np.testing.assert_array_equal(lines["|shear| (multipliers)"].get_ydata(), np.abs(itf["shear"]))
     mu_p = lines[f"mu p (mu = {mu:g})"].get_ydata()
     np.testing.assert_allclose(mu_p, mu * np.asarray(itf["pressure"]))
+    assert "|shear|" in ax.get_ylabel()
     spans = [p for p in ax.patches if p.get_gid() == "stick"]
     assert spans  # the stick zones, beside the grey active set
     covered = np.zeros(len(s), dtype=bool)
