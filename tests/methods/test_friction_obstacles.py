@@ -151,3 +151,21 @@ def test_bad_mu_on_an_obstacle_is_refused_in_one_line(mu: object, tmp_path: Path
     with pytest.raises(InputError, match="mu") as err:
         load_scene_file(path)
     assert "\n" not in str(err.value)
+
+
+def test_summary_carries_the_shear_on_the_obstacle() -> None:
+    """The JSON's obstacle pair in full slip: the floor drags the block by mu P along +x, the
+    block holds the floor back by as much (the obstacle's force from its own columns, not
+    from the body's), and the interface carries shear, slip and status."""
+    from contactfx import SolveRequest, run_scene
+
+    scene = on_floor(
+        floor(MU, 0.05), [Dirichlet("block_top", ux=0.0)], [Pressure("block_top", P)], nu=0.3
+    )
+    _, run = run_scene(scene, SolveRequest.parse("mortar"))
+    pair = run.to_json()["contacts"][0]
+    assert pair["passive"] == "floor"
+    np.testing.assert_allclose(pair["force"], [MU * P, P], rtol=1e-10)
+    np.testing.assert_allclose(pair["force_passive"], [-MU * P, -P], rtol=1e-10)
+    assert set(pair["interface"]["status"]) <= {"open", "slip"}
+    assert "slip" in pair["interface"]["status"]
