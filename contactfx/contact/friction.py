@@ -78,6 +78,9 @@ class FrictionResult:
     slip: np.ndarray
     status: np.ndarray
     tangent: CSR  # the tangential rows B_t in the same order: -B_t^T shear is their force
+    # The rows' columns of a rigid obstacle's motion (m, 2), zero on body pairs' rows: the
+    # shear's force on an obstacle, -motion^T shear. None: no obstacle.
+    tangent_motion: CSR | None = None
 
 
 def _state(

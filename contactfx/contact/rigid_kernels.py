@@ -14,6 +14,12 @@ closest points as a passive "surface" of one node per point); they are split off
   polyline's ends), then Gauss points on each piece: 2 for a plane (N_j g is quadratic: exact),
   6 for a circle or a polyline (exact on pieces facing a segment, to ~(h/R)^12 on round ones).
   The dual basis is built from the same points (`mortar`'s biorthogonal construction).
+
+direction="tangent" (friction's slip rows): the same weights along the obstacle's exact tangent
+t = (n_y, -n_x) at each point; `gap` is then zero (the closest point lies along n) and `motion`
+the weighted slip that the obstacle's rigid motion adds. frame: accepted for the body pairs'
+signature; the rows' frame is always the obstacle's exact normal (a rigid surface is the
+interface the body presses into).
 """
 
 from __future__ import annotations
@@ -25,7 +31,7 @@ import numpy as np
 
 from .geometry import Surface, nodal_normals, radial_weight, segment_lengths
 from .mortar import SLIVER, _check_basis, _dual_values
-from .operator import ContactOperator, assemble, gauss_unit, linear_shape
+from .operator import FRAMES, ContactOperator, assemble, gauss_unit, linear_shape, row_directions
 from .rigid import Circle, Closest, Plane, Polyline, RigidShape
 from .sparse import CSR
 from .sts import gauss_points
@@ -67,8 +73,12 @@ def _assemble(
     act_nodes: np.ndarray,
     act_coef: np.ndarray,
     near: Closest,
+    direction: str = "normal",
+    frame: str = "passive",
 ) -> RigidOperator:
     """Point contributions against the closest points `near`; phantom columns split off."""
+    if frame not in FRAMES:
+        raise ValueError(f"unknown frame {frame!r} (known: {', '.join(FRAMES)})")
     k = len(near.gap)
     phantom = Surface(
         near.foot, np.zeros((0, 2)), np.zeros((0, 2)), np.tile([ndofs, ndofs + 1], (k, 1))
@@ -83,7 +93,7 @@ def _assemble(
         act_coef=act_coef,
         pas_nodes=np.arange(k)[:, None],
         pas_coef=np.ones((k, 1)),
-        normal=near.normal,
+        normal=row_directions(near.normal, direction),
     )
     body = full.B.columns(0, ndofs)  # assemble dropped the exact zeros already
     return RigidOperator(
@@ -156,7 +166,13 @@ def _select(near: Closest, keep: np.ndarray) -> Closest:
     return Closest(near.gap[keep], near.normal[keep], near.foot[keep], near.found[keep])
 
 
-def nts_operator(active: Surface, shape: RigidShape, ndofs: int) -> RigidOperator:
+def nts_operator(
+    active: Surface,
+    shape: RigidShape,
+    ndofs: int,
+    direction: str = "normal",
+    frame: str = "passive",
+) -> RigidOperator:
     """NTS: row j = w_j (g(x_j) + n(x_j) . (u_j - u_obstacle))."""
     w = overlap_weights(active, shape)
     near = shape.closest(active.x)
@@ -169,10 +185,18 @@ def nts_operator(active: Surface, shape: RigidShape, ndofs: int) -> RigidOperato
         act_nodes=j[:, None],
         act_coef=np.ones((len(j), 1)),
         near=_select(near, j),
+        direction=direction,
+        frame=frame,
     )
 
 
-def sts_operator(active: Surface, shape: RigidShape, ndofs: int) -> RigidOperator:
+def sts_operator(
+    active: Surface,
+    shape: RigidShape,
+    ndofs: int,
+    direction: str = "normal",
+    frame: str = "passive",
+) -> RigidOperator:
     """STS: row j = sum_gp w N_j (g + n . (u_active - u_obstacle)), 4 points per segment."""
     w, na, nodes = gauss_points(active)
     near = shape.closest(_points(active, nodes, na))
@@ -185,11 +209,18 @@ def sts_operator(active: Surface, shape: RigidShape, ndofs: int) -> RigidOperato
         act_nodes=nodes[f],
         act_coef=na[f],
         near=_select(near, f),
+        direction=direction,
+        frame=frame,
     )
 
 
 def mortar_operator(
-    active: Surface, shape: RigidShape, ndofs: int, basis: str = "standard"
+    active: Surface,
+    shape: RigidShape,
+    ndofs: int,
+    basis: str = "standard",
+    direction: str = "normal",
+    frame: str = "passive",
 ) -> RigidOperator:
     """Mortar: row j = int phi_j (g + n . (u_active - u_obstacle)) on the facing pieces."""
     _check_basis(basis)
@@ -212,6 +243,8 @@ def mortar_operator(
         act_nodes=nodes,
         act_coef=na,
         near=near,
+        direction=direction,
+        frame=frame,
     )
 
 
@@ -225,7 +258,10 @@ RIGID_OPERATORS: dict[str, Callable[..., RigidOperator]] = {
 def rigid_operator(
     kernel: str, active: Surface, shape: RigidShape, ndofs: int, **options: object
 ) -> RigidOperator:
-    """The operator of `kernel` (nts, sts, mortar) against `shape`; options: mortar's basis."""
+    """The operator of `kernel` (nts, sts, mortar) against `shape`.
+
+    options: mortar's basis, direction ("normal" or "tangent"), frame.
+    """
     return RIGID_OPERATORS[str(kernel)](active, shape, ndofs, **options)
 
 

@@ -19,8 +19,10 @@ stick/slip status or slip direction keeps it going (`Step.changed`, `SetHistory.
 The slip increment is measured from the previous load step (quasi-static).
 
 Supported: nts and mortar (standard and dual basis) with Lagrange multipliers on the direct
-saddle-point path, every model, pairs between bodies. Refused in one line (`refuse_friction`):
-sts, penalty, Schwarz, an iterative or condensed solver, rigid obstacles in a frictional scene.
+saddle-point path, every model, pairs between bodies and against rigid obstacles (their rows
+along the obstacle's exact tangent; the obstacle's prescribed motion enters the slip).
+Refused in one line (`refuse_friction`): sts, penalty, Schwarz, an iterative or condensed
+solver.
 With every mu = 0 nothing here runs: the frictionless path is unchanged.
 """
 
@@ -34,7 +36,7 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from ..contact import ContactOperator, contact_operator
+from ..contact import ContactOperator, contact_operator, rigid_operator
 from ..contact.friction import FrictionResult, Status, classify, ncp
 from ..contact.sparse import CSR
 from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
@@ -62,9 +64,23 @@ FRAME = "bisector"
 SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
 
 
+def pair_mu(scene: Scene) -> list[float]:
+    """Each pair's mu, by pair index: the contact pairs, then the obstacles."""
+    return [pair.mu for pair in scene.contacts] + [ob.mu for ob in scene.obstacles]
+
+
 def frictional_pairs(scene: Scene) -> list[int]:
-    """Indices (into `scene.contacts`) of the pairs with mu > 0."""
-    return [k for k, pair in enumerate(scene.contacts) if pair.mu > 0.0]
+    """Pair indices (into `scene.contacts`, then the obstacles) of the pairs with mu > 0."""
+    return [k for k, mu in enumerate(pair_mu(scene)) if mu > 0.0]
+
+
+def _pair_label(scene: Scene, k: int) -> str:
+    """How a refusal names pair `k`: a contact pair or an obstacle."""
+    if k < len(scene.contacts):
+        pair = scene.contacts[k]
+        return f"contact {k} ('{pair.active}' on '{pair.passive}') has mu = {pair.mu:g}"
+    ob = scene.obstacles[k - len(scene.contacts)]
+    return f"obstacle '{ob.name}' ('{ob.surface}' on it) has mu = {ob.mu:g}"
 
 
 def refuse_friction(scene: Scene, request: SolveRequest) -> None:
@@ -72,8 +88,6 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
     pairs = frictional_pairs(scene)
     if not pairs:
         return
-    k = pairs[0]
-    pair = scene.contacts[k]
     why = ""
     if request.enforcement is not Enforcement.MULTIPLIERS:
         why = f"the {request.enforcement.value} enforcement"
@@ -81,23 +95,24 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
         why = "sts"
     elif request.solver.kind not in (SolverKind.DIRECT, SolverKind.AUTO):
         why = f"the {request.solver.name} solver"
-    elif scene.obstacles:
-        why = "a scene with rigid obstacles"
     if why:
         raise InputError(
-            f"contact {k} ('{pair.active}' on '{pair.passive}') has mu = {pair.mu:g}: Coulomb "
-            f"friction is not solved with {why}; it is solved by {SUPPORTED} (or set mu = 0)"
+            f"{_pair_label(scene, pairs[0])}: Coulomb friction is not solved with {why}; it "
+            f"is solved by {SUPPORTED} (or set mu = 0)"
         )
 
 
 def tangent_constraint(
     scene: Scene, setup: ContactSetup, basis: Basis, kernel: object
-) -> tuple[PETSc.Mat, np.ndarray, CSR, np.ndarray]:
+) -> tuple[PETSc.Mat, np.ndarray, CSR, np.ndarray, CSR | None]:
     """This rank's rows of B_t and the weighted slip that prescribed displacements add.
 
     B_t: the tangential rows of the same kernel, in the layout's order (owned rows); also
     all of them as a CSR, and which owned rows have a free tangential dof (a node on a
-    symmetry line or the axis has none: it cannot slip, its row carries no shear).
+    symmetry line or the axis has none: it cannot slip, its row carries no shear). Against
+    an obstacle the rows follow its exact tangent, and its prescribed rigid motion (this
+    step's) enters the weighted slip: the body's motion relative to the obstacle; the last
+    item is the rows' obstacle-motion columns (all rows, layout order; None: no obstacle).
     """
     el = setup.elasticity
     V = el.V
@@ -105,21 +120,34 @@ def tangent_constraint(
     options: dict[str, object] = {"direction": "tangent", "frame": FRAME}
     if basis is Basis.DUAL:
         options["basis"] = basis
-    ops = []
+    ops, motion, columns = [], [], []
     for p in setup.pairs:
-        assert p.passive is not None  # obstacles are refused with friction
-        ops.append(contact_operator(kernel, p.active.surface, p.passive.surface, ndofs, **options))  # type: ignore[arg-type]
+        if p.passive is None:
+            assert p.obstacle is not None
+            ob = p.obstacle
+            rop = rigid_operator(kernel, p.active.surface, ob.geometry, ndofs, **options)  # type: ignore[arg-type]
+            ops.append(rop.operator)
+            motion.append(rop.motion @ np.asarray(ob.displacement, dtype=np.float64))
+            columns.append(rop.motion)
+        else:
+            pas = p.passive.surface
+            ops.append(contact_operator(kernel, p.active.surface, pas, ndofs, **options))  # type: ignore[arg-type]
+            n = p.active.surface.n_nodes
+            motion.append(np.zeros(n))
+            empty = np.zeros(0, dtype=np.int64)
+            columns.append(CSR.from_coo(empty, empty, np.zeros(0), (n, 2)))
     Bt = CSR.vstack([o.B for o in ops]) if len(ops) > 1 else ops[0].B
     op = ContactOperator(Bt, np.zeros(Bt.shape[0]), setup.operator.weights)
     dofs = np.vstack(
         [p.active.surface.dofs for p in setup.pairs]
         + [p.passive.surface.dofs for p in setup.pairs if p.passive is not None]
     )
-    shift = prescribed_gap_shift(scene, el, op, dofs)
+    shift = prescribed_gap_shift(scene, el, op, dofs) + np.concatenate(motion)
     dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
     B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
     mine = setup.order[setup.layout.mine]
-    return B, shift[mine], Bt.rows(setup.order), constrained_rows(op, dirichlet)[mine]
+    moving = CSR.vstack(columns).rows(setup.order) if scene.obstacles else None
+    return B, shift[mine], Bt.rows(setup.order), constrained_rows(op, dirichlet)[mine], moving
 
 
 def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
@@ -145,7 +173,8 @@ class FrictionIteration:
     ) -> None:
         self.setup, self.Bt, self.shift_t, self.free_t = setup, Bt, shift_t, free_t
         layout = setup.layout
-        self.mu = np.array([scene.contacts[int(k)].mu for k in layout.pair[layout.mine]])
+        mus = pair_mu(scene)
+        self.mu = np.array([mus[int(k)] for k in layout.pair[layout.mine]])
         self.c = setup.e_max / setup.h
         m = len(layout.mine)
         # The first set sticks wherever friction acts; the sign of a slip row is its tau's.
@@ -300,7 +329,9 @@ def _solve_step(
         raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
     try:
         with timers("contact"):
-            Bt, shift_t, tangent, free_t = tangent_constraint(scene, setup, request.basis, kernel)
+            Bt, shift_t, tangent, free_t, moving = tangent_constraint(
+                scene, setup, request.basis, kernel
+            )
         iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t)
         # The first set: the rows within h / 10 of touching (no predictor on this path; a
         # curved contact touching at one node would leave the body free to rotate).
@@ -331,6 +362,7 @@ def _solve_step(
         slip=np.concatenate(comm.allgather(iteration.slip)),
         status=np.concatenate(comm.allgather(status)),
         tangent=tangent,
+        tangent_motion=moving,
     )
     after = StepState(active, iteration.sign, iteration.slip * setup.w)
     return sol, after

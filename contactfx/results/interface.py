@@ -211,7 +211,11 @@ def pair_forces(sol: Solution, k: int) -> tuple[np.ndarray, np.ndarray]:
         nodal -= sol.friction.tangent.rows(pv.rows).transpose_matmul(sol.friction.shear[pv.rows])
     fa = np.array([nodal[pv.active.surface.dofs[:, c]].sum() for c in (0, 1)])
     if pv.motion is not None:  # a rigid obstacle: its force is its columns' share
-        return fa, pv.motion.transpose_matmul(sol.pressure[pv.rows])
+        fp = pv.motion.transpose_matmul(sol.pressure[pv.rows])
+        if sol.friction is not None and sol.friction.tangent_motion is not None:
+            moving = sol.friction.tangent_motion.rows(pv.rows)
+            fp = fp - moving.transpose_matmul(sol.friction.shear[pv.rows])
+        return fa, fp
     assert pv.passive is not None  # a body pair has a passive surface
     fp = np.array([nodal[pv.passive.surface.dofs[:, c]].sum() for c in (0, 1)])
     return fa, fp

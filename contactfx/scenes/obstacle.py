@@ -11,6 +11,7 @@ from types import MappingProxyType
 
 from ..contact.rigid import Circle, Plane, Polyline, RigidShape
 from ..errors import InputError
+from .fits import check_friction
 
 
 class Shape(StrEnum):
@@ -38,7 +39,9 @@ class Obstacle:
     `shape` "circle" (`center`, `radius`; the body outside), "plane" (`point`, `normal` from
     the obstacle towards the body) or "polyline" (`points` in order, the obstacle on the left,
     the body on the right; closed if the last point repeats the first). `displacement` is the
-    obstacle's prescribed rigid motion. InputError at once for a bad shape or parameter.
+    obstacle's prescribed rigid motion (`name` names it in load steps). `mu`: Coulomb's friction
+    coefficient against the body (0, the default: frictionless, the model unchanged).
+    InputError at once for a bad shape or parameter.
     """
 
     name: str
@@ -50,6 +53,7 @@ class Obstacle:
     normal: tuple[float, float] | None = None
     points: tuple[tuple[float, float], ...] | None = None
     displacement: tuple[float, float] = (0.0, 0.0)
+    mu: float = 0.0
 
     def __post_init__(self) -> None:
         where = f"obstacle '{self.name}'"
@@ -60,6 +64,7 @@ class Obstacle:
                 f"{where}: unknown shape {self.shape!r} (choose {', '.join(OBSTACLE_SHAPES)})"
             )
         object.__setattr__(self, "shape", Shape(self.shape))
+        object.__setattr__(self, "mu", check_friction(self.mu, where))
         takes = OBSTACLE_SHAPES[self.shape]
         for key in ("center", "radius", "point", "normal", "points"):
             given = getattr(self, key) is not None

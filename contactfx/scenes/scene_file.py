@@ -117,6 +117,8 @@ def _obstacle(k: int, entry: Any) -> Obstacle:
             values[key] = _vector(f"{where}.{key}", e[key])
     if "displacement" in e:
         values["displacement"] = _vector(f"{where}.displacement", e["displacement"])
+    if "mu" in e:
+        values["mu"] = _friction(f"{where}.mu", e["mu"])
     return Obstacle(name, shape, _string(f"{where}.surface", e["surface"]), **values)
 
 
@@ -147,10 +149,11 @@ def _name(where: str, e: dict[str, Any]) -> str | None:
 
 
 def _steps(
-    doc: dict[str, Any], bcs: list[Dirichlet], loads: list[Load]
+    doc: dict[str, Any], bcs: list[Dirichlet], loads: list[Load], obstacles: list[Obstacle]
 ) -> tuple[Mapping[str, float], ...]:
     """The [[step]] tables, checked against the loads' names (before anything is meshed)."""
     names = {x.name for x in (*bcs, *loads) if x.name is not None}
+    names |= {ob.name for ob in obstacles}  # an obstacle's name names its prescribed motion
     return check_steps(_entries(doc, "step"), names)
 
 
@@ -324,7 +327,7 @@ def parse_scene_file(path: Path) -> tuple[Path, SceneParts]:
         model,
         units,
         tuple(probes),
-        _steps(doc, bcs, loads),
+        _steps(doc, bcs, loads, obstacles),
     )
     return mesh, parts
 

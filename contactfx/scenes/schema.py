@@ -177,7 +177,8 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("name", "name", "obstacleK", "label in the JSON and the output files"),
         Key("shape", "string", None, f"one of {', '.join(OBSTACLE_SHAPES)}", "another shape"),
         Key("surface", _GROUP, None, "the body's curve group that may touch it"),
-        Key("displacement", "vector", "[0, 0]", "prescribed rigid motion"),
+        Key("displacement", "vector", "[0, 0]", "prescribed rigid motion (`name` in [[step]])"),
+        Key("mu", "number", "0", "Coulomb friction coefficient (0: frictionless)", "mu < 0"),
     ),
 }
 

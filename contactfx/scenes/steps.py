@@ -1,6 +1,7 @@
 """Load steps: factors on named loads, in order (friction depends on the load path).
 
-Any pressure, traction or Dirichlet condition may carry a `name`. Each step is a mapping of
+Any pressure, traction or Dirichlet condition may carry a `name`; an obstacle's `name` names
+its prescribed rigid motion (`displacement`). Each step is a mapping of
 load names to factors; a load without a name acts in full in every step, a named load that a
 step does not mention keeps its factor from the step before (0 before the first step). A
 scene without steps is one step with every load in full (the model unchanged).
@@ -18,8 +19,9 @@ from .model import Dirichlet, Load, Pressure, Scene, Traction
 
 
 def load_names(scene: Scene) -> set[str]:
-    """The names the scene's loads and Dirichlet conditions carry."""
-    return {x.name for x in (*scene.loads, *scene.dirichlet) if x.name is not None}
+    """The names the scene's loads, Dirichlet conditions and obstacles (their motion) carry."""
+    named = {x.name for x in (*scene.loads, *scene.dirichlet) if x.name is not None}
+    return named | {ob.name for ob in scene.obstacles}
 
 
 def check_steps(steps: Sequence[Any], names: set[str]) -> tuple[Mapping[str, float], ...]:
@@ -74,5 +76,9 @@ def step_scenes(scene: Scene) -> list[Scene]:
 
         loads: tuple[Load, ...] = tuple(scale(x) for x in scene.loads)
         dirichlet = tuple(scale(x) for x in scene.dirichlet)
-        out.append(replace(scene, loads=loads, dirichlet=dirichlet, steps=()))
+        obstacles = tuple(
+            replace(ob, displacement=(f * ob.displacement[0], f * ob.displacement[1]))
+            for ob, f in ((ob, factors[ob.name]) for ob in scene.obstacles)
+        )
+        out.append(replace(scene, loads=loads, dirichlet=dirichlet, obstacles=obstacles, steps=()))
     return out

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from contactfx import ContactPair, Obstacle, SolveRequest, scene_from_gmsh, solve
+from contactfx import ContactPair, SolveRequest, scene_from_gmsh, solve
 from contactfx.contact.friction import Status
 from contactfx.errors import InputError, SingularSystemError
 from contactfx.methods.solution import Solution
@@ -181,21 +181,6 @@ def test_unsupported_friction_is_refused_in_one_line(
     text = str(err.value)
     assert "contact 0 ('block_bottom' on 'base_top') has mu = 0.3" in text
     assert "nts or mortar (standard or dual) with multipliers" in text and "\n" not in text
-
-
-def test_friction_beside_an_obstacle_is_refused() -> None:
-    """Rigid obstacles have no tangential rows yet: a frictional scene with one is refused."""
-    base = pushed(MU, 0.002)
-    scene = scene_from_gmsh(
-        GEO,
-        bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
-        contacts=list(base.contacts),
-        dirichlet=list(base.dirichlet),
-        loads=list(base.loads),
-        obstacles=[Obstacle("wall", "plane", "block_right", point=(1.6, 0.0), normal=(-1.0, 0.0))],
-    )
-    with pytest.raises(InputError, match="not solved with a scene with rigid obstacles"):
-        solve(scene, "mortar")
 
 
 def test_summary_carries_the_shear_and_the_statuses() -> None:
