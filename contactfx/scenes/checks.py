@@ -166,6 +166,8 @@ def _check_conditions(scene: Scene) -> None:
 def _check_cattaneo(scene: Scene, ref: CattaneoReference) -> None:
     """InputError for a Cattaneo reference the scene cannot be checked against."""
     where = f"cattaneo reference (pair {ref.pair})"
+    if not (ref.R > 0 and (ref.mu is None or ref.mu > 0)):
+        raise InputError(f"{where}: R and mu must be positive (got R = {ref.R}, mu = {ref.mu})")
     if not 0 <= ref.pair < len(scene.contacts):
         raise InputError(
             f"{where}: pair {ref.pair} is not one of the {len(scene.contacts)} contact pairs "
