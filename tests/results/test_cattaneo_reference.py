@@ -15,6 +15,10 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, cli
 
+from contactfx import CattaneoReference, ContactPair, scene_from_gmsh
+from contactfx.errors import InputError
+from contactfx.scenes import Dirichlet, Material
+
 SCENES = ROOT / "tests" / "scenes"
 SCENE = SCENES / "cattaneo_cylinders.toml"
 KEYS = {"a_exact", "c_exact", "c", "c_error_cells", "shear_l2", "slip_law", "P", "Q", "mu"}
@@ -95,3 +99,23 @@ def test_bad_cattaneo_table_is_one_line(tmp_path: Path, old: str, new: str, expe
     assert proc.returncode == 2, proc.stderr
     assert expected in proc.stderr, proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("ref", "mu", "expected"),
+    [
+        (CattaneoReference(0, -0.5), 0.3, "R and mu must be positive"),
+        (CattaneoReference(0, 0.5, mu=0.0), 0.3, "R and mu must be positive"),
+        (CattaneoReference(0, 0.5), 0.0, "the pair is frictionless"),
+    ],
+)
+def test_bad_cattaneo_reference_in_python(ref: CattaneoReference, mu: float, expected: str) -> None:
+    """The Python API refuses what the scene file refuses (InputError, one line)."""
+    with pytest.raises(InputError, match=expected):
+        scene_from_gmsh(
+            SCENES / "cattaneo_cylinders.geo",
+            bodies={"upper": Material(1000.0, 0.3), "lower": Material(1000.0, 0.3)},
+            contacts=[ContactPair("upper_arc", "lower_arc", mu=mu)],
+            dirichlet=[Dirichlet("lower_flat", ux=0.0, uy=0.0), Dirichlet("upper_flat", uy=-0.03)],
+            references=[ref],
+        )
