@@ -46,6 +46,7 @@ from .options import (
 )
 from .request import SchwarzOptions, SolveRequest
 from .scenes import (
+    CattaneoReference,
     ContactPair,
     HertzReference,
     LameReference,
@@ -64,6 +65,7 @@ __all__ = [
     "SOLVERS",
     "ActiveSetError",
     "Basis",
+    "CattaneoReference",
     "ContactFxError",
     "ContactPair",
     "ConvergenceError",

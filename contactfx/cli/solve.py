@@ -50,6 +50,7 @@ def terminal_summary(run: RunSummary) -> list[str]:
             lines.append(
                 f"step {n}, pair {k}: {c.force_text()}{_counts(c)}, {step.iterations} iterations"
             )
+        lines += [f"step {n}, {r.text()}" for r in step.cattaneo]
     for k, c in enumerate(run.contacts):
         lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}{_counts(c)}")
     if run.patch is not None:
@@ -75,6 +76,10 @@ def terminal_summary(run: RunSummary) -> list[str]:
             f"{r.p_exact:.6g}, {100 * (r.p_mean / r.p_exact - 1):+.3f} %)"
             + ("" if r.exact else f"; {r.validity}")
         )
+    for cm in run.cattaneo:
+        lines.append(cm.text())
+        if cm.warning is not None:
+            lines.append(f"  warning: {cm.warning}")
     lines += [p.text() for p in run.probes]
     e = run.estimate
     if e is not None:

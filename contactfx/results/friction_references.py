@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 #: Geometries of `cattaneo_mindlin`: a cylinder (line contact, forces per unit length) or a sphere.
 GEOMETRIES = ("cylinder", "sphere")
@@ -272,6 +271,10 @@ def spence_stick_ratio(mu: float, nu: float, n: int = 300, coupled: bool = True)
     above mu p inside the stick zone on the other). coupled=False is Goodman's approximation
     (the shear's effect on the pressure dropped): c/a then depends on mu / beta only.
     """
+    # scipy only here: a run with a Cattaneo reference imports this module, and the command
+    # line loads no scipy (tests/cli/test_import_cost.py).
+    from scipy.optimize import brentq
+
     if not mu > 0:
         raise ValueError(f"spence_stick_ratio: mu must be positive, got {mu}")
     beta = coupling_beta(nu)

@@ -16,6 +16,7 @@ import numpy as np
 from ..options import Discretization, Enforcement, Method
 from ..scenes import Obstacle, Units
 from .obstacles import obstacle_json
+from .reference_records import CattaneoCheck as CattaneoCheck
 from .reference_records import HertzErrors as HertzErrors
 from .reference_records import LameErrors as LameErrors
 from .reference_records import PatchErrors as PatchErrors
@@ -194,10 +195,17 @@ class StepSummary:
 
     iterations: int
     contacts: tuple[ContactSummary, ...]
+    cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference
 
     def to_json(self) -> dict[str, Any]:
         """The step's entry of the JSON's `steps`."""
-        return {"iterations": self.iterations, "contacts": [c.to_json() for c in self.contacts]}
+        out: dict[str, Any] = {
+            "iterations": self.iterations,
+            "contacts": [c.to_json() for c in self.contacts],
+        }
+        if self.cattaneo:
+            out["cattaneo"] = [c.to_json() for c in self.cattaneo]
+        return out
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -229,6 +237,7 @@ class RunSummary:
     patch: PatchErrors | None = None
     estimate: EstimateSummary | None = None
     lame: tuple[LameErrors, ...] = ()  # one per Lame reference
+    cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference (the last step)
     probes: tuple[ProbeResult, ...] = ()  # one per probe of the scene
     steps: tuple[StepSummary, ...] = ()  # one per [[step]] (none without steps)
 
@@ -274,6 +283,8 @@ class RunSummary:
             out["patch"] = self.patch.to_json()
         if self.lame:
             out["lame"] = [r.to_json() for r in self.lame]
+        if self.cattaneo:
+            out["cattaneo"] = [r.to_json() for r in self.cattaneo]
         if self.probes:
             out["probes"] = [p.to_json() for p in self.probes]
         if self.steps:

@@ -10,6 +10,7 @@ from ..methods.solution import Solution
 from ..options import Method, SolverSpec
 from ..request import SolveRequest
 from ..scenes import HertzReference, LameReference, UniformStress
+from .cattaneo import cattaneo_checks
 from .interface import cartesian_interface, contacts_summary
 from .lame import lame_summary
 from .probes import probe_value
@@ -88,6 +89,7 @@ def summary(
     scene = sol.scene
     refs = scene.references
     patch = [uniform_stress_errors(sol, r) for r in refs if isinstance(r, UniformStress)]
+    cattaneo, cattaneo_steps = cattaneo_checks(sol)
     return RunSummary(
         scene=scene.name,
         method=sol.method,
@@ -118,6 +120,10 @@ def summary(
         # The last uniform stress wins, as one `patch` block holds one.
         patch=patch[-1] if patch else None,
         lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
+        cattaneo=cattaneo,
         probes=tuple(probe_value(sol, p) for p in scene.probes),
-        steps=tuple(StepSummary(s.iterations, contacts_summary(s)) for s in sol.steps),
+        steps=tuple(
+            StepSummary(s.iterations, contacts_summary(s), c)
+            for s, c in zip(sol.steps, cattaneo_steps, strict=True)
+        ),
     )

@@ -15,6 +15,7 @@ from .builtin import (
 from .gmsh_io import GeoRecipe, SceneParts, scene_from_gmsh
 from .model import (
     Body,
+    CattaneoReference,
     ContactPair,
     Dirichlet,
     Groups,
@@ -43,6 +44,7 @@ __all__ = [
     "BlockParams",
     "Body",
     "BuiltinRecipe",
+    "CattaneoReference",
     "ContactPair",
     "Dirichlet",
     "GeoRecipe",

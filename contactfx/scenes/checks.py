@@ -12,7 +12,7 @@ import numpy as np
 from mpi4py import MPI
 
 from ..errors import InputError, MeshError
-from .model import Body, HertzReference, LameReference, Model, Scene
+from .model import Body, CattaneoReference, HertzReference, LameReference, Model, Scene
 from .steps import check_steps, load_names
 
 
@@ -153,12 +153,33 @@ def _check_conditions(scene: Scene) -> None:
             _check_lame(scene, ref)
         if isinstance(ref, HertzReference):
             ref.contact_in(scene.model)
+        if isinstance(ref, CattaneoReference):
+            _check_cattaneo(scene, ref)
         if not 0 <= pair < len(scene.contacts) + len(scene.obstacles):
             what = "probe" if ref in scene.probes else "reference"
             raise InputError(
                 f"{what}: pair {pair} does not exist (the scene has "
                 f"{len(scene.contacts)} contact pairs and {len(scene.obstacles)} obstacles)"
             )
+
+
+def _check_cattaneo(scene: Scene, ref: CattaneoReference) -> None:
+    """InputError for a Cattaneo reference the scene cannot be checked against."""
+    where = f"cattaneo reference (pair {ref.pair})"
+    if not (ref.R > 0 and (ref.mu is None or ref.mu > 0)):
+        raise InputError(f"{where}: R and mu must be positive (got R = {ref.R}, mu = {ref.mu})")
+    if not 0 <= ref.pair < len(scene.contacts):
+        raise InputError(
+            f"{where}: pair {ref.pair} is not one of the {len(scene.contacts)} contact pairs "
+            "(Cattaneo-Mindlin is two elastic bodies)"
+        )
+    if scene.contacts[ref.pair].mu <= 0:
+        raise InputError(f"{where}: the pair is frictionless: give it mu > 0 in its [[contact]]")
+    if scene.model is Model.AXISYMMETRIC:
+        raise InputError(
+            f"{where}: a line contact of a plane model only (the axisymmetric sphere's "
+            "Cattaneo-Mindlin check is not implemented): use plane_strain or plane_stress"
+        )
 
 
 def _text(values: list[float]) -> str:

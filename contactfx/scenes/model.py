@@ -241,7 +241,24 @@ class UniformStress:
     sigma: tuple[tuple[float, float], tuple[float, float]]
 
 
-Reference = HertzReference | UniformStress | LameReference
+@dataclass(frozen=True)
+class CattaneoReference:
+    """Cattaneo-Mindlin on one frictional pair (a plane model's line contact, similar bodies).
+
+    At each load step: Hertz's pressure under the pair's normal force P, the stick half-width
+    c = a sqrt(1 - Q / (mu P)) and the closed-form shear, with P and Q the forces the pair's
+    multipliers carry. `R` is the effective radius (1/R = 1/R1 + 1/R2); `mu` None takes the
+    pair's. It holds where the approach makes no relative slip (mirrored bodies, or a
+    frictionless approach); the summary says when the first step's shear says otherwise.
+    A tangential push breaks a half model's mirror symmetry: full models only.
+    """
+
+    pair: int
+    R: float
+    mu: float | None = None
+
+
+Reference = HertzReference | UniformStress | LameReference | CattaneoReference
 
 
 @dataclass(frozen=True)

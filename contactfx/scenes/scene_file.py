@@ -18,6 +18,7 @@ from mpi4py import MPI
 from ..errors import InputError
 from .gmsh_io import SceneParts, scene_from_parts
 from .model import (
+    CattaneoReference,
     ContactPair,
     Dirichlet,
     HertzContact,
@@ -174,15 +175,30 @@ def _material(body: str, table: Any) -> Material:
     return mat
 
 
+def _cattaneo(where: str, entry: Any) -> CattaneoReference:
+    e = _section(where, entry, "reference.cattaneo")
+    pair = e.get("pair", 0)
+    if isinstance(pair, bool) or not isinstance(pair, int):
+        raise InputError(f"{where}: pair: {TYPE_ERRORS['integer']} into [[contact]]")
+    R = _number(f"{where}.R", e["R"])
+    mu = _number(f"{where}.mu", e["mu"]) if "mu" in e else None
+    if R <= 0 or (mu is not None and mu <= 0):
+        raise InputError(f"{where}: R and mu must be positive")
+    return CattaneoReference(pair, R, mu)
+
+
 def _reference(k: int, entry: Any, model: Model | None = None) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
-    if kind not in ("hertz", "uniform_stress", "lame"):
+    if kind not in ("hertz", "uniform_stress", "lame", "cattaneo"):
         raise InputError(
-            f"reference {k}: type must be 'hertz', 'uniform_stress' or 'lame' (got {kind!r})"
+            f"reference {k}: type must be 'hertz', 'uniform_stress', 'lame' or 'cattaneo' "
+            f"(got {kind!r})"
         )
     where = f"reference {k} ({kind})"
     if kind == "lame":
         return _lame(where, entry)
+    if kind == "cattaneo":
+        return _cattaneo(where, entry)
     if kind == "hertz":
         e = _section(where, entry, "reference.hertz")
         pair = e.get("pair", 0)

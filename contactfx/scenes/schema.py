@@ -151,6 +151,17 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
             '"point" in a plane model',
         ),
     ),
+    "reference.cattaneo": (
+        Key(
+            "type",
+            "string",
+            None,
+            '"cattaneo": Cattaneo-Mindlin on one frictional pair (a plane line contact)',
+        ),
+        Key("pair", "integer", "0", "index into [[contact]]", "a frictionless pair"),
+        Key("R", "number", None, "effective radius, 1/R = 1/R1 + 1/R2", "R <= 0"),
+        Key("mu", "number", "the pair's mu", "friction coefficient", "mu <= 0"),
+    ),
     "reference.lame": (
         Key("type", "string", None, '"lame": a shrink fit of two concentric rings'),
         Key("pair", "integer", "0", "index into [[contact]]"),

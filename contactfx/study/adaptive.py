@@ -46,7 +46,7 @@ def budget(study: Study, method: str) -> int | None:
 def _errors(study: Study, level: AdaptLevel, ref: Run | None) -> dict[str, float | None]:
     """The level's errors, measured as the study measures its uniform runs."""
     if study.reference["kind"] == "exact":
-        kind = "hertz" if study.reference["type"] == "hertz" else "patch"
+        kind = {"hertz": "hertz", "cattaneo": "cattaneo"}.get(study.reference["type"], "patch")
         return exact_errors(kind, level.summary)
     if ref is None or ref.profiles is None:
         return {}

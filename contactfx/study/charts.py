@@ -80,9 +80,11 @@ def _figure(study: Study, x: str) -> tuple[plt.Figure, list[plt.Axes], list[str]
 
 def _title(study: Study) -> str:
     ref = study.reference
-    what = {"hertz": "exact Hertz solution", "uniform_stress": "exact uniform stress"}.get(
-        ref["type"], f"finest level of {ref.get('method')}"
-    )
+    what = {
+        "hertz": "exact Hertz solution",
+        "uniform_stress": "exact uniform stress",
+        "cattaneo": "Cattaneo-Mindlin",
+    }.get(ref["type"], f"finest level of {ref.get('method')}")
     return f"{study.scene}, reference: {what}, {study.ranks} rank{'s' * (study.ranks > 1)}"
 
 

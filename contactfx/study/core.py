@@ -20,11 +20,12 @@ from ..errors import ContactFxError, InputError
 from ..options import Method
 from ..request import SolveRequest
 from ..results.records import RunSummary
-from ..scenes import HertzReference, Reference, Scene, UniformStress
+from ..scenes import CattaneoReference, HertzReference, Reference, Scene, UniformStress
 from ..timers import Timers
 from .levels import Level
 from .measures import (
     ROUND_OFF,
+    cattaneo_study_errors,
     contact_size,
     fit_rate,
     hertz_errors,
@@ -41,7 +42,12 @@ ACCURACY_ORDER = ("mortar", "sts", "nts", "penalty", "schwarz")
 
 
 def reference_kind(scene: Scene) -> str:
-    """The kind of reference: hertz, patch (uniform stress) or self (the finest level)."""
+    """The kind of reference: cattaneo, hertz, patch (uniform stress) or self (the finest level).
+
+    A frictional scene's Cattaneo reference comes first: its Hertz pressure is part of it.
+    """
+    if any(isinstance(r, CattaneoReference) for r in scene.references):
+        return "cattaneo"
     if any(isinstance(r, HertzReference) for r in scene.references):
         return "hertz"
     if any(isinstance(r, UniformStress) for r in scene.references):
@@ -51,6 +57,8 @@ def reference_kind(scene: Scene) -> str:
 
 def exact_errors(kind: str, summary: RunSummary) -> dict[str, float | None]:
     """Errors of one run against the scene's exact solution."""
+    if kind == "cattaneo":
+        return cattaneo_study_errors(summary)
     return hertz_errors(summary) if kind == "hertz" else patch_error(summary)
 
 
@@ -147,6 +155,17 @@ def apply_reference(
     """
     if kind == "hertz":
         return hertz_reference_block(runs, references)
+    if kind == "cattaneo":
+        return {
+            "kind": "exact",
+            "type": "cattaneo",
+            "description": "Cattaneo-Mindlin line contact (similar materials) under each "
+            "run's own forces P and Q, the last load step: relative L2 error of the shear "
+            "(shear) and relative error of the stick half-width read from the statuses (stick)",
+            "exact": False,
+            "validity": "approximate: half-space theory, and a slip-free approach "
+            "(the runs' `cattaneo` warnings say where it slipped)",
+        }
     if kind == "patch":
         return {
             "kind": "exact",

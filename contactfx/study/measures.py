@@ -95,6 +95,22 @@ def hertz_errors(summary: RunSummary) -> dict[str, float | None]:
     return out
 
 
+def cattaneo_study_errors(summary: RunSummary) -> dict[str, float | None]:
+    """Shear (relative L2 of the shear) and stick (|c / c_exact - 1|) against Cattaneo-Mindlin.
+
+    The last load step's; with several Cattaneo pairs the worst. stick is None in full slip
+    (c_exact = 0: no stick zone to measure).
+    """
+    pairs = summary.cattaneo
+    if not pairs:
+        raise ValueError(f"run of {summary.scene} has no Cattaneo reference")
+    sticks = [_rel(c.c, c.c_exact) if c.c_exact > 0 else None for c in pairs]
+    return {
+        "shear": max(float(c.shear_l2) for c in pairs),
+        "stick": None if None in sticks else max(sticks),  # type: ignore[type-var]
+    }
+
+
 def patch_error(summary: RunSummary) -> dict[str, float | None]:
     """stress: the patch test's max stress/pressure error relative to the exact uniform stress."""
     if summary.patch is None:

@@ -26,7 +26,7 @@ from .levels import Level
 from .runs import Run
 
 # The relative errors whose bare names read as values (the half-width, the peak pressure).
-HEADINGS = {"a": "a err", "p0": "p0 err"}
+HEADINGS = {"a": "a err", "p0": "p0 err", "stick": "c err", "shear": "shear L2"}
 
 
 def error_heading(name: str) -> str:
