@@ -70,7 +70,7 @@ class ContactSummary:
 
     @property
     def magnitude(self) -> float:
-        """|force| in a plane model; |axial force| in an axisymmetric one."""
+        """The size of `force` in a plane model; that of `axial_force` in an axisymmetric one."""
         return abs(self.axial_force) if self.axisymmetric else float(np.hypot(*self.force))
 
     @property
