@@ -21,9 +21,9 @@ RESIDUAL_TOL = 0.05
 RESIDUAL_GROWTH = 4.0
 # Sizing by the residual goal takes each cell's contact terms times this weight unless the
 # pressure sizing is on: the energy estimate is bulk-dominated, a pressure needs the contact
-# zone resolved. Measured (docs/adapt.md): Hertz L2 0.118 % at 56k DOFs against 0.503 %
-# unweighted (30 and 100 did worse); with the pressure sizing the weight only takes cells from
-# the bulk (0.059 % with 1 against 0.099 % with 10). The goal estimates size with 1.
+# zone resolved; larger weights did worse, and with the pressure sizing on the weight only
+# takes cells from the bulk (the measurements: benchmarks/log/adapt.md). The goal estimates
+# size with 1.
 RESIDUAL_WEIGHT = 10.0
 # On a full budget, the residual goal's pressure sizing goes on while its estimate falls below
 # this fraction of the previous level's.

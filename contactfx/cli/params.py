@@ -28,8 +28,8 @@ from ..scenes import (
     validate,
 )
 
-# The least memory a solve takes per DOF: the condensed solver's peak, about 110 MB per 100k
-# DOFs (docs/results.md, "peak MB per 100k DOFs"; MUMPS takes about 3 times more).
+# The least memory a solve takes per DOF: the condensed solver's peak, the leanest of the
+# solvers (docs/results.md, "peak MB per 100k DOFs").
 LEAST_BYTES_PER_DOF = 1.1e3
 
 BLOCK_KEYS = (
