@@ -92,6 +92,10 @@ def solve_request(
         return sols[-1]
     # The penalty and Schwarz modules are imported when they run (first-answer time of a
     # plain solve: docs/scale.md).
+    if request.enforcement is Enforcement.PENALTY and frictional_pairs(scene):
+        from .methods.penalty_friction import solve_penalty_friction
+
+        return solve_penalty_friction(scene, request, timers, aso)
     if request.enforcement is Enforcement.PENALTY:
         from .methods.penalty import solve_penalty
 

@@ -20,15 +20,17 @@ The slip increment is measured from the previous load step (quasi-static).
 
 Supported: nts and mortar (standard and dual basis) with Lagrange multipliers on the direct
 saddle-point path, every model, pairs between bodies and against rigid obstacles (their rows
-along the obstacle's exact tangent; the obstacle's prescribed motion enters the slip).
-Refused in one line (`refuse_friction`): sts, penalty, Schwarz, an iterative or condensed
-solver.
+along the obstacle's exact tangent; the obstacle's prescribed motion enters the slip). The
+penalty enforcement's regularized Coulomb law on the same rows: methods/penalty_friction.py.
+Refused in one line (`refuse_friction`): sts (either enforcement), Schwarz, an iterative or
+condensed solver.
 With every mu = 0 nothing here runs: the frictionless path is unchanged.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,7 +63,10 @@ START_BAND = 0.1
 # their symmetry rules out, and the pushed stick zone sat off-centre (docs/friction.md).
 FRAME = "bisector"
 
-SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
+SUPPORTED = (
+    "nts or mortar (standard or dual) with multipliers and a direct solver (mumps), "
+    "or the penalty enforcement on nts or mortar"
+)
 
 
 def pair_mu(scene: Scene) -> list[float]:
@@ -89,11 +94,14 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
     if not pairs:
         return
     why = ""
-    if request.enforcement is not Enforcement.MULTIPLIERS:
+    if request.enforcement is Enforcement.SCHWARZ:
         why = f"the {request.enforcement.value} enforcement"
     elif request.discretization is Discretization.STS:
-        why = "sts"
-    elif request.solver.kind not in (SolverKind.DIRECT, SolverKind.AUTO):
+        why = "sts"  # its kernel has no tangential rows
+    elif request.enforcement is Enforcement.MULTIPLIERS and request.solver.kind not in (
+        SolverKind.DIRECT,
+        SolverKind.AUTO,
+    ):
         why = f"the {request.solver.name} solver"
     if why:
         raise InputError(
@@ -300,10 +308,18 @@ def solve_friction(
     `refuse_friction` has passed. Each load step's slip increment is measured from the step
     before (quasi-static).
     """
+    return in_steps(scene, lambda s, before: _solve_step(s, request, timers, aso, before))
+
+
+def in_steps[S](scene: Scene, one: Callable[[Scene, S | None], tuple[Solution, S]]) -> Solution:
+    """Solve each load step of `scene` by `one`, handing each step's state to the next.
+
+    The last step's solution, holding every step's in `steps` where the scene has steps.
+    """
     sols: list[Solution] = []
-    state: StepState | None = None
+    state: S | None = None
     for k, step_scene in enumerate(step_scenes(scene)):
-        sol, state = _solve_step(step_scene, request, timers, aso, state)
+        sol, state = one(step_scene, state)
         if scene.steps and scene.comm.rank == 0:
             log.info("step %d: %d iterations", k + 1, sol.iterations)
         sols.append(sol)

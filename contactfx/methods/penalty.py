@@ -36,6 +36,10 @@ DEFAULT_FACTOR = 1e3
 """Default eps = DEFAULT_FACTOR * max E / h, h the median active-surface element size."""
 
 
+# The stub types the Structure values as int but the parameter as Structure.
+DIFFERENT = cast(PETSc.Mat.Structure, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+
+
 def default_penalty(e_max: float, h: float) -> float:
     """The default normal stiffness eps (MPa/cm): 1e3 times the stiffer body's E over h."""
     return DEFAULT_FACTOR * e_max / h
@@ -49,6 +53,33 @@ class ConditionOptions:
     rtol: float = 1e-10
 
 
+def scaled_rows(B: PETSc.Mat, coef: np.ndarray) -> PETSc.Mat:
+    """diag(coef) B: a copy of B with each owned row scaled."""
+    d = B.createVecLeft()
+    d.array[:] = coef
+    out = B.copy()
+    out.diagonalScale(L=d)
+    d.destroy()
+    return out
+
+
+def add_product(A: PETSc.Mat | None, BT: PETSc.Mat, C: PETSc.Mat) -> PETSc.Mat:
+    """A + BT C (BT C itself if A is None); the product is freed."""
+    P = BT.matMult(C)
+    if A is None:
+        return P
+    A.axpy(1.0, P, structure=DIFFERENT)
+    P.destroy()
+    return A
+
+
+def transposed(B: PETSc.Mat) -> PETSc.Mat:
+    """B^T as a new matrix."""
+    BT = PETSc.Mat()
+    B.transpose(BT)
+    return BT
+
+
 def _solve(
     K: PETSc.Mat,
     B: PETSc.Mat,
@@ -60,29 +91,35 @@ def _solve(
     check: bool = True,
 ) -> tuple[np.ndarray, dict[str, float]]:
     """Solve (K + B^T diag(coef) B) u = f - B^T diag(coef) g; coef = eps / w on active rows."""
-    d = B.createVecLeft()
-    d.array[:] = np.sqrt(coef)
-    BA = B.copy()
-    BA.diagonalScale(L=d)
-    BAT = PETSc.Mat()
-    BA.transpose(BAT)
-    A = BAT.matMult(BA)
-    # The stub types the Structure values as int but the parameter as Structure.
-    A.axpy(
-        1.0, K, structure=cast(PETSc.Mat.Structure, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    )
+    BT = transposed(B)
+    BA = scaled_rows(B, coef)
+    A = add_product(None, BT, BA)
+    A.axpy(1.0, K, structure=DIFFERENT)
     rhs = f.copy()
+    d = B.createVecLeft()
     d.array[:] = -coef * g
     tmp = rhs.duplicate()
-    B.multTranspose(d, tmp)
+    BT.mult(d, tmp)
     rhs.axpy(1.0, tmp)
+    with released(K.getComm().tompi4py(), BA, BT, tmp, d):
+        return factor_solve(A, rhs, options, condition, check)
+
+
+def factor_solve(
+    A: PETSc.Mat,
+    rhs: PETSc.Vec,
+    options: Mapping[str, object],
+    condition: bool = False,
+    check: bool = True,
+) -> tuple[np.ndarray, dict[str, float]]:
+    """Solve A u = rhs with the request's PETSc options (A and rhs are freed)."""
     x = rhs.duplicate()
-    ksp = PETSc.KSP().create(K.getComm())
+    ksp = PETSc.KSP().create(A.getComm())
     ksp.setOperators(A)
     info: dict[str, float] = {}
-    with released(K.getComm().tompi4py(), ksp, A, BA, BAT, rhs, tmp, x, d):
+    with released(A.getComm().tompi4py(), ksp, A, rhs, x):
         try:
-            with petsc_options(with_ordering(options, K.getSize()[0])) as prefix:
+            with petsc_options(with_ordering(options, A.getSize()[0])) as prefix:
                 ksp.setOptionsPrefix(prefix)
                 ksp.setFromOptions()
                 if condition:

@@ -1,0 +1,236 @@
+"""Coulomb friction by penalty (regularized Coulomb): the approximate baseline of the multipliers.
+
+The normal side is the frictionless penalty's (methods/penalty.py): a node in contact where
+its nodal gap g_j < 0 carries p_j = -eps_n g_j. Beside it each row has a tangential
+stiffness eps_t and a return map on its nodal slip s_j = (B_t u + shift)_j / w_j (the
+tangential rows of the same kernel as the multipliers', contact/friction.py's sign: the
+traction on the active body is -lambda_t t):
+
+    trial:  t_j = lambda_t,old + eps_t (s_j - s_j,old)      (the previous load step's values)
+    stick:  |t_j| < mu p_j       lambda_t = t_j             (an elastic slip t_j / eps_t)
+    slip:   otherwise            lambda_t = mu p_j sign(t_j)
+
+With a row's set (open, stick, slip and its direction) fixed, lambda_t is linear in u and the
+set's system is K + B_n^T (eps_n / w) B_n + B_t^T (eps_t / w) B_t on stick rows and
++ B_t^T (-mu s eps_n / w) B_n on slip rows: the consistent tangent of the return map (in 2D
+the direction's derivative vanishes), unsymmetric where a row slips, factored by LU. The loop
+is active_set.py's, as for the multipliers: the set of the solution is the next set, and the
+loop stops when no row changes. The history carried from step to step is the traction
+lambda_t and the slip s at the step's end (an open row keeps none: its lambda_t is 0).
+
+eps_t = eps_n = the request's penalty, by default 1e3 E_max / h (penalty.default_penalty):
+both are stiffnesses per unit area of the interface, and the stick state's elastic slip
+shear / eps_t is then of the penetration's size (docs/friction.md, "The penalty baseline").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from ..contact.friction import FrictionResult, Status
+from ..discretize.setup import ContactSetup, prepare_contact
+from ..errors import SingularSystemError, SolverError
+from ..request import SolveRequest
+from ..scenes import Scene
+from ..timers import Timers
+from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .cleanup import released
+from .friction import FRAME, in_steps, pair_mu, tangent_constraint
+from .penalty import (
+    DIFFERENT,
+    add_product,
+    default_penalty,
+    factor_solve,
+    penetration,
+    scaled_rows,
+    transposed,
+)
+from .solution import PenaltyResult, Solution, finish
+
+
+def lu_options(petsc: Mapping[str, object]) -> dict[str, object]:
+    """The request's factorization as LU: the frictional system is unsymmetric where a row slips."""
+    return {**petsc, "pc_type": "lu"} if petsc.get("pc_type") == "cholesky" else dict(petsc)
+
+
+@dataclass(frozen=True)
+class PenaltyState:
+    """What a converged load step hands the next (owned rows)."""
+
+    active: np.ndarray
+    sign: np.ndarray
+    ut: np.ndarray  # the weighted slip B_t u (+ prescribed) at its end
+    shear: np.ndarray  # lambda_t at its end (0 where open)
+
+
+class PenaltyFrictionIteration:
+    """Penalty solves on a set (open, stick, slip and direction) and the return map's update."""
+
+    label = "penalty friction"
+    probing = False
+
+    def __init__(
+        self,
+        scene: Scene,
+        setup: ContactSetup,
+        tangential: tuple[PETSc.Mat, np.ndarray, np.ndarray],
+        eps: float,
+        options: Mapping[str, object],
+    ) -> None:
+        self.setup, self.eps_n, self.eps_t = setup, eps, eps
+        self.Bt, self.shift_t, self.free_t = tangential
+        self.options = lu_options(options)
+        layout = setup.layout
+        mus = pair_mu(scene)
+        self.mu = np.array([mus[int(k)] for k in layout.pair[layout.mine]])
+        m = len(layout.mine)
+        # The first set sticks wherever friction acts (as the multipliers' does).
+        self.stick = self.mu > 0.0
+        self.sign = np.ones(m)
+        self.ut_prev = np.zeros(m)
+        self.shear_prev = np.zeros(m)
+        self.u = fem.Function(setup.elasticity.V, name="u")
+        self.lam_t = np.zeros(m)
+        self.slip = np.zeros(m)
+        self.status = np.zeros(m, dtype=np.int64)
+
+    def key(self, active: np.ndarray) -> np.ndarray:
+        """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
+        return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+
+    def _system(self, active: np.ndarray) -> tuple[PETSc.Mat, PETSc.Vec]:
+        """The set's matrix and right-hand side (module docstring)."""
+        setup, el = self.setup, self.setup.elasticity
+        w, g0 = setup.w, setup.g
+        stick = active & self.stick & self.free_t
+        slip = active & ~self.stick & self.free_t
+        cn = np.where(active, self.eps_n / w, 0.0)
+        ctt = np.where(stick, self.eps_t / w, 0.0)
+        ctn = np.where(slip, -self.mu * self.sign * self.eps_n / w, 0.0)
+        # Stick rows' lambda_t = a + (eps_t / w) B_t u; slip rows' = ctn (g0 + B_n u).
+        a = self.shear_prev + self.eps_t * (self.shift_t - self.ut_prev) / w
+        Bn, Bt = setup.B, self.Bt
+        BnT, BtT = transposed(Bn), transposed(Bt)
+        An, M, Mn = scaled_rows(Bn, cn), scaled_rows(Bt, ctt), scaled_rows(Bn, ctn)
+        M.axpy(1.0, Mn, structure=DIFFERENT)
+        A = add_product(add_product(None, BnT, An), BtT, M)
+        A.axpy(1.0, el.K, structure=DIFFERENT)
+        rhs = el.f.copy()
+        dn, dt, tmp = Bn.createVecLeft(), Bt.createVecLeft(), rhs.duplicate()
+        dn.array[:] = -cn * g0
+        dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0
+        with released(setup.comm, BnT, BtT, An, M, Mn, dn, dt, tmp):
+            BnT.mult(dn, tmp)
+            rhs.axpy(1.0, tmp)
+            BtT.mult(dt, tmp)
+            rhs.axpy(1.0, tmp)
+        return A, rhs
+
+    def solve(self, active: np.ndarray, it: int) -> Step:
+        """One LU solve on `active` and the friction sets; the next set from the return map."""
+        setup, comm = self.setup, self.setup.comm
+        A, rhs = self._system(active)
+        x, info = factor_solve(A, rhs, self.options)
+        self.u.x.petsc_vec.array[:] = x
+        self.u.x.scatter_forward()
+        gap = setup.normalized_gap(self.u)
+        y = self.Bt.createVecLeft()
+        self.Bt.mult(self.u.x.petsc_vec, y)
+        ut = y.array_r + self.shift_t
+        y.destroy()
+        w = setup.w
+        p = -self.eps_n * gap
+        contact = gap < 0.0
+        trial = np.where(self.free_t, self.shear_prev + self.eps_t * (ut - self.ut_prev) / w, 0.0)
+        stick = np.abs(trial) < self.mu * p
+        sign = np.where(trial >= 0.0, 1.0, -1.0)
+        lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
+        changed = contact & active & ((stick != self.stick) | (~stick & (sign != self.sign)))
+        n_changed = comm.allreduce(int(changed.sum()))
+        self.stick = np.where(contact, stick, self.stick)
+        self.sign = np.where(contact & ~stick, sign, self.sign)
+        self.lam_t, self.slip = lam_t, ut / w
+        self.status = np.where(contact, np.where(stick, Status.STICK, Status.SLIP), Status.OPEN)
+        pen = max(comm.allreduce(float(np.max(-gap, initial=0.0)), op=MPI.MAX), 0.0)
+        n_stick = comm.allreduce(int(np.sum(self.status == Status.STICK)))
+        n_slip = comm.allreduce(int(np.sum(self.status == Status.SLIP)))
+        record: dict[str, float] = {
+            "stick": n_stick,
+            "slip": n_slip,
+            "friction_changed": n_changed,
+            "penetration": pen,
+            "penalty": self.eps_n,
+            **info,
+        }
+        text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, max penetration {pen:.3e}, "
+        return Step(p, gap, contact, 0.0, record, text, True, n_changed)
+
+    def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
+        """The return map's set."""
+        return None
+
+
+def solve_penalty_friction(
+    scene: Scene, request: SolveRequest, timers: Timers, aso: ActiveSetOptions
+) -> Solution:
+    """Solve `scene` with regularized Coulomb friction by penalty, step by step.
+
+    `refuse_friction` has passed (nts or mortar). eps_t = eps_n (the module's docstring).
+    """
+    return in_steps(scene, lambda s, before: _solve_step(s, request, timers, aso, before))
+
+
+def _solve_step(
+    scene: Scene,
+    request: SolveRequest,
+    timers: Timers,
+    aso: ActiveSetOptions,
+    before: PenaltyState | None,
+) -> tuple[Solution, PenaltyState]:
+    """One load step of `solve_penalty_friction`, from the state the step before left."""
+    kernel = request.discretization.kernel
+    try:
+        setup = prepare_contact(scene, kernel, aso.penetration_tol, timers, frame=FRAME)
+    except SingularSystemError as err:
+        raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
+    with released(scene.comm, setup):
+        eps = default_penalty(setup.e_max, setup.h) if request.penalty is None else request.penalty
+        with timers("contact"):
+            Bt, shift_t, tangent, free_t, moving = tangent_constraint(
+                scene, setup, request.basis, kernel
+            )
+        with released(scene.comm, Bt):
+            iteration = PenaltyFrictionIteration(
+                scene, setup, (Bt, shift_t, free_t), eps, request.solver.petsc
+            )
+            active = setup.initial_active(aso.penetration_tol * setup.h)
+            if before is not None:
+                if len(before.active) != len(active):
+                    raise SolverError("the contact rows changed between load steps")
+                active = active | before.active
+                iteration.sign, iteration.ut_prev = before.sign.copy(), before.ut.copy()
+                iteration.shear_prev = before.shear.copy()
+            step, active, history = run_active_set(setup, iteration, active, aso, timers)
+        sol = finish(
+            setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
+        )
+        w = setup.w
+    sol.penalty = PenaltyResult(eps, penetration(sol))
+    comm = scene.comm
+    status = np.where(active, iteration.status, Status.OPEN)
+    shear = np.where(active, iteration.lam_t, 0.0)
+    sol.friction = FrictionResult(
+        mu=np.concatenate(comm.allgather(iteration.mu)),
+        shear=np.concatenate(comm.allgather(shear)),
+        slip=np.concatenate(comm.allgather(iteration.slip)),
+        status=np.concatenate(comm.allgather(status)),
+        tangent=tangent,
+        tangent_motion=moving,
+    )
+    return sol, PenaltyState(active, iteration.sign, iteration.slip * w, shear)
