@@ -13,7 +13,8 @@ traction on the active body is -lambda_t t):
 With a row's set (open, stick, slip and its direction) fixed, lambda_t is linear in u and the
 set's system is K + B_n^T (eps_n / w) B_n + B_t^T (eps_t / w) B_t on stick rows and
 + B_t^T (-mu s eps_n / w) B_n on slip rows: the consistent tangent of the return map (in 2D
-the direction's derivative vanishes), unsymmetric where a row slips, factored by LU. The loop
+the direction's derivative vanishes), unsymmetric where a row slips: factored by LU then,
+by the request's factorization (LDL^T by default) while no row slips. The loop
 is active_set.py's, as for the multipliers: the set of the solution is the next set, and the
 loop stops when no row changes. The history carried from step to step is the traction
 lambda_t and the slip s at the step's end (an open row keeps none: its lambda_t is 0).
@@ -85,7 +86,7 @@ class PenaltyFrictionIteration:
     ) -> None:
         self.setup, self.eps_n, self.eps_t = setup, eps, eps
         self.Bt, self.shift_t, self.free_t = tangential
-        self.options = lu_options(options)
+        self.options, self.lu = options, lu_options(options)
         layout = setup.layout
         mus = pair_mu(scene)
         self.mu = np.array([mus[int(k)] for k in layout.pair[layout.mine]])
@@ -104,39 +105,50 @@ class PenaltyFrictionIteration:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
         return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
 
-    def _system(self, active: np.ndarray) -> tuple[PETSc.Mat, PETSc.Vec]:
-        """The set's matrix and right-hand side (module docstring)."""
+    def _system(self, active: np.ndarray) -> tuple[PETSc.Mat, PETSc.Vec, bool]:
+        """The set's matrix and right-hand side (module docstring), and whether a row slips.
+
+        Without a stick or slip row carrying a shear (mu = 0, or every row open) the system
+        is the frictionless penalty's, assembled as it is.
+        """
         setup, el = self.setup, self.setup.elasticity
         w, g0 = setup.w, setup.g
         stick = active & self.stick & self.free_t
-        slip = active & ~self.stick & self.free_t
+        slip = active & ~self.stick & self.free_t & (self.mu > 0.0)
         cn = np.where(active, self.eps_n / w, 0.0)
         ctt = np.where(stick, self.eps_t / w, 0.0)
         ctn = np.where(slip, -self.mu * self.sign * self.eps_n / w, 0.0)
-        # Stick rows' lambda_t = a + (eps_t / w) B_t u; slip rows' = ctn (g0 + B_n u).
-        a = self.shear_prev + self.eps_t * (self.shift_t - self.ut_prev) / w
+        comm = setup.comm
+        slips = comm.allreduce(bool(slip.any()), op=MPI.LOR)
+        sheared = slips or comm.allreduce(bool(stick.any()), op=MPI.LOR)
         Bn, Bt = setup.B, self.Bt
-        BnT, BtT = transposed(Bn), transposed(Bt)
-        An, M, Mn = scaled_rows(Bn, cn), scaled_rows(Bt, ctt), scaled_rows(Bn, ctn)
-        M.axpy(1.0, Mn, structure=DIFFERENT)
-        A = add_product(add_product(None, BnT, An), BtT, M)
-        A.axpy(1.0, el.K, structure=DIFFERENT)
+        BnT, An = transposed(Bn), scaled_rows(Bn, cn)
+        A = add_product(None, BnT, An)
         rhs = el.f.copy()
-        dn, dt, tmp = Bn.createVecLeft(), Bt.createVecLeft(), rhs.duplicate()
+        dn, tmp = Bn.createVecLeft(), rhs.duplicate()
         dn.array[:] = -cn * g0
-        dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0
-        with released(setup.comm, BnT, BtT, An, M, Mn, dn, dt, tmp):
+        with released(comm, BnT, An, dn, tmp):
             BnT.mult(dn, tmp)
             rhs.axpy(1.0, tmp)
-            BtT.mult(dt, tmp)
-            rhs.axpy(1.0, tmp)
-        return A, rhs
+            if sheared:
+                # Stick rows' lambda_t = a + (eps_t / w) B_t u; slip rows' = ctn (g0 + B_n u).
+                a = self.shear_prev + self.eps_t * (self.shift_t - self.ut_prev) / w
+                BtT, M, Mn = transposed(Bt), scaled_rows(Bt, ctt), scaled_rows(Bn, ctn)
+                dt = Bt.createVecLeft()
+                dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0
+                with released(comm, BtT, M, Mn, dt):
+                    M.axpy(1.0, Mn, structure=DIFFERENT)
+                    A = add_product(A, BtT, M)
+                    BtT.mult(dt, tmp)
+                    rhs.axpy(1.0, tmp)
+        A.axpy(1.0, el.K, structure=DIFFERENT)
+        return A, rhs, slips
 
     def solve(self, active: np.ndarray, it: int) -> Step:
         """One LU solve on `active` and the friction sets; the next set from the return map."""
         setup, comm = self.setup, self.setup.comm
-        A, rhs = self._system(active)
-        x, info = factor_solve(A, rhs, self.options)
+        A, rhs, slips = self._system(active)
+        x, info = factor_solve(A, rhs, self.lu if slips else self.options)
         self.u.x.petsc_vec.array[:] = x
         self.u.x.scatter_forward()
         gap = setup.normalized_gap(self.u)

@@ -166,7 +166,7 @@ def test_vanishing_mu_gives_the_frictionless_pressures(method: str, basis: str) 
     ("method", "options", "words"),
     [
         ("sts", {}, "not solved with sts"),
-        ("penalty", {}, "not solved with the penalty enforcement"),
+        ("sts", {"enforcement": "penalty"}, "not solved with sts"),
         ("schwarz", {}, "not solved with the schwarz enforcement"),
         ("mortar", {"solver": "condensed", "basis": "dual"}, "not solved with the condensed"),
         ("mortar", {"solver": "fieldsplit"}, "not solved with the fieldsplit solver"),

@@ -56,14 +56,16 @@ def test_scene_file_bad_mu_is_one_line(tmp_path: Path, mu: str, expected: str) -
 
 
 def test_frictional_pair_is_read_and_solved_or_refused(tmp_path: Path) -> None:
-    """mu > 0 is read onto its pair; mortar solves it with friction, sts, penalty and Schwarz
-    refuse it in one line."""
+    """mu > 0 is read onto its pair; mortar and penalty solve it with friction, sts and
+    Schwarz refuse it in one line."""
     scene = load_scene_file(stacked(tmp_path, "0.3"))
     assert [p.mu for p in scene.contacts] == [0.3, 0.0, 0.0]
     sol, _ = run_scene(scene, SolveRequest.parse("mortar"))
     assert sol.friction is not None
     np.testing.assert_array_equal(np.unique(sol.friction.mu), [0.0, 0.3])
-    for method in ("sts", "penalty", "schwarz"):
+    pen, _ = run_scene(scene, SolveRequest.parse("penalty"))
+    assert pen.friction is not None and pen.penalty is not None
+    for method in ("sts", "schwarz"):
         with pytest.raises(InputError, match=r"contact 0 \('b2_bottom' on 'b1_top'\) has mu = 0.3"):
             run_scene(scene, SolveRequest.parse(method))
 
