@@ -219,22 +219,26 @@ def stacked_blocks() -> tuple[Solution, Arrays]:
 CASES["cli-stacked-blocks"] = Case(stacked_blocks, {"forces": Abs(1e-8 * 10.0 * 2.0)})
 
 
-def friction_push() -> tuple[Solution, Arrays]:
-    """`contactfx solve friction_push.toml`: each load step's force, shear and statuses."""
-    sol, data = cli_json(["solve", str(SCENES / "friction_push.toml")])
-    pairs = [step["contacts"][0] for step in data["steps"]]
-    names = ("open", "stick", "slip")
-    return sol, {
-        "forces": np.array([c["force"] for c in pairs], dtype=float),
-        "shear": np.array([c["interface"]["shear"] for c in pairs], dtype=float),
-        "status": np.array([[names.index(v) for v in c["interface"]["status"]] for c in pairs]),
-    }
+def friction_push(*options: str) -> Callable[[], tuple[Solution, Arrays]]:
+    """`contactfx solve friction_push.toml [options]`: each step's force, shear and statuses."""
+
+    def run() -> tuple[Solution, Arrays]:
+        sol, data = cli_json(["solve", str(SCENES / "friction_push.toml"), *options])
+        pairs = [step["contacts"][0] for step in data["steps"]]
+        names = ("open", "stick", "slip")
+        return sol, {
+            "forces": np.array([c["force"] for c in pairs], dtype=float),
+            "shear": np.array([c["interface"]["shear"] for c in pairs], dtype=float),
+            "status": np.array([[names.index(v) for v in c["interface"]["status"]] for c in pairs]),
+        }
+
+    return run
 
 
-# p = 10 on the block's width 1; the statuses exactly serial's.
-CASES["cli-friction-push"] = Case(
-    friction_push, {"forces": Abs(1e-9 * 10.0), "shear": Abs(1e-9 * 10.0), "status": Exact()}
-)
+# p = 10 on the block's width 1; the statuses exactly serial's. The penalty baseline too.
+FRICTION_CHECKS = {"forces": Abs(1e-9 * 10.0), "shear": Abs(1e-9 * 10.0), "status": Exact()}
+CASES["cli-friction-push"] = Case(friction_push(), FRICTION_CHECKS)
+CASES["cli-friction-push-penalty"] = Case(friction_push("--method", "penalty"), FRICTION_CHECKS)
 
 
 # --- Hertz (test_hertz, test_scale, test_dual_condensed, test_direct_floor, test_penalty) ----
