@@ -188,7 +188,8 @@ def _solve_parser(sub: Any) -> None:
         default=None,
         metavar="EPS",
         help="penalty normal stiffness (pressure = EPS * penetration) for --method "
-        "penalty; default 1e3 * max E / h, h the median contact element size",
+        "penalty (with friction also the tangential stiffness); default 1e3 * max E / h, "
+        "h the median contact element size",
     )
     m.add_argument(
         "--basis",
