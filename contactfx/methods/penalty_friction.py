@@ -113,8 +113,9 @@ class PenaltyFrictionIteration:
         """
         setup, el = self.setup, self.setup.elasticity
         w, g0 = setup.w, setup.g
-        stick = active & self.stick & self.free_t
-        slip = active & ~self.stick & self.free_t & (self.mu > 0.0)
+        rubs = self.free_t & (self.mu > 0.0)  # a row that can carry a shear
+        stick = active & self.stick & rubs
+        slip = active & ~self.stick & rubs
         cn = np.where(active, self.eps_n / w, 0.0)
         ctt = np.where(stick, self.eps_t / w, 0.0)
         ctn = np.where(slip, -self.mu * self.sign * self.eps_n / w, 0.0)
@@ -166,7 +167,7 @@ class PenaltyFrictionIteration:
         # A row solved as slipping whose trial turns against its direction sticks next: a
         # reversal passes through stick. Flipping it straight to the other direction made an
         # unloading step cycle (tests/methods/test_penalty_friction.py, the pull back).
-        reversed_ = active & ~self.stick & ~stick & (sign != self.sign)
+        reversed_ = active & ~self.stick & ~stick & (sign != self.sign) & (self.mu > 0.0)
         stick = stick | reversed_
         changed = contact & active & ((stick != self.stick) | (~stick & (sign != self.sign)))
         n_changed = comm.allreduce(int(changed.sum()))

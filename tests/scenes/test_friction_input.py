@@ -65,6 +65,8 @@ def test_frictional_pair_is_read_and_solved_or_refused(tmp_path: Path) -> None:
     np.testing.assert_array_equal(np.unique(sol.friction.mu), [0.0, 0.3])
     pen, _ = run_scene(scene, SolveRequest.parse("penalty"))
     assert pen.friction is not None and pen.penalty is not None
+    frictionless = pen.friction.mu == 0.0
+    assert frictionless.any() and np.all(pen.friction.shear[frictionless] == 0.0)
     for method in ("sts", "schwarz"):
         with pytest.raises(InputError, match=r"contact 0 \('b2_bottom' on 'b1_top'\) has mu = 0.3"):
             run_scene(scene, SolveRequest.parse(method))
