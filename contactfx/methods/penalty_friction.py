@@ -86,6 +86,8 @@ class PenaltyFrictionIteration:
     ) -> None:
         self.setup, self.eps_n, self.eps_t = setup, eps, eps
         self.Bt, self.shift_t, self.free_t = tangential
+        # B_n^T and B_t^T: the same in every solve of the step (freed by `destroy`).
+        self.BnT, self.BtT = transposed(setup.B), transposed(self.Bt)
         self.options, self.lu = options, lu_options(options)
         layout = setup.layout
         mus = pair_mu(scene)
@@ -100,6 +102,11 @@ class PenaltyFrictionIteration:
         self.lam_t = np.zeros(m)
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
+
+    def destroy(self) -> None:
+        """Free the transposes."""
+        self.BnT.destroy()
+        self.BtT.destroy()
 
     def key(self, active: np.ndarray) -> np.ndarray:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
@@ -123,21 +130,21 @@ class PenaltyFrictionIteration:
         slips = comm.allreduce(bool(slip.any()), op=MPI.LOR)
         sheared = slips or comm.allreduce(bool(stick.any()), op=MPI.LOR)
         Bn, Bt = setup.B, self.Bt
-        BnT, An = transposed(Bn), scaled_rows(Bn, cn)
+        BnT, BtT, An = self.BnT, self.BtT, scaled_rows(Bn, cn)
         A = add_product(None, BnT, An)
         rhs = el.f.copy()
         dn, tmp = Bn.createVecLeft(), rhs.duplicate()
         dn.array[:] = -cn * g0
-        with released(comm, BnT, An, dn, tmp):
+        with released(comm, An, dn, tmp):
             BnT.mult(dn, tmp)
             rhs.axpy(1.0, tmp)
             if sheared:
                 # Stick rows' lambda_t = a + (eps_t / w) B_t u; slip rows' = ctn (g0 + B_n u).
                 a = self.shear_prev + self.eps_t * (self.shift_t - self.ut_prev) / w
-                BtT, M, Mn = transposed(Bt), scaled_rows(Bt, ctt), scaled_rows(Bn, ctn)
+                M, Mn = scaled_rows(Bt, ctt), scaled_rows(Bn, ctn)
                 dt = Bt.createVecLeft()
                 dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0
-                with released(comm, BtT, M, Mn, dt):
+                with released(comm, M, Mn, dt):
                     M.axpy(1.0, Mn, structure=DIFFERENT)
                     A = add_product(A, BtT, M)
                     BtT.mult(dt, tmp)
@@ -223,10 +230,10 @@ def _solve_step(
             Bt, shift_t, tangent, free_t, moving = tangent_constraint(
                 scene, setup, request.basis, kernel
             )
-        with released(scene.comm, Bt):
-            iteration = PenaltyFrictionIteration(
-                scene, setup, (Bt, shift_t, free_t), eps, request.solver.petsc
-            )
+        iteration = PenaltyFrictionIteration(
+            scene, setup, (Bt, shift_t, free_t), eps, request.solver.petsc
+        )
+        with released(scene.comm, Bt, iteration):
             active = setup.initial_active(aso.penetration_tol * setup.h)
             if before is not None:
                 if len(before.active) != len(active):

@@ -97,8 +97,9 @@ def test_patch_test_uniform_state_by_either_enforcement(
 
 def test_penalty_stick_error_is_its_elastic_slip_and_falls_like_one_over_eps() -> None:
     """The patch test's stick state with the top moved by the multipliers' answer (no slip):
-    the penalty's interface slips by shear / eps_t at every node and the shear falls short
-    of tau by that much of the shear strain; ten times eps_t, a tenth of the error."""
+    the penalty's interface slips elastically by shear / eps_t at every node, which takes a
+    part of the prescribed motion from the shear strain, so the shear falls short of tau;
+    ten times eps_t, a tenth of the error."""
     tau, errors = 2.0, []
     for eps in (1e5, 1e6, 1e7):
         sol = solve(patch(tau, 0.0), "penalty", penalty=eps)
