@@ -153,7 +153,7 @@ class PenaltyFrictionIteration:
         return A, rhs, slips
 
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One LU solve on `active` and the friction sets; the next set from the return map."""
+        """One factorization on `active` and its friction sets; the next set by the return map."""
         setup, comm = self.setup, self.setup.comm
         A, rhs, slips = self._system(active)
         x, info = factor_solve(A, rhs, self.lu if slips else self.options)
