@@ -20,7 +20,7 @@ from conftest import ROOT, cli
 from test_friction import MU, PATCH, SUPPORTS, P, forces, patch, pushed, stepped
 from test_friction_obstacles import floor, on_floor
 
-from contactfx import ContactPair, SolveRequest, scene_from_gmsh, solve
+from contactfx import ContactPair, SolveRequest, load_scene_file, scene_from_gmsh, solve
 from contactfx.contact.friction import Status
 from contactfx.errors import InputError
 from contactfx.methods.active_set import ActiveSetOptions
@@ -316,3 +316,31 @@ def test_cli_solves_the_pushed_block_by_penalty(tmp_path: Path) -> None:
     pair = data["contacts"][0]
     np.testing.assert_allclose(pair["force"], [-MU * P, P], rtol=1e-10)
     assert set(pair["interface"]["status"]) == {"open", "slip"}
+
+
+@pytest.mark.parametrize("request_", PENALTY, ids=ids(PENALTY))
+def test_penalty_press_fit_pushed_out_slides_at_mu_p(request_: SolveRequest) -> None:
+    """The axisymmetric shaft-hub press fit (tests/scenes/press_fit.toml: an interference),
+    mu = 0.2, its hub then pushed along the axis by 0.1 at its mid point: fitted, every
+    contact node sticks with no axial force (the fit is symmetric about the mid-plane);
+    pushed out, every contact node slips and the axial force is mu times the radial force
+    (the push-out reference) to 1e-10."""
+    fit = load_scene_file(ROOT / "tests" / "scenes" / "press_fit.toml")
+    held = [d for d in fit.dirichlet if d.group != "hub_mid"]
+    scene = replace(
+        fit,
+        contacts=tuple(replace(c, mu=0.2) for c in fit.contacts),
+        dirichlet=(*held, Dirichlet("hub_mid", uy=0.1, name="push")),
+        steps=({"push": 0.0}, {"push": 1.0}),
+    )
+    sol = solve(scene, request_)
+    fitted, pushed_out = sol.steps
+    for before, step in ((None, fitted), (fitted, pushed_out)):
+        check_coulomb(step, 0.2, before)
+    assert fitted.friction is not None and pushed_out.friction is not None
+    np.testing.assert_array_equal(fitted.friction.status, Status.STICK)
+    p_fit, q_fit = forces(fitted)
+    assert abs(q_fit) < 1e-6 * p_fit
+    np.testing.assert_array_equal(pushed_out.friction.status, Status.SLIP)
+    p_total, q_total = forces(pushed_out)
+    assert q_total == pytest.approx(-0.2 * p_total, rel=1e-10)
