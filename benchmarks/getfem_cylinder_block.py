@@ -31,6 +31,8 @@ import time
 import getfem as gf
 import numpy as np
 
+gf.util("trace level", 0)
+
 E, NU, MU = 1000.0, 0.3, 0.3
 PRESS, PUSH = 0.03, 0.01
 NOISY: list[str] = []
@@ -176,6 +178,9 @@ def main() -> None:
         nbit, converged = md.solve("max_res", 1e-10, "max_iter", 100, "lsolver", "mumps", *NOISY)
         wall = time.perf_counter() - t0
         lam_v = md.variable("lam").reshape(-1, 2)
+        # The step's slip increment at the arc nodes (cylinder relative to block).
+        vs = np.asarray(md.interpolation(slip, mfl, ARC))
+        vs = (vs[dofs] if vs.size == mfl.nbdof() else vs).reshape(-1, 2)
         force = gf.asm("generic", mim1, 0, "lam", ARC, md)
         # Contact stress on the cylinder: its normal part along the bisector is the pressure.
         n, t = frame(xy[:, 0], xy[:, 1])
@@ -193,6 +198,7 @@ def main() -> None:
                 "traction": trac.tolist(),
                 "pressure": np.einsum("ij,ij->i", trac, n).tolist(),
                 "shear": (-np.einsum("ij,ij->i", trac, t)).tolist(),
+                "slip_increment": vs.tolist(),
             }
         )
         print(
@@ -210,6 +216,8 @@ def main() -> None:
         "dofs": int(mfu1.nbdof() + mfu2.nbdof()),
         "multiplier_dofs": int(len(dofs)),
         "h": h,
+        "frame": args.frame,
+        "normal": FRAMES[args.frame],
         "r": r,
         "setup_s": t_setup,
         "steps": steps,
