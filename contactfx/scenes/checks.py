@@ -200,7 +200,7 @@ def _check_pushout(scene: Scene, ref: PushoutReference) -> None:
             f"{where}: pair {ref.pair} is not one of the {len(scene.contacts)} contact pairs "
             "(a push-out is a shaft and a hub)"
         )
-    if ref.mu is None and scene.contacts[ref.pair].mu <= 0:
+    if scene.contacts[ref.pair].mu <= 0:
         raise InputError(f"{where}: the pair is frictionless: give it mu > 0 in its [[contact]]")
     if scene.model is not Model.AXISYMMETRIC:
         raise InputError(
