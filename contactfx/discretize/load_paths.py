@@ -351,7 +351,11 @@ def what_pulls(scene: Scene) -> str:
 
 
 def _verdict(
-    comm: MPI.Comm, a: np.ndarray, load: np.ndarray, at: np.ndarray | None, mu: np.ndarray | None
+    comm: MPI.Comm,
+    a: np.ndarray,
+    load: np.ndarray,
+    at: np.ndarray | None = None,
+    mu: np.ndarray | None = None,
 ) -> tuple[Any, Any]:
     """Rank 0's carrying_rows (and pulled_away where nothing carries), on every rank.
 

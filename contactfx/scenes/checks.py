@@ -236,8 +236,10 @@ def _check_overlaps(scene: Scene) -> None:
         return
     x = scene.mesh.geometry.x[:, :2]
     comm = scene.comm
-    lo = comm.allreduce(x.min(axis=0, initial=np.inf), op=MPI.MIN)
-    hi = comm.allreduce(x.max(axis=0, initial=-np.inf), op=MPI.MAX)
+    # Buffers, not pickled objects: a pickled MIN compares two arrays as one truth value.
+    lo, hi = x.min(axis=0, initial=np.inf), x.max(axis=0, initial=-np.inf)
+    comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+    comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
     extent = float(np.max(hi - lo))
     for k, pair in given:
         d = pair.prescribed_overlap

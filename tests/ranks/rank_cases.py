@@ -237,6 +237,28 @@ CASES["cli-friction-push"] = Case(
 )
 
 
+def pushout() -> tuple[Solution, Arrays]:
+    """`contactfx solve press_fit_pushout.toml` (the pushout reference): each step's axial
+    force, normal force and statuses (the interface sorted by arc length)."""
+    scene = ROOT / "demos" / "scenes" / "press_fit_pushout.toml"
+    sol, data = cli_json(["solve", str(scene)])
+    steps = [step["pushout"][0] for step in data["steps"]]
+    names = ("open", "stick", "slip")
+    return sol, {
+        "forces": np.array([[s["axial_force"], s["normal_force"]] for s in steps]),
+        "status": np.array(
+            [
+                [names.index(v) for v in st["contacts"][0]["interface"]["status"]]
+                for st in data["steps"]
+            ]
+        ),
+    }
+
+
+# mu N = 0.2 * 4429 at full slip; the statuses exactly serial's.
+CASES["cli-pushout"] = Case(pushout, {"forces": Abs(1e-9 * 1000.0), "status": Exact()})
+
+
 # --- Hertz (test_hertz, test_scale, test_dual_condensed, test_direct_floor, test_penalty) ----
 
 
