@@ -18,7 +18,7 @@ import pytest
 from conftest import ROOT, cli, run_cli
 
 from contactfx import SolveRequest, load_scene_file, run_scene
-from contactfx.discretize.load_paths import _carrying_lp, _one_mode, carrying_rows, pulled_away
+from contactfx.discretize.load_programs import _carrying_lp, _one_mode, carrying_rows, pulled_away
 from contactfx.discretize.setup import prepare_contact
 from contactfx.errors import SingularSystemError
 from contactfx.methods.active_set import ActiveSetOptions
