@@ -90,6 +90,22 @@ def test_one_free_mode_in_closed_form_agrees_with_the_program(load: float) -> No
             assert lp.tolist() == closed.tolist(), (a, load)
 
 
+@pytest.mark.parametrize(("q", "held"), [(0.0, True), (2.9, True), (-2.9, True), (3.1, False)])
+def test_friction_holds_a_block_sideways_within_its_cone(q: float, held: bool) -> None:
+    """A block (modes x, y) on two floor rows (normal along y, tangent along x, mu = 0.3)
+    pressed by 10 and pulled by q along x: an equilibrium inside Coulomb's cone exists iff
+    |q| <= mu * 10; a frictionless pair never holds a pull (hand statics)."""
+    a = np.array([[0.0, 1.0], [0.0, 2.0]])  # unequal rows: the bound is per row
+    at = np.array([[1.0, 0.0], [2.0, 0.0]])
+    load = np.array([q, -10.0])
+    got = carrying_rows(a, load, at, np.array([0.3, 0.3]))
+    assert (got is not None) == held
+    if got is not None:
+        assert got.tolist() == [True, True]
+    frictionless = carrying_rows(a, load, at, np.zeros(2))
+    assert (frictionless is not None) == (q == 0.0)
+
+
 def test_load_that_pulls_a_block_off_has_no_equilibrium() -> None:
     """Rows push up only, the load pulls up: no lam >= 0 balances it; the motion that
     proves it opens every gap (rows . y >= 0) and the load does work on it."""
