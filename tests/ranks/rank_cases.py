@@ -237,6 +237,25 @@ CASES["cli-friction-push"] = Case(
 )
 
 
+def held_sideways() -> tuple[Solution, Arrays]:
+    """`contactfx solve friction_held_sideways.toml`: a block held along x by stick alone (the
+    free-body program with friction's rows on 2 ranks): its force, shear and statuses."""
+    sol, data = cli_json(["solve", str(SCENES / "friction_held_sideways.toml")])
+    c = data["contacts"][0]
+    names = ("open", "stick", "slip")
+    return sol, {
+        "forces": np.array(c["force"], dtype=float),
+        "shear": np.array(c["interface"]["shear"], dtype=float),
+        "status": np.array([names.index(v) for v in c["interface"]["status"]]),
+    }
+
+
+# p = 10 on the block's width 1; the statuses exactly serial's.
+CASES["cli-friction-held-sideways"] = Case(
+    held_sideways, {"forces": Abs(1e-9 * 10.0), "shear": Abs(1e-9 * 10.0), "status": Exact()}
+)
+
+
 def pushout() -> tuple[Solution, Arrays]:
     """`contactfx solve press_fit_pushout.toml` (the pushout reference): each step's axial
     force, normal force and statuses (the interface sorted by arc length)."""

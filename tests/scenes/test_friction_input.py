@@ -102,6 +102,25 @@ def test_friction_refused_by_enforcement_or_solver_is_one_line(
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
 
 
+def test_a_body_held_sideways_by_stick_alone_from_the_cli(tmp_path: Path) -> None:
+    """friction_held_sideways.toml solves (the shear carries the pull, the middle sticks);
+    with mu = 0 the block is free along x: one line, exit 2, before any solve."""
+    out = tmp_path / "run.json"
+    scene = SCENES / "friction_held_sideways.toml"
+    proc = cli("solve", str(scene), "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    (pair,) = json.loads(out.read_text())["contacts"]
+    assert (
+        pair["force"][0] == pytest.approx(-1.0, rel=1e-9) and "stick" in pair["interface"]["status"]
+    )
+    (tmp_path / "friction_blocks.geo").write_text((SCENES / "friction_blocks.geo").read_text())
+    plain = tmp_path / "plain.toml"
+    plain.write_text(scene.read_text().replace("mu = 0.3", "mu = 0.0"))
+    proc = cli("solve", str(plain))
+    assert proc.returncode == 2 and "can still move freely" in proc.stderr, proc.stderr
+    assert "translation along x" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
 def test_load_steps_in_the_json_and_on_the_terminal(tmp_path: Path) -> None:
     """[[step]] tables: one JSON entry per step (the press alone carries no shear, the last
     push slides the block: Q = mu P), the top-level keys are the last step's, and the
