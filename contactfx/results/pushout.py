@@ -28,9 +28,11 @@ def pushout_check(sol: Solution, ref: PushoutReference) -> PushoutCheck:
     fr = sol.friction
     assert fr is not None  # checks.py refuses a frictionless pair
     mu = _mu(sol, ref)
-    rows = sol.pairs[ref.pair].rows
+    pv = sol.pairs[ref.pair]
+    rows = pv.rows
     w = sol.layout.weights[rows]
     p, q, status = sol.pressure[rows], fr.shear[rows], fr.status[rows]
+    touching = status != Status.OPEN
     axial = float(pair_forces(sol, ref.pair)[0][1])
     slip = status == Status.SLIP
     p_max = float(p.max(initial=0.0))
@@ -46,6 +48,7 @@ def pushout_check(sol: Solution, ref: PushoutReference) -> PushoutCheck:
         slip=int(slip.sum()),
         open=int(np.sum(status == Status.OPEN)),
         slip_law=law,
+        taper=float(np.abs(pv.n[touching, 1]).max(initial=0.0)),
     )
 
 

@@ -233,6 +233,13 @@ class CattaneoCheck:
         }
 
 
+# A push-out: the active surface's normal may lean this far from radial (round-off of a
+# cylinder), and in full slip the ratio and the slip law must hold to this (round-off of
+# the multipliers: measured 1e-15 and 2e-16, docs/friction.md).
+CYLINDER_TOL = 1e-6
+COULOMB_TOL = 1e-6
+
+
 @dataclass(frozen=True, kw_only=True)
 class PushoutCheck:
     """One press fit at one load step: its axial force against mu times its normal force.
@@ -249,6 +256,25 @@ class PushoutCheck:
     slip: int
     open: int
     slip_law: float | None  # max over slip nodes of ||shear| - mu p| / (mu max p); None: none
+    taper: float = 0.0  # max |n_axial| of the active surface over the contact nodes
+
+    @property
+    def warning(self) -> str | None:
+        """Why the reference does not describe the pair, or where Coulomb's law fails."""
+        if self.taper > CYLINDER_TOL:
+            return (
+                f"the interface is not a cylinder (its normal's axial part reaches "
+                f"{self.taper:.2g}): the pressure has an axial force, and axial = mu N holds "
+                "only on a cylinder"
+            )
+        if self.full_slip and not (
+            abs(self.ratio - 1.0) <= COULOMB_TOL and (self.slip_law or 0.0) <= COULOMB_TOL
+        ):
+            return (
+                f"full slip, but axial / (mu N) = {self.ratio:.6g} and the slip law's largest "
+                f"violation is {self.slip_law:.2g} (both 1 and 0 to {COULOMB_TOL:g} expected)"
+            )
+        return None
 
     @property
     def ratio(self) -> float:
@@ -264,11 +290,12 @@ class PushoutCheck:
         """One terminal line."""
         law = "" if self.slip_law is None else f", slip law {self.slip_law:.1e}"
         state = "full slip" if self.full_slip else ("stick" if self.slip == 0 else "partial slip")
-        return (
+        text = (
             f"push-out, pair {self.pair}: axial / (mu N) = {self.ratio:.4f} ({state}: "
             f"{self.stick} stick, {self.slip} slip), axial {self.axial:.6g}, N {self.normal:.6g} "
             f"(totals over the turn){law}"
         )
+        return text if self.warning is None else f"{text}; warning: {self.warning}"
 
     def to_json(self) -> dict[str, Any]:
         """The entry of a step's `pushout` list."""
@@ -283,6 +310,8 @@ class PushoutCheck:
             "open": self.open,
             "full_slip": self.full_slip,
             "slip_law": self.slip_law,
+            "taper": self.taper,
+            "warning": self.warning,
         }
 
 

@@ -23,6 +23,7 @@ from conftest import ROOT, cli
 from contactfx import ContactPair, PushoutReference, SolveRequest, load_scene_file
 from contactfx.api import run_scene
 from contactfx.errors import InputError
+from contactfx.results.reference_records import PushoutCheck
 from contactfx.scenes import Dirichlet, Material, scene_from_gmsh
 
 SCENE = ROOT / "demos" / "scenes" / "press_fit_pushout.toml"
@@ -59,6 +60,7 @@ def test_pushout_reaches_mu_n_in_full_slip() -> None:
         assert c.normal == pytest.approx(2 * math.pi * abs(contact.radial_per_radian), rel=1e-9)
         assert c.axial == contact.axial_force
         assert c.stick + c.slip + c.open == contact.multipliers
+    assert all(c.warning is None and c.taper < 1e-12 for c in checks)
     for c in checks[first:]:
         assert c.ratio == pytest.approx(1.0, abs=1e-9)
         assert c.slip_law is not None and c.slip_law < 1e-9
@@ -100,6 +102,7 @@ def test_pushout_in_the_json_and_on_the_terminal(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     (top,) = data["pushout"]
+    assert top["warning"] is None
     assert top["full_slip"] and top["first_full_slip_step"] == 9 and len(top["ratios"]) == 13
     assert top["fit"]["between"] and top["fit"]["lame_open_ended"] == pytest.approx(78.75)
     steps = [s["pushout"][0] for s in data["steps"]]
@@ -146,6 +149,21 @@ def test_bad_pushout_table_is_one_line(
     assert proc.returncode == 2, proc.stderr
     assert expected in proc.stderr, proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_pushout_warns_off_a_cylinder_or_where_coulomb_fails() -> None:
+    """A tapered interface (the pressure has an axial part) or a full slip whose ratio or slip
+    law is off: the record's warning says which, on its terminal line and in its JSON."""
+    base = {"pair": 0, "mu": 0.2, "axial": 100.0, "normal": 500.0, "open": 0}
+    good = PushoutCheck(**base, stick=0, slip=9, slip_law=1e-16)
+    assert good.full_slip and good.ratio == 1.0 and good.warning is None
+    tapered = PushoutCheck(**base, stick=3, slip=6, slip_law=1e-16, taper=0.05)
+    assert "not a cylinder" in str(tapered.warning) and "warning:" in tapered.text()
+    off = PushoutCheck(**{**base, "axial": 99.0}, stick=0, slip=9, slip_law=1e-16)
+    assert "axial / (mu N) = 0.99" in str(off.warning)
+    assert off.to_json()["warning"] == off.warning
+    loose = PushoutCheck(**base, stick=0, slip=9, slip_law=1e-3)
+    assert "slip law's largest violation is 0.001" in str(loose.warning)
 
 
 def test_bad_pushout_reference_in_python() -> None:
