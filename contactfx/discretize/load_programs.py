@@ -25,21 +25,22 @@ def carrying_rows(
     equilibrium is a^T lam + at^T lam_t + load = 0 with |lam_t| <= mu lam.
     """
     n = a.shape[0]
-    frictional = at is not None and mu is not None and bool(np.any(mu > 0))
-    if frictional:
-        assert at is not None and mu is not None
-        at = np.where((mu > 0)[:, None], at, 0.0)
     on = np.abs(a).max(axis=1, initial=0.0) > 0.0
-    if frictional:
-        assert at is not None
-        on |= np.abs(at).max(axis=1, initial=0.0) > 0.0
+    # Tangential rows count where friction acts and a free mode moves them (else: as before).
+    tangent = None
+    if at is not None and mu is not None:
+        tangent = np.where((mu > 0)[:, None], at, 0.0)
+        if not tangent.any():
+            tangent = None
+    if tangent is not None:
+        on |= np.abs(tangent).max(axis=1, initial=0.0) > 0.0
     out = np.ones(n, dtype=bool)
     j = np.flatnonzero(on)
     if not j.size:
         return out if not load.any() else None
-    if frictional:
-        assert at is not None and mu is not None
-        return _friction_lp(a, at, mu, load, j, out)
+    if tangent is not None:
+        assert mu is not None
+        return _friction_lp(a, tangent, mu, load, j, out)
     if a.shape[1] == 1:
         return _one_mode(a[:, 0], float(load[0]), out)
     return _carrying_lp(a, load, j, out)
