@@ -317,11 +317,13 @@ class PushoutCheck:
 
 @dataclass(frozen=True, kw_only=True)
 class PushoutFit:
-    """The fit before the push (step 1) against Lame's rings: the two limits of its ends.
+    """The fit before the push (step 1) against Lame's rings, open-ended and in plane strain.
 
-    Lame's open-ended cylinder (plane stress: sigma_z = 0, the ends free to slide: a
-    frictionless fit) and plane strain (the axial strain held: what stick friction along the
-    interface tends to): the fit's mean pressure is compared with the first.
+    Lame's open-ended cylinder (plane stress, sigma_z = 0: shaft and hub free to change
+    length, which a frictionless fit meets) is the reference the error is taken against;
+    plane strain (eps_z = 0) is the value above it: stick friction holds the axial strains
+    the fit's Poisson effect would slide by and raises the pressure towards it (a bonded fit
+    stays below: shaft and hub share one axial strain, not zero; docs/friction.md).
     """
 
     p_mean: float  # sum p_j w_j / sum w_j at step 1
