@@ -44,10 +44,14 @@ def variant(tmp_path: Path, *edits: tuple[str, str]) -> Path:
     return path
 
 
-def test_pushout_reaches_mu_n_in_full_slip() -> None:
+@pytest.mark.parametrize(
+    ("method", "basis"), [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")]
+)
+def test_pushout_reaches_mu_n_in_full_slip(method: str, basis: str) -> None:
     """Stick with partial slip, then full slip at |axial| = mu N to round-off; N is the
-    summary's axisymmetric convention (2 pi times the radial resultant per radian)."""
-    _, run = run_scene(load_scene_file(SCENE), SolveRequest.parse("mortar"))
+    summary's axisymmetric convention (2 pi times the radial resultant per radian). The
+    interface's nodes match: nts and both mortar bases give the same values."""
+    _, run = run_scene(load_scene_file(SCENE), SolveRequest.parse(method, basis=basis))
     (po,) = run.pushout
     checks = po.steps
     assert len(checks) == len(run.steps) == 13
