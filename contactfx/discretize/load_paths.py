@@ -15,6 +15,12 @@ positive together in one, and maximizing sum min(lam_i, 1) over it finds them al
 mode (a body free along one direction, the usual case) is decided in closed form. If no
 nonnegative lam balances the load, a Farkas certificate (a combination of free modes along
 which the load does work and no gap closes) names the bodies that the load pulls away.
+
+Friction: a frictional pair's tangential rows (B_t m) hold too. Their multipliers take either
+sign, bounded by Coulomb's |lambda_t| <= mu lambda_n at the same node, so a body pressed on
+a floor and pushed sideways by less than mu times the pressing force is held by stick alone;
+the program then carries the tangential unknowns with that bound, and a row's tangential
+part holds wherever its normal row can carry load (docs/friction.md).
 """
 
 from __future__ import annotations
@@ -31,6 +37,7 @@ from ..contact.geometry import Surface
 from ..contact.sparse import CSR
 from ..errors import InputError, SingularSystemError
 from ..scenes import Body, Scene
+from .load_programs import carrying_rows, pulled_away
 from .pairs import PairData
 from .supports import Holding, _free_motions, body_blocks, rigid_modes_at
 
@@ -48,11 +55,20 @@ class LoadPaths:
 
     `rows` (n, 3 nb): B m for each rigid mode m of each body (column 3 k + j: mode j of
     body k), one row per multiplier row in the layout order. `carries` (n,): whether the
-    row can be positive in a nonnegative equilibrium of the free rigid modes.
+    row can be positive in a nonnegative equilibrium of the free rigid modes. `tangent`
+    (n, 3 nb): B_t m of the frictional rows (zero on frictionless ones), None without
+    friction.
     """
 
     rows: np.ndarray
     carries: np.ndarray
+    tangent: np.ndarray | None = None
+
+    def holding(self, on: np.ndarray) -> np.ndarray:
+        """The rows B m that hold the bodies where `on` (n,): normal, and tangential (stick)."""
+        if self.tangent is None:
+            return self.rows[on]
+        return np.vstack([self.rows[on], self.tangent[on]])
 
 
 def surface_modes(pairs: list[PairData], hold: Holding, ndofs: int) -> CSR:
@@ -106,86 +122,6 @@ def mode_loads(scene: Scene, V: fem.FunctionSpace, f: PETSc.Vec, hold: Holding) 
     return work
 
 
-def carrying_rows(a: np.ndarray, load: np.ndarray) -> np.ndarray | None:
-    """Rows (of a (n, k)) positive in some lam >= 0 with a^T lam + load = 0; None: no such lam.
-
-    A row of zeros (no free mode acts on it) counts as carrying: statics do not bound it.
-    """
-    n = a.shape[0]
-    on = np.abs(a).max(axis=1, initial=0.0) > 0.0
-    out = np.ones(n, dtype=bool)
-    j = np.flatnonzero(on)
-    if not j.size:
-        return out if not load.any() else None
-    if a.shape[1] == 1:
-        return _one_mode(a[:, 0], float(load[0]), out)
-    return _carrying_lp(a, load, j, out)
-
-
-def _one_mode(a: np.ndarray, load: float, out: np.ndarray) -> np.ndarray | None:
-    """carrying_rows with one free mode (a body free along one direction), in closed form.
-
-    sum a_i lam_i = -load, lam >= 0: the rows of the sign of -load can carry it, and then
-    every other nonzero row too (its share is balanced by more on the first); with no load
-    the nonzero rows carry only if both signs are present (the body squeezed). The LP's
-    answer without scipy.optimize (imported only for two or more free modes).
-    """
-    pos, neg = bool((a > 0).any()), bool((a < 0).any())
-    if (load < 0 and not pos) or (load > 0 and not neg):
-        return None
-    out[a != 0] = load != 0 or (pos and neg)
-    return out
-
-
-def _carrying_lp(
-    a: np.ndarray, load: np.ndarray, j: np.ndarray, out: np.ndarray
-) -> np.ndarray | None:
-    """carrying_rows by the linear program (HiGHS), `j` the rows some free mode acts on."""
-    # Each lam_i scaled by its row's size: the same signs, a well-scaled program.
-    aj = a[j] / np.abs(a[j]).max(axis=1, keepdims=True)
-    fl = load / max(float(np.abs(load).max()), 1e-300)
-    m, k = len(j), a.shape[1]
-    # Unknowns (lam, s, t): a^T lam + load s = 0, t <= lam, s >= 1, 0 <= t <= 1.
-    import scipy.sparse as sp  # with scipy.optimize below: only for 2+ free modes
-
-    a_eq = sp.hstack([sp.csr_matrix(aj.T), sp.csr_matrix(fl.reshape(k, 1)), sp.csr_matrix((k, m))])
-    eye = sp.identity(m, format="csr")
-    a_ub = sp.hstack([-eye, sp.csr_matrix((m, 1)), eye])
-    c = np.concatenate([np.zeros(m + 1), -np.ones(m)])
-    bounds = [(0.0, None)] * m + [(1.0, None)] + [(0.0, 1.0)] * m
-    from scipy.optimize import linprog  # scipy.optimize (~0.15 s) only for 2+ free modes
-
-    res = linprog(c, a_ub, np.zeros(m), a_eq, np.zeros(k), bounds=bounds, method="highs")
-    if res.status == 2:
-        return None
-    if res.status != 0:
-        raise SingularSystemError(
-            f"the check of which contacts can hold the bodies failed: {res.message}"
-        )
-    out[j] = res.x[m + 1 :] > 0.5
-    return out
-
-
-def pulled_away(a: np.ndarray, load: np.ndarray) -> np.ndarray:
-    """A free-mode combination y with a y >= 0 (no gap closes) and load . y = 1 (Farkas)."""
-    k = a.shape[1]
-    on = np.abs(a).max(axis=1, initial=0.0) > 0.0
-    aj = a[on] / np.abs(a[on]).max(axis=1, keepdims=True)
-    fl = load / max(float(np.abs(load).max()), 1e-300)
-    from scipy.optimize import linprog  # scipy.optimize (~0.15 s) only for a refusal
-
-    res = linprog(
-        np.zeros(k),
-        -aj if aj.size else None,
-        np.zeros(len(aj)) if aj.size else None,
-        fl.reshape(1, k),
-        np.ones(1),
-        bounds=[(None, None)] * k,
-        method="highs",
-    )
-    return np.asarray(res.x) if res.status == 0 else np.ones(k)
-
-
 def _named(hold: Holding, free: np.ndarray, loose: list[int]) -> list[str]:
     """'name' (every free motion) of each loose body."""
     return [f"'{hold.bodies[k].name}' ({_free_motions(free[:, 3 * k : 3 * k + 3])})" for k in loose]
@@ -211,11 +147,11 @@ def floating_message(
     pairs: list[PairData], layout_pair: np.ndarray, hold: Holding, paths: LoadPaths
 ) -> str | None:
     """One line naming the bodies the supports and load-carrying rows leave free, or None."""
-    free = hold.free_modes(paths.rows[paths.carries])
+    free = hold.free_modes(paths.holding(paths.carries))
     loose = hold.loose(free)
     if not loose:
         return None
-    bilateral = set(hold.loose(hold.free_modes(paths.rows)))
+    bilateral = set(hold.loose(hold.free_modes(paths.holding(np.ones(len(paths.rows), bool)))))
     when = "before the first solve"
     parts = [
         f"body '{hold.bodies[k].name}' can still move freely after its supports and contacts "
@@ -264,7 +200,13 @@ def what_pulls(scene: Scene) -> str:
     return f"{thermal} pulls the bodies apart (no load is applied)"
 
 
-def _verdict(comm: MPI.Comm, a: np.ndarray, load: np.ndarray) -> tuple[Any, Any]:
+def _verdict(
+    comm: MPI.Comm,
+    a: np.ndarray,
+    load: np.ndarray,
+    at: np.ndarray | None = None,
+    mu: np.ndarray | None = None,
+) -> tuple[Any, Any]:
     """Rank 0's carrying_rows (and pulled_away where nothing carries), on every rank.
 
     An exception there (HiGHS refusing its input) is sent to every rank and raised on each,
@@ -274,7 +216,7 @@ def _verdict(comm: MPI.Comm, a: np.ndarray, load: np.ndarray) -> tuple[Any, Any]
     error = None
     if comm.rank == 0:
         try:
-            carries = carrying_rows(a, load)
+            carries = carrying_rows(a, load, at, mu)
             verdict = (carries, pulled_away(a, load) if carries is None else None)
         except ValueError as exc:
             error = str(exc)
@@ -295,6 +237,7 @@ def load_paths(
     order: np.ndarray,
     layout_pair: np.ndarray,
     hold: Holding,
+    friction: tuple[CSR, np.ndarray] | None = None,
 ) -> LoadPaths:
     """The rows B m of the layout's multiplier rows and which of them can carry load.
 
@@ -302,10 +245,18 @@ def load_paths(
     free motion of each loose body, if the supports and all rows (bilateral) leave a body
     free, if no nonnegative contact force balances the load on the free modes (the load
     pulls the bodies apart), or if the rows that can carry load leave a body free.
+    `friction`: the tangential rows B_t (stacked order) and each stacked row's mu.
     """
-    rows = B.rows(order).dense_product(surface_modes(pairs, hold, B.shape[1]))
+    modes = surface_modes(pairs, hold, B.shape[1])
+    rows = B.rows(order).dense_product(modes)
     rows[np.abs(rows) <= ROW_RTOL * float(np.abs(rows).max(initial=0.0))] = 0.0
-    every = LoadPaths(rows, np.ones(len(rows), dtype=bool))
+    tangent, mu = None, None
+    if friction is not None:
+        mu = friction[1][order]
+        tangent = friction[0].rows(order).dense_product(modes)
+        tangent[np.abs(tangent) <= ROW_RTOL * float(np.abs(tangent).max(initial=0.0))] = 0.0
+        tangent[mu <= 0] = 0.0
+    every = LoadPaths(rows, np.ones(len(rows), dtype=bool), tangent)
     # Free even with every row bilateral: no load can make the system regular.
     message = floating_message(pairs, layout_pair, hold, every)
     if message is not None:
@@ -316,6 +267,10 @@ def load_paths(
     free[np.abs(free) < 1e-12] = 0.0  # eigh's round-off on the held modes
     a = rows @ free.T
     a[np.abs(a) <= ROW_RTOL * float(np.abs(a).max(initial=0.0))] = 0.0
+    at = None
+    if tangent is not None:
+        at = tangent @ free.T
+        at[np.abs(at) <= ROW_RTOL * float(np.abs(at).max(initial=0.0))] = 0.0
     work = mode_loads(scene, V, f, hold)
     if not (np.isfinite(work).all() and np.isfinite(a).all()):
         # inf or nan in the assembled system (a lifting of 0 * inf): no program can decide.
@@ -325,7 +280,7 @@ def load_paths(
         )
     load = free @ work
     load[np.abs(load) <= LOAD_RTOL * float(np.abs(work).sum())] = 0.0
-    carries, away = _verdict(scene.comm, a, load)
+    carries, away = _verdict(scene.comm, a, load, at, mu)
     if carries is None:
         assert away is not None
         motion = (free.T @ away)[None, :]
@@ -336,10 +291,11 @@ def load_paths(
             f"against the load ({hold.describe(motion, k)})"
             for k in loose
         ]
+        bound = "" if at is None else " (friction holds at most mu times the normal force)"
         raise SingularSystemError(
-            f"{'; '.join(said)}; decided before the first solve: {what_pulls(scene)}"
+            f"{'; '.join(said)}; decided before the first solve: {what_pulls(scene)}{bound}"
         )
-    paths = LoadPaths(rows, carries)
+    paths = LoadPaths(rows, carries, tangent)
     message = floating_message(pairs, layout_pair, hold, paths)
     if message is not None:
         raise SingularSystemError(message)

@@ -34,6 +34,7 @@ from .obstacles import (
 from .pairs import GatheredPair, PairData, build_pairs, gather_pairs, stack
 from .supports import Holding, holding
 from .surfaces import check_facing
+from .tangents import TangentRows, pair_friction, tangent_rows
 
 # An active row whose traction is below this fraction of the largest holds nothing.
 HOLDING_RTOL = 1e-9
@@ -58,6 +59,10 @@ class ContactSetup:
     holding: Holding  # the bodies' rigid frames and what their supports fix
     row_modes: np.ndarray  # (n, 3 nb) B m of every rigid mode m at every row (global)
     pulls: str = "the load pulls the bodies apart"  # load_paths.what_pulls of the scene
+    # Friction (prepare_contact(..., friction=True) with a frictional pair): the tangential
+    # rows, and their B_t m at every row (zero on frictionless rows): stick holds bodies too.
+    tangent: TangentRows | None = None
+    tangent_modes: np.ndarray | None = None
 
     def normalized_gap(self, u: fem.Function) -> np.ndarray:
         """Nodal gap (weighted gap / weight) of the owned rows at displacement u."""
@@ -125,7 +130,10 @@ class ContactSetup:
         glob = np.zeros(self.layout.size, dtype=bool)
         for idx, vals in self.comm.allgather((self.layout.mine, np.asarray(holds, dtype=bool))):
             glob[idx] = vals
-        return self.holding.free_modes(self.row_modes[glob]), glob
+        rows = self.row_modes[glob]
+        if self.tangent_modes is not None:  # an active frictional row holds tangentially too
+            rows = np.vstack([rows, self.tangent_modes[glob]])
+        return self.holding.free_modes(rows), glob
 
     def _floating_message(
         self, loose: list[int], free: np.ndarray, holds: np.ndarray, when: str
@@ -220,11 +228,13 @@ def prepare_contact(
     timers: Timers,
     basis: Basis = Basis.STANDARD,
     frame: str = "passive",
+    friction: bool = False,
 ) -> ContactSetup:
     """Assemble K and f, build every pair's operator and B, and check the geometry.
 
     frame: the rows' normals, the passive surface's or (friction, pairs between bodies) the
-    bisector of both surfaces' (contact/operator.bisector_normals).
+    bisector of both surfaces' (contact/operator.bisector_normals). friction: also the
+    tangential rows of the frictional pairs, which hold bodies in the free-body check.
     """
     comm = scene.comm
     el, ndofs, gathered = assemble_and_gather(scene, timers)
@@ -286,7 +296,12 @@ def prepare_contact(
     hold = holding(scene, V, el.bc_dofs)
     # Before any solve: a body that only rows carrying no load could hold floats, whatever
     # round-off the singular solve would show (decided from statics, see load_paths).
-    paths = load_paths(scene, V, el.f, pairs, op.B, order, layout.pair, hold)
+    mu = pair_friction(pairs)
+    tangent = None
+    if friction and np.any(mu > 0):
+        tangent = tangent_rows(pairs, kernel, basis, frame, ndofs)
+    friction_rows = None if tangent is None else (tangent.B, mu)
+    paths = load_paths(scene, V, el.f, pairs, op.B, order, layout.pair, hold, friction_rows)
     mine = layout.mine
     return ContactSetup(
         comm,
@@ -304,6 +319,8 @@ def prepare_contact(
         hold,
         paths.rows,
         what_pulls(scene),
+        tangent,
+        paths.tangent,
     )
 
 

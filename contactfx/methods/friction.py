@@ -38,12 +38,13 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from ..contact import ContactOperator, contact_operator, rigid_operator
+from ..contact import ContactOperator
 from ..contact.friction import FrictionResult, Status, classify, ncp
 from ..contact.sparse import CSR
 from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
-from ..errors import InputError, SingularSystemError, SolverError
+from ..discretize.tangents import tangent_rows
+from ..errors import InputError, SolverError
 from ..linalg.blocks import diagonal_matrix
 from ..options import Basis, Discretization, Enforcement, SolverKind
 from ..request import SolveRequest
@@ -125,26 +126,8 @@ def tangent_constraint(
     el = setup.elasticity
     V = el.V
     ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-    options: dict[str, object] = {"direction": "tangent", "frame": FRAME}
-    if basis is Basis.DUAL:
-        options["basis"] = basis
-    ops, motion, columns = [], [], []
-    for p in setup.pairs:
-        if p.passive is None:
-            assert p.obstacle is not None
-            ob = p.obstacle
-            rop = rigid_operator(kernel, p.active.surface, ob.geometry, ndofs, **options)  # type: ignore[arg-type]
-            ops.append(rop.operator)
-            motion.append(rop.motion @ np.asarray(ob.displacement, dtype=np.float64))
-            columns.append(rop.motion)
-        else:
-            pas = p.passive.surface
-            ops.append(contact_operator(kernel, p.active.surface, pas, ndofs, **options))  # type: ignore[arg-type]
-            n = p.active.surface.n_nodes
-            motion.append(np.zeros(n))
-            empty = np.zeros(0, dtype=np.int64)
-            columns.append(CSR.from_coo(empty, empty, np.zeros(0), (n, 2)))
-    Bt = CSR.vstack([o.B for o in ops]) if len(ops) > 1 else ops[0].B
+    rows = setup.tangent or tangent_rows(setup.pairs, kernel, basis, FRAME, ndofs)
+    Bt, motion, columns = rows.B, rows.motion, rows.columns
     op = ContactOperator(Bt, np.zeros(Bt.shape[0]), setup.operator.weights)
     dofs = np.vstack(
         [p.active.surface.dofs for p in setup.pairs]
@@ -337,12 +320,9 @@ def _solve_step(
 ) -> tuple[Solution, StepState]:
     """One load step of `solve_friction`, from the state the step before left."""
     kernel = request.discretization.kernel
-    try:
-        setup = prepare_contact(
-            scene, kernel, aso.penetration_tol, timers, request.basis, frame=FRAME
-        )
-    except SingularSystemError as err:
-        raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
+    setup = prepare_contact(
+        scene, kernel, aso.penetration_tol, timers, request.basis, frame=FRAME, friction=True
+    )
     try:
         with timers("contact"):
             Bt, shift_t, tangent, free_t, moving = tangent_constraint(

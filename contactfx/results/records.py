@@ -21,6 +21,8 @@ from .reference_records import HertzErrors as HertzErrors
 from .reference_records import LameErrors as LameErrors
 from .reference_records import PatchErrors as PatchErrors
 from .reference_records import ProbeResult as ProbeResult
+from .reference_records import PushoutCheck as PushoutCheck
+from .reference_records import PushoutSummary as PushoutSummary
 
 # The JSON's `estimate.norm`: what the relative values are relative to.
 ESTIMATE_NORM = (
@@ -92,7 +94,8 @@ class ContactSummary:
             f"axial force {self.axial_force:.6g} (total over the turn), radial resultant "
             f"{self.radial_per_radian:.6g} per radian"
         )
-        if self.fit and self.force[0] != 0.0:
+        # A frictional fit's shear carries an axial force (its interface has statuses).
+        if self.fit and self.force[0] != 0.0 and "status" not in self.interface:
             share = abs(self.axial_force / self.force[0])
             text += (
                 f" (a fit's axial force is {100 * share:.2g} % of its radial load: none "
@@ -196,6 +199,7 @@ class StepSummary:
     iterations: int
     contacts: tuple[ContactSummary, ...]
     cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference
+    pushout: tuple[PushoutCheck, ...] = ()  # one per push-out reference
 
     def to_json(self) -> dict[str, Any]:
         """The step's entry of the JSON's `steps`."""
@@ -205,6 +209,8 @@ class StepSummary:
         }
         if self.cattaneo:
             out["cattaneo"] = [c.to_json() for c in self.cattaneo]
+        if self.pushout:
+            out["pushout"] = [c.to_json() for c in self.pushout]
         return out
 
 
@@ -238,6 +244,7 @@ class RunSummary:
     estimate: EstimateSummary | None = None
     lame: tuple[LameErrors, ...] = ()  # one per Lame reference
     cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference (the last step)
+    pushout: tuple[PushoutSummary, ...] = ()  # one per push-out reference
     probes: tuple[ProbeResult, ...] = ()  # one per probe of the scene
     steps: tuple[StepSummary, ...] = ()  # one per [[step]] (none without steps)
 
@@ -285,6 +292,8 @@ class RunSummary:
             out["lame"] = [r.to_json() for r in self.lame]
         if self.cattaneo:
             out["cattaneo"] = [r.to_json() for r in self.cattaneo]
+        if self.pushout:
+            out["pushout"] = [r.to_json() for r in self.pushout]
         if self.probes:
             out["probes"] = [p.to_json() for p in self.probes]
         if self.steps:

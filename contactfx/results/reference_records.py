@@ -231,3 +231,163 @@ class CattaneoCheck:
             "warning": self.warning,
             "reference": "Cattaneo-Mindlin line contact, similar materials (Johnson 7.1)",
         }
+
+
+# A push-out: the active surface's normal may lean this far from radial (round-off of a
+# cylinder), and in full slip the ratio and the slip law must hold to this (round-off of
+# the multipliers: measured 1e-15 and 2e-16, docs/friction.md).
+CYLINDER_TOL = 1e-6
+COULOMB_TOL = 1e-6
+
+
+@dataclass(frozen=True, kw_only=True)
+class PushoutCheck:
+    """One press fit at one load step: its axial force against mu times its normal force.
+
+    Both forces are totals over the turn (the summary's `axial_force` convention): N is the
+    contact pressure integrated over the revolved interface, sum_j w_j lambda_n,j.
+    """
+
+    pair: int
+    mu: float
+    axial: float  # the axial force on the active body (the shaft), total over the turn
+    normal: float  # N, total over the turn
+    stick: int
+    slip: int
+    open: int
+    slip_law: float | None  # max over slip nodes of ||shear| - mu p| / (mu max p); None: none
+    taper: float = 0.0  # max |n_axial| of the active surface over the contact nodes
+
+    @property
+    def warning(self) -> str | None:
+        """Why the reference does not describe the pair, or where Coulomb's law fails."""
+        if self.taper > CYLINDER_TOL:
+            return (
+                f"the interface is not a cylinder (its normal's axial part reaches "
+                f"{self.taper:.2g}): the pressure has an axial force, and axial = mu N holds "
+                "only on a cylinder"
+            )
+        if self.full_slip and not (
+            abs(self.ratio - 1.0) <= COULOMB_TOL and (self.slip_law or 0.0) <= COULOMB_TOL
+        ):
+            return (
+                f"full slip, but axial / (mu N) = {self.ratio:.6g} and the slip law's largest "
+                f"violation is {self.slip_law:.2g} (both 1 and 0 to {COULOMB_TOL:g} expected)"
+            )
+        return None
+
+    @property
+    def ratio(self) -> float:
+        """|axial| / (mu N): 1 in full slip."""
+        return abs(self.axial) / (self.mu * self.normal) if self.normal > 0 else 0.0
+
+    @property
+    def full_slip(self) -> bool:
+        """Every contact node slips."""
+        return self.stick == 0 and self.slip > 0
+
+    def text(self) -> str:
+        """One terminal line."""
+        law = "" if self.slip_law is None else f", slip law {self.slip_law:.1e}"
+        state = "full slip" if self.full_slip else ("stick" if self.slip == 0 else "partial slip")
+        text = (
+            f"push-out, pair {self.pair}: axial / (mu N) = {self.ratio:.4f} ({state}: "
+            f"{self.stick} stick, {self.slip} slip), axial {self.axial:.6g}, N {self.normal:.6g} "
+            f"(totals over the turn){law}"
+        )
+        return text if self.warning is None else f"{text}; warning: {self.warning}"
+
+    def to_json(self) -> dict[str, Any]:
+        """The entry of a step's `pushout` list."""
+        return {
+            "pair": self.pair,
+            "mu": self.mu,
+            "axial_force": self.axial,
+            "normal_force": self.normal,
+            "ratio": self.ratio,
+            "stick": self.stick,
+            "slip": self.slip,
+            "open": self.open,
+            "full_slip": self.full_slip,
+            "slip_law": self.slip_law,
+            "taper": self.taper,
+            "warning": self.warning,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class PushoutFit:
+    """The fit before the push (step 1) against Lame's rings, open-ended and in plane strain.
+
+    Lame's open-ended cylinder (plane stress, sigma_z = 0: shaft and hub free to change
+    length, which a frictionless fit meets) is the reference the error is taken against;
+    plane strain (eps_z = 0) is the value above it: stick friction holds the axial strains
+    the fit's Poisson effect would slide by and raises the pressure towards it (a bonded fit
+    stays below: shaft and hub share one axial strain, not zero; docs/friction.md).
+    """
+
+    p_mean: float  # sum p_j w_j / sum w_j at step 1
+    open_ended: float  # Lame, plane stress (sigma_z = 0)
+    plane_strain: float  # Lame, eps_z = 0
+    delta: float
+
+    @property
+    def error(self) -> float:
+        """p_mean / open_ended - 1."""
+        return self.p_mean / self.open_ended - 1.0
+
+    @property
+    def between(self) -> bool:
+        """The fit's pressure lies between the two limits."""
+        return (
+            min(self.open_ended, self.plane_strain)
+            <= self.p_mean
+            <= max(self.open_ended, self.plane_strain)
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        """The `fit` block of a `pushout` entry."""
+        return {
+            "p_mean": self.p_mean,
+            "lame_open_ended": self.open_ended,
+            "lame_plane_strain": self.plane_strain,
+            "error": self.error,
+            "between": self.between,
+            "delta": self.delta,
+        }
+
+
+@dataclass(frozen=True, kw_only=True)
+class PushoutSummary:
+    """A push-out reference over the run: each step's check, and the fit against Lame."""
+
+    steps: tuple[PushoutCheck, ...]
+    fit: PushoutFit | None = None
+
+    def lines(self) -> list[str]:
+        """The terminal lines: the fit, the last step, the ratio's course."""
+        out = []
+        if self.fit is not None:
+            f = self.fit
+            out.append(
+                f"push-out fit (step 1): mean pressure {f.p_mean:.6g}, Lame open-ended "
+                f"{f.open_ended:.6g} ({100 * f.error:+.2f} %), plane strain {f.plane_strain:.6g}"
+            )
+        last = self.steps[-1]
+        ratios = ", ".join(f"{c.ratio:.3f}" for c in self.steps)
+        out.append(last.text())
+        out.append(f"  axial / (mu N) by step: {ratios}")
+        return out
+
+    def to_json(self) -> dict[str, Any]:
+        """One entry of the JSON's `pushout` list (the last step's, with the ratios and fit)."""
+        last = self.steps[-1]
+        return {
+            **last.to_json(),
+            "ratios": [c.ratio for c in self.steps],
+            "first_full_slip_step": next(
+                (k + 1 for k, c in enumerate(self.steps) if c.full_slip), None
+            ),
+            "fit": None if self.fit is None else self.fit.to_json(),
+            "reference": "Coulomb: in full slip the axial force is mu times the normal force",
+        }

@@ -14,6 +14,7 @@ from .cattaneo import cattaneo_checks
 from .interface import cartesian_interface, contacts_summary
 from .lame import lame_summary
 from .probes import probe_value
+from .pushout import pushout_checks
 from .records import (
     ContactSummary,
     EstimateSummary,
@@ -90,6 +91,7 @@ def summary(
     refs = scene.references
     patch = [uniform_stress_errors(sol, r) for r in refs if isinstance(r, UniformStress)]
     cattaneo, cattaneo_steps = cattaneo_checks(sol)
+    pushout, pushout_steps = pushout_checks(sol)
     return RunSummary(
         scene=scene.name,
         method=sol.method,
@@ -121,9 +123,10 @@ def summary(
         patch=patch[-1] if patch else None,
         lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
         cattaneo=cattaneo,
+        pushout=pushout,
         probes=tuple(probe_value(sol, p) for p in scene.probes),
         steps=tuple(
-            StepSummary(s.iterations, contacts_summary(s), c)
-            for s, c in zip(sol.steps, cattaneo_steps, strict=True)
+            StepSummary(s.iterations, contacts_summary(s), c, po)
+            for s, c, po in zip(sol.steps, cattaneo_steps, pushout_steps, strict=True)
         ),
     )

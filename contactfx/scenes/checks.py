@@ -12,7 +12,15 @@ import numpy as np
 from mpi4py import MPI
 
 from ..errors import InputError, MeshError
-from .model import Body, CattaneoReference, HertzReference, LameReference, Model, Scene
+from .model import (
+    Body,
+    CattaneoReference,
+    HertzReference,
+    LameReference,
+    Model,
+    PushoutReference,
+    Scene,
+)
 from .steps import check_steps, load_names
 
 
@@ -155,6 +163,8 @@ def _check_conditions(scene: Scene) -> None:
             ref.contact_in(scene.model)
         if isinstance(ref, CattaneoReference):
             _check_cattaneo(scene, ref)
+        if isinstance(ref, PushoutReference):
+            _check_pushout(scene, ref)
         if not 0 <= pair < len(scene.contacts) + len(scene.obstacles):
             what = "probe" if ref in scene.probes else "reference"
             raise InputError(
@@ -182,6 +192,34 @@ def _check_cattaneo(scene: Scene, ref: CattaneoReference) -> None:
         )
 
 
+def _check_pushout(scene: Scene, ref: PushoutReference) -> None:
+    """InputError for a push-out reference the scene cannot be checked against."""
+    where = f"pushout reference (pair {ref.pair})"
+    if not 0 <= ref.pair < len(scene.contacts):
+        raise InputError(
+            f"{where}: pair {ref.pair} is not one of the {len(scene.contacts)} contact pairs "
+            "(a push-out is a shaft and a hub)"
+        )
+    if scene.contacts[ref.pair].mu <= 0:
+        raise InputError(f"{where}: the pair is frictionless: give it mu > 0 in its [[contact]]")
+    if scene.model is not Model.AXISYMMETRIC:
+        raise InputError(
+            f"{where}: a shaft pushed out of a hub is an axisymmetric scene (its axial force "
+            f"against mu times the revolved normal force): set model = 'axisymmetric'"
+        )
+    if len(scene.steps) < 2:
+        raise InputError(
+            f"{where}: give [[step]] tables, the fit first and then the push (the scene has "
+            f"{len(scene.steps)}): friction depends on the load path"
+        )
+    pair = scene.contacts[ref.pair]
+    if ref.rings is not None and ref.delta is None and not pair.prescribed_overlap > 0:
+        raise InputError(
+            f"{where}: give delta for Lame's rings (the pair has no interference = D to take "
+            "it from)"
+        )
+
+
 def _text(values: list[float]) -> str:
     return f"{values[0]:g}" if len(values) == 1 else "[" + ", ".join(f"{v:g}" for v in values) + "]"
 
@@ -198,8 +236,10 @@ def _check_overlaps(scene: Scene) -> None:
         return
     x = scene.mesh.geometry.x[:, :2]
     comm = scene.comm
-    lo = comm.allreduce(x.min(axis=0, initial=np.inf), op=MPI.MIN)
-    hi = comm.allreduce(x.max(axis=0, initial=-np.inf), op=MPI.MAX)
+    # Buffers, not pickled objects: a pickled MIN compares two arrays as one truth value.
+    lo, hi = x.min(axis=0, initial=np.inf), x.max(axis=0, initial=-np.inf)
+    comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+    comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
     extent = float(np.max(hi - lo))
     for k, pair in given:
         d = pair.prescribed_overlap

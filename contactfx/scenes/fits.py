@@ -92,3 +92,39 @@ class LameReference:
             )
         if self.delta is not None and not self.delta > 0:
             raise InputError(f"lame reference: delta must be > 0 (got {self.delta})")
+
+
+@dataclass(frozen=True)
+class PushoutReference:
+    """A press fit pushed out (axisymmetric): Coulomb's law on the whole interface.
+
+    At each load step the pair's axial force (total over the turn) against mu times its
+    normal force N = sum_j w_j lambda_n,j (the contact pressure integrated over the revolved
+    interface, total over the turn as well): their ratio reaches 1 in full slip, where every
+    contact node slips with |shear| = mu p. `mu` None takes the pair's. With the rings' radii
+    (a, b, c; `delta` None: the pair's `interference = D`) the first step, the fit before the
+    push, is compared with Lame's open-ended cylinder and its plane-strain value
+    (docs/friction.md, "The push-out of a press fit").
+    """
+
+    pair: int = 0
+    mu: float | None = None
+    rings: tuple[float, float, float] | None = None
+    delta: float | None = None
+
+    def __post_init__(self) -> None:
+        where = f"pushout reference (pair {self.pair})"
+        if self.mu is not None and not (_finite(self.mu) and self.mu > 0):
+            raise InputError(f"{where}: mu must be a number > 0 (got {self.mu!r})")
+        if self.rings is None:
+            if self.delta is not None:
+                raise InputError(f"{where}: delta is Lame's: give the rings' a, b and c with it")
+            return
+        a, b, c = self.rings
+        if not all(_finite(v) for v in self.rings) or not 0 <= a < b < c:
+            raise InputError(
+                f"{where}: the rings' radii must satisfy 0 <= a < b < c (got a = {a}, b = {b}, "
+                f"c = {c})"
+            )
+        if self.delta is not None and not (_finite(self.delta) and self.delta > 0):
+            raise InputError(f"{where}: delta must be > 0 (got {self.delta!r})")

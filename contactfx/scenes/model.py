@@ -19,7 +19,7 @@ from mpi4py import MPI
 
 from ..errors import InputError, MeshError
 from ..meshes import GridLines
-from .fits import LameReference, check_friction, check_interference, check_thermal
+from .fits import LameReference, PushoutReference, check_friction, check_interference, check_thermal
 from .obstacle import Obstacle
 from .probe import Probe
 
@@ -258,7 +258,7 @@ class CattaneoReference:
     mu: float | None = None
 
 
-Reference = HertzReference | UniformStress | LameReference | CattaneoReference
+Reference = HertzReference | UniformStress | LameReference | CattaneoReference | PushoutReference
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ from .model import (
     Model,
     Obstacle,
     Pressure,
+    PushoutReference,
     Reference,
     Scene,
     Traction,
@@ -187,18 +188,35 @@ def _cattaneo(where: str, entry: Any) -> CattaneoReference:
     return CattaneoReference(pair, R, mu)
 
 
+def _pushout(where: str, entry: Any) -> PushoutReference:
+    e = _section(where, entry, "reference.pushout")
+    pair = e.get("pair", 0)
+    if isinstance(pair, bool) or not isinstance(pair, int):
+        raise InputError(f"{where}: pair: {TYPE_ERRORS['integer']} into [[contact]]")
+    mu = _number(f"{where}.mu", e["mu"]) if "mu" in e else None
+    given = [key for key in ("a", "b", "c") if key in e]
+    if given and len(given) < 3:
+        missing = next(key for key in ("a", "b", "c") if key not in e)
+        raise InputError(f"{where}: Lame's rings need a, b and c: missing key '{missing}'")
+    rings = tuple(_number(f"{where}.{key}", e[key]) for key in given) or None
+    delta = _number(f"{where}.delta", e["delta"]) if "delta" in e else None
+    return PushoutReference(pair, mu, rings, delta)  # type: ignore[arg-type]
+
+
 def _reference(k: int, entry: Any, model: Model | None = None) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
-    if kind not in ("hertz", "uniform_stress", "lame", "cattaneo"):
+    if kind not in ("hertz", "uniform_stress", "lame", "cattaneo", "pushout"):
         raise InputError(
-            f"reference {k}: type must be 'hertz', 'uniform_stress', 'lame' or 'cattaneo' "
-            f"(got {kind!r})"
+            f"reference {k}: type must be 'hertz', 'uniform_stress', 'lame', 'cattaneo' or "
+            f"'pushout' (got {kind!r})"
         )
     where = f"reference {k} ({kind})"
     if kind == "lame":
         return _lame(where, entry)
     if kind == "cattaneo":
         return _cattaneo(where, entry)
+    if kind == "pushout":
+        return _pushout(where, entry)
     if kind == "hertz":
         e = _section(where, entry, "reference.hertz")
         pair = e.get("pair", 0)

@@ -162,6 +162,20 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("R", "number", None, "effective radius, 1/R = 1/R1 + 1/R2", "R <= 0"),
         Key("mu", "number", "the pair's mu", "friction coefficient", "mu <= 0"),
     ),
+    "reference.pushout": (
+        Key(
+            "type",
+            "string",
+            None,
+            '"pushout": a press fit pushed out (axisymmetric): axial force against mu N',
+        ),
+        Key("pair", "integer", "0", "index into [[contact]]", "a frictionless pair"),
+        Key("mu", "number", "the pair's mu", "friction coefficient", "mu <= 0"),
+        Key("a", "number", "none", "Lame's rings for the fit (step 1): the inner bore"),
+        Key("b", "number", "none", "the interface radius (with a and c)"),
+        Key("c", "number", "none", "the outer radius of the outer ring (with a and b)"),
+        Key("delta", "number", "the pair's interference D", "radial interference", "delta <= 0"),
+    ),
     "reference.lame": (
         Key("type", "string", None, '"lame": a shrink fit of two concentric rings'),
         Key("pair", "integer", "0", "index into [[contact]]"),

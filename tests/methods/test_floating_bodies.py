@@ -18,7 +18,7 @@ import pytest
 from conftest import ROOT, cli, run_cli
 
 from contactfx import SolveRequest, load_scene_file, run_scene
-from contactfx.discretize.load_paths import _carrying_lp, _one_mode, carrying_rows, pulled_away
+from contactfx.discretize.load_programs import _carrying_lp, _one_mode, carrying_rows, pulled_away
 from contactfx.discretize.setup import prepare_contact
 from contactfx.errors import SingularSystemError
 from contactfx.methods.active_set import ActiveSetOptions
@@ -88,6 +88,22 @@ def test_one_free_mode_in_closed_form_agrees_with_the_program(load: float) -> No
         assert (lp is None) == (closed is None), (a, load)
         if lp is not None and closed is not None:
             assert lp.tolist() == closed.tolist(), (a, load)
+
+
+@pytest.mark.parametrize(("q", "held"), [(0.0, True), (2.9, True), (-2.9, True), (3.1, False)])
+def test_friction_holds_a_block_sideways_within_its_cone(q: float, held: bool) -> None:
+    """A block (modes x, y) on two floor rows (normal along y, tangent along x, mu = 0.3)
+    pressed by 10 and pulled by q along x: an equilibrium inside Coulomb's cone exists iff
+    |q| <= mu * 10; a frictionless pair never holds a pull (hand statics)."""
+    a = np.array([[0.0, 1.0], [0.0, 2.0]])  # unequal rows: the bound is per row
+    at = np.array([[1.0, 0.0], [2.0, 0.0]])
+    load = np.array([q, -10.0])
+    got = carrying_rows(a, load, at, np.array([0.3, 0.3]))
+    assert (got is not None) == held
+    if got is not None:
+        assert got.tolist() == [True, True]
+    frictionless = carrying_rows(a, load, at, np.zeros(2))
+    assert (frictionless is not None) == (q == 0.0)
 
 
 def test_load_that_pulls_a_block_off_has_no_equilibrium() -> None:

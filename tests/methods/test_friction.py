@@ -313,17 +313,44 @@ def test_axisymmetric_friction_along_the_meridian(basis: str) -> None:
     np.testing.assert_allclose(tiny.pressure, plain.pressure, rtol=0, atol=1e-9 * scale)
 
 
-def test_a_body_held_sideways_by_friction_alone_is_refused() -> None:
-    """Not solved yet: the floating-body check counts only normal rows, and says so."""
-    scene = scene_from_gmsh(
+def sideways(mu: float, q: float) -> Scene:
+    """The block pressed by P on the held base and pulled sideways by q: no lateral support."""
+    return scene_from_gmsh(
         GEO,
         bodies={"base": Material(1000.0, 0.3), "block": Material(1000.0, 0.3)},
-        contacts=[ContactPair("block_bottom", "base_top", mu=MU)],
+        contacts=[ContactPair("block_bottom", "base_top", mu=mu)],
         dirichlet=[Dirichlet("base_bottom", ux=0.0, uy=0.0)],
-        loads=[Pressure("block_top", P), Traction("block_top", (1.0, 0.0))],
+        loads=[Pressure("block_top", P), Traction("block_top", (q, 0.0))],
     )
-    with pytest.raises(SingularSystemError, match=r"translation along x.*friction does not hold"):
-        solve(scene, "mortar")
+
+
+@pytest.mark.parametrize(("method", "basis"), CASES)
+def test_a_body_held_sideways_by_stick_friction_alone(method: str, basis: str) -> None:
+    """No support holds the block along x: with mu = 0.3 and a pull q = P / 10 stick holds
+    it. The shear balances the pull, Coulomb's law holds at every node, and the middle
+    sticks (the free-body check counts a frictional pair's tangential rows)."""
+    sol = solve(sideways(MU, 1.0), method, basis=basis)
+    check_coulomb(sol, MU)
+    fr = sol.friction
+    assert fr is not None and np.any(fr.status == Status.STICK)
+    w = sol.layout.weights
+    top = float(np.ptp(sol.layout.x[sol.active, 0]))  # the pull acts over the block's top
+    # The shear carries the whole pull: sum w lambda_t = q times the top's width (the block
+    # is as wide as its contact), up to the sign of the tangent.
+    assert abs(float(w @ fr.shear)) == pytest.approx(1.0 * top, rel=1e-6)
+
+
+def test_a_frictionless_body_held_by_nothing_sideways_is_refused() -> None:
+    """mu = 0: nothing holds the block along x, refused before any solve as before."""
+    with pytest.raises(SingularSystemError, match=r"translation along x"):
+        solve(sideways(0.0, 1.0), "mortar")
+
+
+def test_a_pull_beyond_mu_p_is_refused_before_any_solve() -> None:
+    """A pull of P / 2 > mu P: no equilibrium inside the friction cone, and the message says
+    that friction holds at most mu times the normal force."""
+    with pytest.raises(SingularSystemError, match=r"at most mu times the normal force"):
+        solve(sideways(MU, 5.0), "mortar")
 
 
 CYLINDERS = ROOT / "tests" / "scenes" / "cattaneo_cylinders.geo"

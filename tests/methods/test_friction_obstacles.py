@@ -18,6 +18,7 @@ from test_friction import check_coulomb, forces
 
 from contactfx import InputError, Obstacle, load_scene_file, scene_from_gmsh, solve
 from contactfx.contact.friction import Status
+from contactfx.errors import SingularSystemError
 from contactfx.scenes import Dirichlet, Material, Pressure, Scene, Traction
 
 PATCH = ROOT / "tests" / "scenes" / "friction_patch.geo"
@@ -169,3 +170,20 @@ def test_summary_carries_the_shear_on_the_obstacle() -> None:
     np.testing.assert_allclose(pair["force_passive"], [-MU * P, -P], rtol=1e-10)
     assert set(pair["interface"]["status"]) <= {"open", "slip"}
     assert "slip" in pair["interface"]["status"]
+
+
+@pytest.mark.parametrize(("method", "basis"), CASES)
+def test_a_block_held_sideways_by_a_frictional_floor_alone(method: str, basis: str) -> None:
+    """The block pressed on the rigid floor and pulled sideways by a tenth of P, nothing else
+    holding it along x: stick on the floor holds it (the free-body check counts the
+    obstacle's tangential rows), the shear carries the whole pull, Coulomb's law at every
+    node; frictionless, the same block is refused before any solve."""
+    loads: list[Pressure | Traction] = [Pressure("block_top", P), Traction("block_top", (1.0, 0.0))]
+    sol = solve(on_floor(floor(MU), [], loads), method, basis=basis)
+    check_coulomb(sol, MU)
+    fr = sol.friction
+    assert fr is not None and np.any(fr.status == Status.STICK)
+    # The pull over the block's top (width 1) is the shear's total.
+    assert abs(float(sol.layout.weights @ fr.shear)) == pytest.approx(1.0, rel=1e-6)
+    with pytest.raises(SingularSystemError, match="translation along x"):
+        solve(on_floor(floor(0.0), [], loads), method, basis=basis)

@@ -241,6 +241,47 @@ CASES["cli-friction-push"] = Case(friction_push(), FRICTION_CHECKS)
 CASES["cli-friction-push-penalty"] = Case(friction_push("--method", "penalty"), FRICTION_CHECKS)
 
 
+def held_sideways() -> tuple[Solution, Arrays]:
+    """`contactfx solve friction_held_sideways.toml`: a block held along x by stick alone (the
+    free-body program with friction's rows on 2 ranks): its force, shear and statuses."""
+    sol, data = cli_json(["solve", str(SCENES / "friction_held_sideways.toml")])
+    c = data["contacts"][0]
+    names = ("open", "stick", "slip")
+    return sol, {
+        "forces": np.array(c["force"], dtype=float),
+        "shear": np.array(c["interface"]["shear"], dtype=float),
+        "status": np.array([names.index(v) for v in c["interface"]["status"]]),
+    }
+
+
+# p = 10 on the block's width 1; the statuses exactly serial's.
+CASES["cli-friction-held-sideways"] = Case(
+    held_sideways, {"forces": Abs(1e-9 * 10.0), "shear": Abs(1e-9 * 10.0), "status": Exact()}
+)
+
+
+def pushout() -> tuple[Solution, Arrays]:
+    """`contactfx solve press_fit_pushout.toml` (the pushout reference): each step's axial
+    force, normal force and statuses (the interface sorted by arc length)."""
+    scene = ROOT / "demos" / "scenes" / "press_fit_pushout.toml"
+    sol, data = cli_json(["solve", str(scene)])
+    steps = [step["pushout"][0] for step in data["steps"]]
+    names = ("open", "stick", "slip")
+    return sol, {
+        "forces": np.array([[s["axial_force"], s["normal_force"]] for s in steps]),
+        "status": np.array(
+            [
+                [names.index(v) for v in st["contacts"][0]["interface"]["status"]]
+                for st in data["steps"]
+            ]
+        ),
+    }
+
+
+# mu N = 0.2 * 4429 at full slip; the statuses exactly serial's.
+CASES["cli-pushout"] = Case(pushout, {"forces": Abs(1e-9 * 1000.0), "status": Exact()})
+
+
 # --- Hertz (test_hertz, test_scale, test_dual_condensed, test_direct_floor, test_penalty) ----
 
 

@@ -45,6 +45,7 @@ def test_contact_pair_mu() -> None:
     [
         ("-0.2", "contact 0.mu: must be a number >= 0"),
         ('"high"', "contact 0.mu: expected a number"),
+        ("nan", "contact 0.mu: expected a finite number, got nan"),
     ],
 )
 def test_scene_file_bad_mu_is_one_line(tmp_path: Path, mu: str, expected: str) -> None:
@@ -80,6 +81,50 @@ def test_builtin_mu_option_reaches_the_pair() -> None:
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize(
+    ("args", "refused"),
+    [
+        (("--method", "penalty"), "the penalty enforcement"),
+        (("--method", "schwarz"), "the schwarz enforcement"),
+        (("--solver", "fieldsplit"), "the fieldsplit solver"),
+        (
+            ("--method", "mortar", "--basis", "dual", "--solver", "condensed"),
+            "the condensed solver",
+        ),
+    ],
+)
+def test_friction_refused_by_enforcement_or_solver_is_one_line(
+    args: tuple[str, ...], refused: str
+) -> None:
+    """Penalty, Schwarz, an iterative or the condensed solver with friction: one line, exit 2,
+    naming the pair and what does solve it."""
+    proc = cli("solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1", *args)
+    assert proc.returncode == 2, proc.stderr
+    assert f"has mu = 0.2: Coulomb friction is not solved with {refused}; it is solved by nts" in (
+        proc.stderr
+    ), proc.stderr
+    assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_a_body_held_sideways_by_stick_alone_from_the_cli(tmp_path: Path) -> None:
+    """friction_held_sideways.toml solves (the shear carries the pull, the middle sticks);
+    with mu = 0 the block is free along x: one line, exit 2, before any solve."""
+    out = tmp_path / "run.json"
+    scene = SCENES / "friction_held_sideways.toml"
+    proc = cli("solve", str(scene), "--json", str(out))
+    assert proc.returncode == 0, proc.stderr
+    (pair,) = json.loads(out.read_text())["contacts"]
+    assert (
+        pair["force"][0] == pytest.approx(-1.0, rel=1e-9) and "stick" in pair["interface"]["status"]
+    )
+    (tmp_path / "friction_blocks.geo").write_text((SCENES / "friction_blocks.geo").read_text())
+    plain = tmp_path / "plain.toml"
+    plain.write_text(scene.read_text().replace("mu = 0.3", "mu = 0.0"))
+    proc = cli("solve", str(plain))
+    assert proc.returncode == 2 and "can still move freely" in proc.stderr, proc.stderr
+    assert "translation along x" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+
+
 def test_load_steps_in_the_json_and_on_the_terminal(tmp_path: Path) -> None:
     """[[step]] tables: one JSON entry per step (the press alone carries no shear, the last
     push slides the block: Q = mu P), the top-level keys are the last step's, and the
@@ -108,6 +153,7 @@ def test_load_steps_in_the_json_and_on_the_terminal(tmp_path: Path) -> None:
         ("[[step]]\npull = 1.0\n", "step 0: no load is named 'pull' (named loads: press, push)"),
         ('[[step]]\npush = "full"\n', "step 0.push: expected a number (a factor), got 'full'"),
         ("step = [1.0]\n", "step 0: expected a table of load names and factors (got 1.0)"),
+        ("[[step]]\npush = inf\n", "step 0.push: expected a finite number, got inf"),
     ],
 )
 def test_bad_step_is_one_line(tmp_path: Path, step: str, expected: str) -> None:
