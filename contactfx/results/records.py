@@ -21,6 +21,7 @@ from .reference_records import HertzErrors as HertzErrors
 from .reference_records import LameErrors as LameErrors
 from .reference_records import PatchErrors as PatchErrors
 from .reference_records import ProbeResult as ProbeResult
+from .reference_records import SpenceCheck as SpenceCheck
 
 # The JSON's `estimate.norm`: what the relative values are relative to.
 ESTIMATE_NORM = (
@@ -196,6 +197,7 @@ class StepSummary:
     iterations: int
     contacts: tuple[ContactSummary, ...]
     cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference
+    spence: tuple[SpenceCheck, ...] = ()  # one per Spence reference
 
     def to_json(self) -> dict[str, Any]:
         """The step's entry of the JSON's `steps`."""
@@ -205,6 +207,8 @@ class StepSummary:
         }
         if self.cattaneo:
             out["cattaneo"] = [c.to_json() for c in self.cattaneo]
+        if self.spence:
+            out["spence"] = [c.to_json() for c in self.spence]
         return out
 
 
@@ -238,6 +242,7 @@ class RunSummary:
     estimate: EstimateSummary | None = None
     lame: tuple[LameErrors, ...] = ()  # one per Lame reference
     cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference (the last step)
+    spence: tuple[SpenceCheck, ...] = ()  # one per Spence reference (the last step)
     probes: tuple[ProbeResult, ...] = ()  # one per probe of the scene
     steps: tuple[StepSummary, ...] = ()  # one per [[step]] (none without steps)
 
@@ -285,6 +290,8 @@ class RunSummary:
             out["lame"] = [r.to_json() for r in self.lame]
         if self.cattaneo:
             out["cattaneo"] = [r.to_json() for r in self.cattaneo]
+        if self.spence:
+            out["spence"] = [r.to_json() for r in self.spence]
         if self.probes:
             out["probes"] = [p.to_json() for p in self.probes]
         if self.steps:

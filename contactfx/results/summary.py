@@ -26,6 +26,7 @@ from .records import (
     StepSummary,
 )
 from .references import hertz_summary, uniform_stress_errors
+from .spence import spence_checks
 
 __all__ = [
     "ContactSummary",
@@ -90,6 +91,7 @@ def summary(
     refs = scene.references
     patch = [uniform_stress_errors(sol, r) for r in refs if isinstance(r, UniformStress)]
     cattaneo, cattaneo_steps = cattaneo_checks(sol)
+    spence, spence_steps = spence_checks(sol)
     return RunSummary(
         scene=scene.name,
         method=sol.method,
@@ -121,9 +123,10 @@ def summary(
         patch=patch[-1] if patch else None,
         lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
         cattaneo=cattaneo,
+        spence=spence,
         probes=tuple(probe_value(sol, p) for p in scene.probes),
         steps=tuple(
-            StepSummary(s.iterations, contacts_summary(s), c)
-            for s, c in zip(sol.steps, cattaneo_steps, strict=True)
+            StepSummary(s.iterations, contacts_summary(s), c, sp)
+            for s, c, sp in zip(sol.steps, cattaneo_steps, spence_steps, strict=True)
         ),
     )

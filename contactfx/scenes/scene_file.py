@@ -31,6 +31,7 @@ from .model import (
     Pressure,
     Reference,
     Scene,
+    SpenceReference,
     Traction,
     UniformStress,
     Units,
@@ -187,18 +188,36 @@ def _cattaneo(where: str, entry: Any) -> CattaneoReference:
     return CattaneoReference(pair, R, mu)
 
 
+def _spence(where: str, entry: Any) -> SpenceReference:
+    e = _section(where, entry, "reference.spence")
+    pair = e.get("pair", 0)
+    if isinstance(pair, bool) or not isinstance(pair, int):
+        raise InputError(
+            f"{where}: pair: {TYPE_ERRORS['integer']} into [[contact]], then [[obstacle]]"
+        )
+    symmetric = e.get("symmetric", False)
+    if not isinstance(symmetric, bool):
+        raise InputError(f"{where}: symmetric: {TYPE_ERRORS['bool']}")
+    mu = _number(f"{where}.mu", e["mu"]) if "mu" in e else None
+    if mu is not None and mu <= 0:
+        raise InputError(f"{where}: mu must be positive (got {mu:g})")
+    return SpenceReference(pair, symmetric, mu)
+
+
 def _reference(k: int, entry: Any, model: Model | None = None) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
-    if kind not in ("hertz", "uniform_stress", "lame", "cattaneo"):
+    if kind not in ("hertz", "uniform_stress", "lame", "cattaneo", "spence"):
         raise InputError(
-            f"reference {k}: type must be 'hertz', 'uniform_stress', 'lame' or 'cattaneo' "
-            f"(got {kind!r})"
+            f"reference {k}: type must be 'hertz', 'uniform_stress', 'lame', 'cattaneo' or "
+            f"'spence' (got {kind!r})"
         )
     where = f"reference {k} ({kind})"
     if kind == "lame":
         return _lame(where, entry)
     if kind == "cattaneo":
         return _cattaneo(where, entry)
+    if kind == "spence":
+        return _spence(where, entry)
     if kind == "hertz":
         e = _section(where, entry, "reference.hertz")
         pair = e.get("pair", 0)
