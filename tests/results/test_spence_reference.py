@@ -37,7 +37,10 @@ STEPS = tuple({"indenter": 1.15 ** (2 * (k - 7))} for k in range(8))
 CELLS = 1.5  # the done-when's tolerance on the stick edge, in contact cells
 
 
-@pytest.mark.parametrize(("method", "basis"), [("nts", "standard"), ("mortar", "standard"), ("mortar", "dual")])  # fmt: skip
+METHODS = [("nts", "standard"), ("mortar", "standard"), ("mortar", "dual")]
+
+
+@pytest.mark.parametrize(("method", "basis"), METHODS)
 def test_spence_stick_ratio_at_every_step(method: str, basis: str) -> None:
     """c within 1.5 cells of Spence's (c/a) a from step 2 on, at a/h up to 23; step 1 (the
     whole contact at once) sticks far less than Spence's; every step converges (no cycle)."""
