@@ -12,7 +12,8 @@ show what moves the answer away from Spence's:
   a, a/R ten times larger, to 0.033);
 - `equal`: R = 200 moved in 15 equal steps (the contact grows by 1.48, 1.27, ... 1.04).
 
-    OPENBLAS_NUM_THREADS=1 python benchmarks/spence_rigid_indenter.py --json benchmarks/spence_rigid_indenter.json
+    OPENBLAS_NUM_THREADS=1 python benchmarks/spence_rigid_indenter.py \
+        --json benchmarks/spence_rigid_indenter.json
 
 (about two minutes on one loaded core: nts, mortar and dual mortar on each variant) prints the
 per-step table and writes it; `--table benchmarks/spence_rigid_indenter.json` prints
