@@ -234,8 +234,9 @@ class CattaneoCheck:
 
 
 # Spence's analysis is the limit a/R -> 0: beyond this a/R the cylinder's tilt across the
-# contact shifts the stick edge by more than a cell at a/h ~ 45 (docs/friction.md, Spence).
-SPENCE_AR_MAX = 0.01
+# contact moved the measured stick edge out by more than the done-when's 1.5 cells
+# (docs/friction.md, Spence, "Finite a/R").
+SPENCE_AR_MAX = 0.02
 
 
 @dataclass(frozen=True, kw_only=True)

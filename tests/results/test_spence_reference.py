@@ -132,3 +132,17 @@ def test_bad_spence_reference_in_python(obstacle: Obstacle, expected: str) -> No
             dirichlet=[Dirichlet("symmetry", ux=0.0), Dirichlet("base", uy=0.0)],
             references=[SpenceReference(0, symmetric=True)],
         )
+
+
+def test_spence_check_warns_outside_the_theory() -> None:
+    """Step 1 (a single step from zero) and a/R above 0.02 carry a warning; the offset is
+    signed, in cells."""
+    from contactfx.results.reference_records import SpenceCheck
+
+    base = {"pair": 0, "mu": 0.3, "nu": 0.3, "R": 20.0, "ratio_exact": 0.689, "h": 0.015}
+    inside = SpenceCheck(**base, a=0.3, c=0.21, step=2)
+    assert inside.warning is None
+    assert inside.offset_cells == pytest.approx((0.21 - 0.689 * 0.3) / 0.015, rel=1e-12)
+    wide = SpenceCheck(**base, a=0.6, c=0.45, step=5)
+    assert wide.warning is not None and "a/R = 0.03" in wide.warning
+    assert "step 1" in (SpenceCheck(**base, a=0.1, c=0.03, step=1).warning or "")
