@@ -57,7 +57,7 @@ def spence_check(sol: Solution, ref: SpenceReference, step: int) -> SpenceCheck:
     across = np.argsort(r, kind="stable")
     r, status = r[across], status[across]
     act = status != Status.OPEN
-    ra = np.sort(np.abs(r[act]))
+    ra = r[act]  # sorted; signed, so a full model's mirror nodes do not pair up at 0
     h = float(np.median(np.diff(ra))) if ra.size > 1 else 0.0
     return SpenceCheck(
         pair=ref.pair,
