@@ -41,7 +41,8 @@ def variant(name: str) -> Scene:
     scene = load_scene_file(SCENE)
     ob = scene.obstacles[0]
     if name == "R20":
-        ob = replace(ob, center=(0.0, 20.0), radius=20.0, displacement=(0.0, -0.05))
+        d = tuple(10.0 * v for v in ob.displacement)
+        ob = replace(ob, center=(0.0, 20.0), radius=20.0, displacement=(d[0], d[1]))
         return replace(scene, obstacles=(ob,))
     if name == "equal":
         n = len(scene.steps)

@@ -2,9 +2,10 @@
 
 Spence's stick ratio itself (spence_stick_ratio, 0.689 for mu = nu = 0.3) is checked against an
 independent half-plane BEM in test_friction_references.py. Here the solver against it on
-demos/scenes/spence_indenter.toml (R = 200, a/R <= 0.0035: the theory's regime), coarsened for
-speed (size factor 2: a/h from 7.5 to 23.5 over 8 steps growing a by ~1.15 each): the stick
-half-width from the statuses within 1.5 contact cells of Spence's at every step after the first,
+demos/scenes/spence_indenter.toml (R = 200, a/R <= 0.0035, a 100 x 100 block: the theory's
+regime), coarsened for speed (size factor 2: a/h up to ~23 over 8 steps growing a by ~1.15
+each): the stick half-width from the statuses within 1.5 contact cells of Spence's at every
+step after the first,
 no active-set cycle (nts, mortar, dual mortar); step 1, a single step from zero, is not Spence's
 (docs/friction.md: measured c/a = 0.33 and 0.24); and the scene-file plumbing and its refusals.
 """
@@ -31,7 +32,7 @@ from contactfx.results.friction_references import spence_stick_ratio
 from contactfx.scenes import Dirichlet, Material
 
 SCENE = ROOT / "demos" / "scenes" / "spence_indenter.toml"
-MESH = ROOT / "meshes" / "rigid_block.geo"
+MESH = ROOT / "meshes" / "spence_block.geo"
 # 8 steps, the contact growing by ~1.15 per step (the approach ~ a^2).
 STEPS = tuple({"indenter": 1.15 ** (2 * (k - 7))} for k in range(8))
 CELLS = 1.5  # the done-when's tolerance on the stick edge, in contact cells
@@ -75,7 +76,7 @@ def test_spence_on_a_full_model() -> None:
 
 def small(tmp_path: Path, old: str = "", new: str = "") -> Path:
     """spence_indenter.toml with 3 steps (and `old` replaced by `new`), its mesh path absolute."""
-    toml = SCENE.read_text().replace('"../../meshes/rigid_block.geo"', f'"{MESH}"')
+    toml = SCENE.read_text().replace('"../../meshes/spence_block.geo"', f'"{MESH}"')
     head, _, _ = toml.partition("[[step]]")
     toml = head + "[[step]]\nindenter = 0.6\n[[step]]\nindenter = 0.8\n[[step]]\nindenter = 1.0\n"
     toml += '\n[[reference]]\ntype = "spence"\npair = 0\nsymmetric = true\n'

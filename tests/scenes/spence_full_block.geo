@@ -1,15 +1,15 @@
 // A full (unmirrored) elastic block for a rigid cylinder pressed at its top's centre: the
-// block [-W, W] x [-H, 0], the top y = 0 fine (h_c) for |x| <= r_fine, the base held (the
+// block [-W, W] x [-H, 0] (large: the contact sees a half-plane), the top y = 0 fine (h_c) for |x| <= r_fine, the base held (the
 // scene holds u_y on the base and u_x at the base's midpoint). All quads, sizes from one
 // MathEval field as meshes/rigid_block.geo's.
 
 DefineConstant[
-  W = {10, Name "Parameters/W block half width"},
-  H = {10, Name "Parameters/H block height"},
+  W = {100, Name "Parameters/W block half width"},
+  H = {100, Name "Parameters/H block height"},
   r_fine = {1.0, Name "Parameters/r_fine end of the fine zone (|x|)"},
   hc = {0.03, Name "Parameters/hc size on the top for |x| <= r_fine"},
   slope = {0.15, Name "Parameters/slope size growth per unit distance"},
-  hf = {2.0, Name "Parameters/hf far size"}
+  hf = {5.0, Name "Parameters/hf far size"}
 ];
 
 Point(1) = {-W, -H, 0, hf};
