@@ -1,23 +1,25 @@
 """Spence against a frictional solve: a rigid cylinder pressed with mu into a block, step by step.
 
-demos/scenes/spence_indenter.toml (the block of rigid_indenter.toml, E = 7000, nu = 0.3, plane
-strain, half model, h = 0.015 on the top; a rigid cylinder R = 200 with mu = 0.3 moved 0.005
-down in 15 load steps growing the contact by ~1.1 each) through its own `[[reference]] type =
-"spence"`: per step the contact half-width a and the stick half-width c from the statuses, c/a
-against spence_stick_ratio(0.3, 0.3) = 0.689, and c - 0.689 a in contact cells. Three variants
-show what moves the answer away from Spence's:
+demos/scenes/spence_indenter.toml (a block 100 x 100, E = 7000, nu = 0.3, plane strain, half
+model, h = 0.015 on the top; a rigid cylinder R = 200 with mu = 0.3 moved 0.007 down in 28 load
+steps growing the contact by ~1.05 each) through its own `[[reference]] type = "spence"`: per
+step the contact half-width a and the stick half-width c from the statuses, c/a against
+spence_stick_ratio(0.3, 0.3) = 0.689, and c - 0.689 a in contact cells. Variants show what
+moves the answer away from Spence's:
 
-- `spence`: the scene as it is (a/R <= 0.0033: the theory's regime);
-- `R20`: the cylinder of rigid_indenter.toml (R = 20, moved 0.05 in the same steps: the same
-  a, a/R ten times larger, to 0.033);
-- `equal`: R = 200 moved in 15 equal steps (the contact grows by 1.48, 1.27, ... 1.04).
+- `spence`: the scene as it is (a/R <= 0.0034, a/H <= 0.007: the theory's regime);
+- `steps1.1`: 15 steps growing the contact by ~1.1 each (factors 1.1^(2 (k - 15)));
+- `equal`: 28 equal steps of the approach (the contact grows by 1.41, 1.22, ... 1.02);
+- `R20`: R = 20, moved 0.07 in the scene's steps (the same a, a/R ten times larger, to 0.034);
+- `block20`: the 20 x 20 block of rigid_indenter.toml (meshes/rigid_block.geo), moved 0.005
+  (the same a, a/H up to 0.034).
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/spence_rigid_indenter.py \
         --json benchmarks/spence_rigid_indenter.json
 
-(about two minutes on one loaded core: nts, mortar and dual mortar on each variant) prints the
-per-step table and writes it; `--table benchmarks/spence_rigid_indenter.json` prints
-docs/friction.md's table from the recorded runs.
+(about five minutes on the shared 2-core machine: nts, mortar and dual mortar on each variant)
+prints the per-step tables and writes them; `--table benchmarks/spence_rigid_indenter.json`
+prints them from the recorded runs.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import tempfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -37,16 +40,25 @@ METHODS = [("nts", "standard"), ("mortar", "standard"), ("mortar", "dual")]
 
 
 def variant(name: str) -> Scene:
-    """The scene of variant `name` (spence, R20, equal)."""
-    scene = load_scene_file(SCENE)
-    ob = scene.obstacles[0]
+    """The scene of variant `name` (spence, steps1.1, equal, R20, block20)."""
+    text = SCENE.read_text().replace('"../../meshes/', f'"{SCENE.parents[2] / "meshes"}/')
+    if name == "block20":
+        text = text.replace("spence_block.geo", "rigid_block.geo")
+        text = text.replace("displacement = [0.0, -0.007]", "displacement = [0.0, -0.005]")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "spence.toml"
+        path.write_text(text)
+        scene = load_scene_file(path)
+    n = len(scene.steps)
+    if name == "steps1.1":
+        return replace(scene, steps=tuple({"indenter": 1.1 ** (2 * (k - 14))} for k in range(15)))
+    if name == "equal":
+        return replace(scene, steps=tuple({"indenter": (k + 1) / n} for k in range(n)))
     if name == "R20":
+        ob = scene.obstacles[0]
         d = tuple(10.0 * v for v in ob.displacement)
         ob = replace(ob, center=(0.0, 20.0), radius=20.0, displacement=(d[0], d[1]))
         return replace(scene, obstacles=(ob,))
-    if name == "equal":
-        n = len(scene.steps)
-        return replace(scene, steps=tuple({"indenter": (k + 1) / n} for k in range(n)))
     return scene
 
 
@@ -96,7 +108,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path, help="write the runs here")
     parser.add_argument("--table", type=Path, help="print the table of a recorded JSON")
-    parser.add_argument("--variants", default="spence,R20,equal")
+    parser.add_argument("--variants", default="spence,steps1.1,equal,R20,block20")
     args = parser.parse_args()
     if args.table is not None:
         table(json.loads(args.table.read_text())["results"])

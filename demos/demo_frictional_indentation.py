@@ -9,10 +9,11 @@
 # boundary-element computation in docs/friction.md).
 #
 # The scene is `demos/scenes/spence_indenter.toml`: a block ($E = 7000$, $\nu = 0.3$,
-# plane strain, half model) under a rigid cylinder of radius $R = 200$ moved down in 15
-# load steps that grow the contact by about 1.1 each, to $a = 0.67$ (45 cells), so that
-# $a/R \le 0.0033$: Spence's analysis is the limit $a/R \to 0$. The scene's own
-# `[[reference]] type = "spence"` reads $a$ and $c$ from the nodes' statuses at every step.
+# plane strain, half model) 100 wide and deep, so that the contact sees a half-plane, under a
+# rigid cylinder of radius $R = 200$ moved down in 28 load steps that grow the contact by
+# about 1.05 each, to $a = 0.67$ (45 cells), so that $a/R \le 0.0034$: Spence's analysis is
+# the limit $a/R \to 0$. The scene's own `[[reference]] type = "spence"` reads $a$ and $c$
+# from the nodes' statuses at every step.
 # `CONTACTFX_QUICK=1` runs a mesh twice as coarse in 8 steps (ratio 1.15).
 
 # +
