@@ -52,6 +52,7 @@ def terminal_summary(run: RunSummary) -> list[str]:
             )
         lines += [f"step {n}, {r.text()}" for r in step.cattaneo]
         lines += [f"step {n}, {r.text()}" for r in step.pushout]
+        lines += [f"step {n}, {r.text()}" for r in step.spence]
     for k, c in enumerate(run.contacts):
         lines.append(f"pair {k} ({c.active} on {c.passive}): {c.force_text()}{_counts(c)}")
     if run.patch is not None:
@@ -83,6 +84,10 @@ def terminal_summary(run: RunSummary) -> list[str]:
             lines.append(f"  warning: {cm.warning}")
     for po in run.pushout:
         lines += po.lines()
+    for sp in run.spence:
+        lines.append(sp.text())
+        if sp.warning is not None:
+            lines.append(f"  warning: {sp.warning}")
     lines += [p.text() for p in run.probes]
     e = run.estimate
     if e is not None:

@@ -42,6 +42,7 @@ from ..contact import ContactOperator
 from ..contact.friction import FrictionResult, Status, classify, ncp
 from ..contact.sparse import CSR
 from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
+from ..discretize.obstacles import node_free_rows
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
 from ..discretize.tangents import tangent_rows
 from ..errors import InputError, SolverError
@@ -63,6 +64,13 @@ START_BAND = 0.1
 # the passive surface's frame, mirrored cylinders pressed with friction locked in a shear that
 # their symmetry rules out, and the pushed stick zone sat off-centre (docs/friction.md).
 FRAME = "bisector"
+
+# A tangential row against an obstacle whose own node moves along it by less than this
+# fraction of the row's largest entry has no free tangential dof (its lambda_t is 0): a node
+# on a symmetry line (ux fixed) whose mortar row reaches the tangent's tilt (~h/R) across its
+# support. Kept, such a row outnumbered the free tangential motions: its multipliers went to
+# +-1e14 in a checkerboard and the stick/slip sets cycled (docs/friction.md, Spence).
+TANGENT_OWN_RTOL = 0.1
 
 SUPPORTED = (
     "nts or mortar (standard or dual) with multipliers and a direct solver (mumps), "
@@ -138,7 +146,11 @@ def tangent_constraint(
     B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
     mine = setup.order[setup.layout.mine]
     moving = CSR.vstack(columns).rows(setup.order) if scene.obstacles else None
-    return B, shift[mine], Bt.rows(setup.order), constrained_rows(op, dirichlet)[mine], moving
+    own = np.vstack([p.active.surface.dofs for p in setup.pairs])
+    free = constrained_rows(op, dirichlet) & node_free_rows(
+        op, own, setup.pairs, dirichlet, TANGENT_OWN_RTOL
+    )
+    return B, shift[mine], Bt.rows(setup.order), free[mine], moving
 
 
 def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:

@@ -23,6 +23,7 @@ from .reference_records import PatchErrors as PatchErrors
 from .reference_records import ProbeResult as ProbeResult
 from .reference_records import PushoutCheck as PushoutCheck
 from .reference_records import PushoutSummary as PushoutSummary
+from .reference_records import SpenceCheck as SpenceCheck
 
 # The JSON's `estimate.norm`: what the relative values are relative to.
 ESTIMATE_NORM = (
@@ -200,6 +201,7 @@ class StepSummary:
     contacts: tuple[ContactSummary, ...]
     cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference
     pushout: tuple[PushoutCheck, ...] = ()  # one per push-out reference
+    spence: tuple[SpenceCheck, ...] = ()  # one per Spence reference
 
     def to_json(self) -> dict[str, Any]:
         """The step's entry of the JSON's `steps`."""
@@ -211,6 +213,8 @@ class StepSummary:
             out["cattaneo"] = [c.to_json() for c in self.cattaneo]
         if self.pushout:
             out["pushout"] = [c.to_json() for c in self.pushout]
+        if self.spence:
+            out["spence"] = [c.to_json() for c in self.spence]
         return out
 
 
@@ -245,6 +249,7 @@ class RunSummary:
     lame: tuple[LameErrors, ...] = ()  # one per Lame reference
     cattaneo: tuple[CattaneoCheck, ...] = ()  # one per Cattaneo reference (the last step)
     pushout: tuple[PushoutSummary, ...] = ()  # one per push-out reference
+    spence: tuple[SpenceCheck, ...] = ()  # one per Spence reference (the last step)
     probes: tuple[ProbeResult, ...] = ()  # one per probe of the scene
     steps: tuple[StepSummary, ...] = ()  # one per [[step]] (none without steps)
 
@@ -294,6 +299,8 @@ class RunSummary:
             out["cattaneo"] = [r.to_json() for r in self.cattaneo]
         if self.pushout:
             out["pushout"] = [r.to_json() for r in self.pushout]
+        if self.spence:
+            out["spence"] = [r.to_json() for r in self.spence]
         if self.probes:
             out["probes"] = [p.to_json() for p in self.probes]
         if self.steps:

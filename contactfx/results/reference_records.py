@@ -391,3 +391,74 @@ class PushoutSummary:
             "fit": None if self.fit is None else self.fit.to_json(),
             "reference": "Coulomb: in full slip the axial force is mu times the normal force",
         }
+
+
+# Spence's analysis is the limit a/R -> 0: beyond this a/R the cylinder's tilt across the
+# contact moved the measured stick edge out by more than the done-when's 1.5 cells
+# (docs/friction.md, Spence, "Finite a/R").
+SPENCE_AR_MAX = 0.02
+
+
+@dataclass(frozen=True, kw_only=True)
+class SpenceCheck:
+    """A rigid cylinder pressed with friction, at one load step, against Spence's c/a."""
+
+    pair: int
+    mu: float
+    nu: float
+    R: float
+    ratio_exact: float  # Spence's c/a (spence_stick_ratio(mu, nu))
+    a: float  # the contact half-width read from the statuses (edge halfway to the open node)
+    c: float  # the stick half-width read from the statuses (edge halfway to the slip node)
+    h: float  # the contact cell (median node spacing over the contact nodes)
+    step: int  # the load step (1: the first, a single step from zero)
+
+    @property
+    def ratio(self) -> float:
+        """The computed c/a (0 without contact)."""
+        return self.c / self.a if self.a > 0 else 0.0
+
+    @property
+    def offset_cells(self) -> float:
+        """C - (c/a)_Spence a in contact cells (signed: positive, a stick zone too wide)."""
+        return (self.c - self.ratio_exact * self.a) / self.h if self.h > 0 else float("inf")
+
+    @property
+    def warning(self) -> str | None:
+        """Why Spence's c/a does not describe this step, or None."""
+        if self.step == 1:
+            return (
+                "step 1 loads from zero in one step (the whole contact forms at once), while "
+                "Spence's c/a is that of a load grown in small steps: compare the later steps"
+            )
+        if self.a / self.R > SPENCE_AR_MAX:
+            return (
+                f"a/R = {self.a / self.R:.3g} is above {SPENCE_AR_MAX:g}: Spence's analysis is "
+                "the limit a/R -> 0 (the cylinder's tilt across the contact adds to the slip)"
+            )
+        return None
+
+    def text(self) -> str:
+        """One terminal line."""
+        return (
+            f"Spence, pair {self.pair}: c/a = {self.ratio:.4f} (Spence {self.ratio_exact:.4f}, "
+            f"c off by {self.offset_cells:+.2f} cells), a = {self.a:.4g} "
+            f"({self.a / self.h:.1f} cells), a/R = {self.a / self.R:.2g}"
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON's `spence` entry."""
+        return {
+            "pair": self.pair,
+            "mu": self.mu,
+            "nu": self.nu,
+            "R": self.R,
+            "ratio_exact": self.ratio_exact,
+            "ratio": self.ratio,
+            "a": self.a,
+            "c": self.c,
+            "h": self.h,
+            "offset_cells": self.offset_cells,
+            "warning": self.warning,
+            "reference": "Spence (1975) self-similar stick ratio, rigid cylinder, plane strain",
+        }

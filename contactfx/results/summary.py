@@ -27,6 +27,7 @@ from .records import (
     StepSummary,
 )
 from .references import hertz_summary, uniform_stress_errors
+from .spence import spence_checks
 
 __all__ = [
     "ContactSummary",
@@ -92,6 +93,7 @@ def summary(
     patch = [uniform_stress_errors(sol, r) for r in refs if isinstance(r, UniformStress)]
     cattaneo, cattaneo_steps = cattaneo_checks(sol)
     pushout, pushout_steps = pushout_checks(sol)
+    spence, spence_steps = spence_checks(sol)
     return RunSummary(
         scene=scene.name,
         method=sol.method,
@@ -124,9 +126,12 @@ def summary(
         lame=tuple(lame_summary(sol, r) for r in refs if isinstance(r, LameReference)),
         cattaneo=cattaneo,
         pushout=pushout,
+        spence=spence,
         probes=tuple(probe_value(sol, p) for p in scene.probes),
         steps=tuple(
-            StepSummary(s.iterations, contacts_summary(s), c, po)
-            for s, c, po in zip(sol.steps, cattaneo_steps, pushout_steps, strict=True)
+            StepSummary(s.iterations, contacts_summary(s), c, po, sp)
+            for s, c, po, sp in zip(
+                sol.steps, cattaneo_steps, pushout_steps, spence_steps, strict=True
+            )
         ),
     )

@@ -20,7 +20,9 @@ from .model import (
     Model,
     PushoutReference,
     Scene,
+    SpenceReference,
 )
+from .obstacle import Shape
 from .steps import check_steps, load_names
 
 
@@ -165,6 +167,8 @@ def _check_conditions(scene: Scene) -> None:
             _check_cattaneo(scene, ref)
         if isinstance(ref, PushoutReference):
             _check_pushout(scene, ref)
+        if isinstance(ref, SpenceReference):
+            _check_spence(scene, ref)
         if not 0 <= pair < len(scene.contacts) + len(scene.obstacles):
             what = "probe" if ref in scene.probes else "reference"
             raise InputError(
@@ -217,6 +221,33 @@ def _check_pushout(scene: Scene, ref: PushoutReference) -> None:
         raise InputError(
             f"{where}: give delta for Lame's rings (the pair has no interference = D to take "
             "it from)"
+        )
+
+
+def _check_spence(scene: Scene, ref: SpenceReference) -> None:
+    """InputError for a Spence reference the scene cannot be checked against."""
+    where = f"spence reference (pair {ref.pair})"
+    n = len(scene.contacts)
+    if not n <= ref.pair < n + len(scene.obstacles):
+        raise InputError(
+            f"{where}: pair {ref.pair} is not one of the {len(scene.obstacles)} obstacles "
+            f"(pairs {n} to {n + len(scene.obstacles) - 1}; Spence is a rigid cylinder)"
+        )
+    ob = scene.obstacles[ref.pair - n]
+    if ob.shape is not Shape.CIRCLE:
+        raise InputError(
+            f"{where}: obstacle '{ob.name}' is a {ob.shape.value}; Spence's indenter is a "
+            "cylinder: give it shape = 'circle'"
+        )
+    mu = ob.mu if ref.mu is None else ref.mu
+    if not (ob.mu > 0 and mu > 0):
+        raise InputError(
+            f"{where}: obstacle '{ob.name}' is frictionless: give it mu > 0 in its [[obstacle]]"
+        )
+    if scene.model is not Model.PLANE_STRAIN:
+        raise InputError(
+            f"{where}: Spence's stick ratio is a plane-strain half-plane's; the scene's model "
+            f"is {scene.model.value}: use plane_strain"
         )
 
 

@@ -258,7 +258,31 @@ class CattaneoReference:
     mu: float | None = None
 
 
-Reference = HertzReference | UniformStress | LameReference | CattaneoReference | PushoutReference
+@dataclass(frozen=True)
+class SpenceReference:
+    """Spence's stick ratio on a rigid circle obstacle pressed with friction (plane strain).
+
+    At each load step: the stick half-width c and the contact half-width a read from the
+    statuses, against c/a = spence_stick_ratio(mu, nu) (Spence 1975: constant as the load
+    grows), with the offset c - (c/a) a in contact cells. `pair` indexes [[contact]], then
+    [[obstacle]], and must be a circle obstacle; `symmetric`: a half model cut through the
+    contact centre (as HertzReference's); `mu` None takes the obstacle's, nu is the body's.
+    Spence's analysis is the limit a/R -> 0 under a monotonic load in small steps.
+    """
+
+    pair: int
+    symmetric: bool = False
+    mu: float | None = None
+
+
+Reference = (
+    HertzReference
+    | UniformStress
+    | LameReference
+    | CattaneoReference
+    | PushoutReference
+    | SpenceReference
+)
 
 
 @dataclass(frozen=True)

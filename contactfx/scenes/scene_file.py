@@ -32,6 +32,7 @@ from .model import (
     PushoutReference,
     Reference,
     Scene,
+    SpenceReference,
     Traction,
     UniformStress,
     Units,
@@ -203,12 +204,28 @@ def _pushout(where: str, entry: Any) -> PushoutReference:
     return PushoutReference(pair, mu, rings, delta)  # type: ignore[arg-type]
 
 
+def _spence(where: str, entry: Any) -> SpenceReference:
+    e = _section(where, entry, "reference.spence")
+    pair = e.get("pair", 0)
+    if isinstance(pair, bool) or not isinstance(pair, int):
+        raise InputError(
+            f"{where}: pair: {TYPE_ERRORS['integer']} into [[contact]], then [[obstacle]]"
+        )
+    symmetric = e.get("symmetric", False)
+    if not isinstance(symmetric, bool):
+        raise InputError(f"{where}: symmetric: {TYPE_ERRORS['bool']}")
+    mu = _number(f"{where}.mu", e["mu"]) if "mu" in e else None
+    if mu is not None and mu <= 0:
+        raise InputError(f"{where}: mu must be positive (got {mu:g})")
+    return SpenceReference(pair, symmetric, mu)
+
+
 def _reference(k: int, entry: Any, model: Model | None = None) -> Reference:
     kind = entry.get("type") if isinstance(entry, dict) else None
-    if kind not in ("hertz", "uniform_stress", "lame", "cattaneo", "pushout"):
+    if kind not in ("hertz", "uniform_stress", "lame", "cattaneo", "pushout", "spence"):
         raise InputError(
-            f"reference {k}: type must be 'hertz', 'uniform_stress', 'lame', 'cattaneo' or "
-            f"'pushout' (got {kind!r})"
+            f"reference {k}: type must be 'hertz', 'uniform_stress', 'lame', 'cattaneo', "
+            f"'pushout' or 'spence' (got {kind!r})"
         )
     where = f"reference {k} ({kind})"
     if kind == "lame":
@@ -217,6 +234,8 @@ def _reference(k: int, entry: Any, model: Model | None = None) -> Reference:
         return _cattaneo(where, entry)
     if kind == "pushout":
         return _pushout(where, entry)
+    if kind == "spence":
+        return _spence(where, entry)
     if kind == "hertz":
         e = _section(where, entry, "reference.hertz")
         pair = e.get("pair", 0)

@@ -176,6 +176,24 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
         Key("c", "number", "none", "the outer radius of the outer ring (with a and b)"),
         Key("delta", "number", "the pair's interference D", "radial interference", "delta <= 0"),
     ),
+    "reference.spence": (
+        Key(
+            "type",
+            "string",
+            None,
+            '"spence": Spence\'s stick ratio c/a under a rigid circle obstacle pressed with '
+            "friction (plane strain)",
+        ),
+        Key(
+            "pair",
+            "integer",
+            "0",
+            "index into [[contact]], then [[obstacle]]",
+            "a pair that is not a frictional circle obstacle",
+        ),
+        Key("symmetric", "bool", "false", "a half model cut through the contact centre"),
+        Key("mu", "number", "the obstacle's mu", "friction coefficient", "mu <= 0"),
+    ),
     "reference.lame": (
         Key("type", "string", None, '"lame": a shrink fit of two concentric rings'),
         Key("pair", "integer", "0", "index into [[contact]]"),
