@@ -84,7 +84,6 @@ def test_builtin_mu_option_reaches_the_pair() -> None:
 @pytest.mark.parametrize(
     ("args", "refused"),
     [
-        (("--method", "penalty"), "the penalty enforcement"),
         (("--method", "schwarz"), "the schwarz enforcement"),
         (("--solver", "fieldsplit"), "the fieldsplit solver"),
         (
@@ -96,7 +95,7 @@ def test_builtin_mu_option_reaches_the_pair() -> None:
 def test_friction_refused_by_enforcement_or_solver_is_one_line(
     args: tuple[str, ...], refused: str
 ) -> None:
-    """Penalty, Schwarz, an iterative or the condensed solver with friction: one line, exit 2,
+    """Schwarz, an iterative or the condensed solver with friction: one line, exit 2,
     naming the pair and what does solve it."""
     proc = cli("solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1", *args)
     assert proc.returncode == 2, proc.stderr
