@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, replace
+from typing import Any, cast
 
 from dolfinx import mesh
 from mpi4py import MPI
@@ -32,6 +33,7 @@ from ..request import SolveRequest, direct_path
 from ..scenes import Scene
 from ..timers import Timers
 from .cleanup import dropped, released
+from .mumps_model import MODEL_MAX_ASPECT, model_bound
 from .solver_choice import (
     CHECK_KB_PER_DOF,
     COARSE_BOUND_DOFS,
@@ -44,7 +46,6 @@ from .solver_choice import (
     node_budget,
     scaled_bound,
 )
-from .mumps_model import model_bound
 from .solvers import setup_solver
 
 log = logging.getLogger("contactfx")
@@ -98,13 +99,16 @@ def _model_bound(setup: ContactSetup, scene: Scene, request: SolveRequest) -> Pr
         return None  # other MUMPS options (ordering, out-of-core) estimate otherwise
     comm = scene.comm
     K = setup.elasticity.K
-    nnz = int(K.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_used"])
+    nnz = int(K.getInfo(cast(Any, PETSc.Mat.InfoType.GLOBAL_SUM))["nz_used"])
     bound = model_bound(K.getSize()[0], nnz, comm.size)
     if bound is None:
         return None
     needed, avail = node_budget(comm, bound / comm.size, request.available_mb)
     choice = choose(needed, avail, request.diagonal)
     if choice is Choice.DIRECT:
+        return None
+    # Checked only where it would decide (a pass over the cells): stretched cells fill less.
+    if comm.allreduce(max_cell_aspect(scene.mesh), op=MPI.MAX) > MODEL_MAX_ASPECT:
         return None
     assert needed is not None and avail is not None
     ran = CONDENSED if choice is Choice.CONDENSED else direct_path(request.solver).name
