@@ -56,7 +56,6 @@ def _analysis(scene) -> tuple[float, int, int]:
         SMALL,
         HertzParams(refine=0.045, h_far=0.45, mesh="structured"),  # about 150k DOFs
         HertzParams(refine=0.05, h_far=0.5, refine_edge=0.0125),  # gmsh, about 60k DOFs
-        HertzParams(refine=0.02, mesh="structured"),  # the stretched default grading
     ],
 )
 def test_model_bound_is_below_the_analysis(params: HertzParams) -> None:
@@ -78,6 +77,23 @@ def test_model_applies_only_where_measured() -> None:
     assert model_bound(n, 14 * n, 1) is None  # P1 triangles' sparser graph: not measured
     # The fit grows per DOF with N (nested dissection in 2D): 10M needs more per DOF than 1M.
     assert model_mb(10**7, 2) / 10**7 > model_mb(10**6, 2) / 10**6
+
+
+def test_auto_keeps_the_analysis_on_stretched_cells(monkeypatch) -> None:
+    """The default grading's cells (hundreds to one) fill less per DOF than the model's
+    families: there the analysis decides even with the model's floor opened."""
+    stretched = hertz(HertzParams(refine=0.02, mesh="structured"), comm=MPI.COMM_SELF)
+    calls: list[int] = []
+    estimate = SaddleSolver.mumps_estimate
+
+    def counted(linear):
+        calls.append(linear._m.A.getSize()[0])
+        return estimate(linear)
+
+    monkeypatch.setattr(SaddleSolver, "mumps_estimate", counted)
+    monkeypatch.setattr(mumps_model, "MODEL_MIN_DOFS", 0)
+    _, out, fine = _auto(stretched, 1.0, calls)
+    assert out["solver_choice"]["estimate_of"] == "fine" and len(fine) == 1
 
 
 def _auto(scene, available: float, calls: list[int]):
