@@ -75,7 +75,8 @@ def prepare_solver(
     if request.solver.kind is not SolverKind.AUTO:
         return Prepared(setup, request)
     try:
-        modelled = _model_bound(setup, scene, request)
+        with timers("solve"):  # the decision's cost, as the analyses' below
+            modelled = _model_bound(setup, scene, request)
         if modelled is not None:
             return modelled
         coarse = _coarse_bound(setup, scene, request, penetration_tol, timers)
