@@ -11,7 +11,8 @@ analysis as it did: the fine one, or from 1.6M DOFs the coarse check) and `after
 model decides). It writes the phases (mesh, assembly, predictor, the solver decision =
 the solve phase minus its active-set steps, the steps, CG iterations), the peak memory, the
 Hertz L2 error, the active set and DOF/s per core end to end, and prints one JSON line per
-run. docs/scale.md, "The 10.46M default command" and benchmarks/README.md cite it.
+run. `--table` prints the README's table from the JSON instead. docs/scale.md ("How `auto`
+decides") and benchmarks/README.md cite it.
 """
 
 from __future__ import annotations
@@ -103,7 +104,28 @@ def run_one(h: float, available: float, variant: str, ranks: int) -> dict[str, o
     }
 
 
+def table(path: str) -> str:
+    """The README's rows: one per run, in the order run."""
+    data = json.loads(Path(path).read_text())
+    head = "| DOFs | variant | decided from | mesh | assembly | predictor | decision | step(s) |"
+    head += " total | DOF/s per core | CG its | active | Hertz L2 | peak MB | load |"
+    lines = [head, "|" + "---|" * 15]
+    for r in data["rows"]:
+        steps = " + ".join(f"{s:.2f}" for s in r["steps_s"])
+        its = ", ".join(str(i) for i in r["cg_iterations"])
+        lines.append(
+            f"| {r['dofs']:,} | {r['variant']} | {r['estimate_of']} | {r['mesh_s']:.2f} | "
+            f"{r['assembly_s']:.2f} | {r['predictor_s']:.2f} | {max(r['decision_s'], 0):.2f} | "
+            f"{steps} | {r['total_s']:.2f} | {r['dof_per_s_per_core']:,.0f} | {its} | "
+            f"{r['active']} | {100 * r['hertz_l2']:.4f} % | {r['peak_mb']:,.0f} | {r['load']:.1f} |"
+        )
+    return "\n".join(lines)
+
+
 def main() -> None:
+    if sys.argv[1:2] == ["--table"]:
+        print(table(sys.argv[2] if len(sys.argv) > 2 else str(HERE / "floor_phases.json")))
+        return
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("sizes", nargs="+", help="H:AVAILABLE_MB")
     ap.add_argument("--ranks", type=int, default=2)
