@@ -18,6 +18,7 @@ import contactfx.methods.mumps_model as mumps_model
 from contactfx import run_scene
 from contactfx.discretize.mesh_utils import scene_dofs
 from contactfx.discretize.setup import prepare_contact
+from contactfx.errors import InputError
 from contactfx.linalg.saddle import SaddleSolver
 from contactfx.methods.mumps_model import model_bound, model_mb
 from contactfx.methods.solver_choice import SAFETY
@@ -139,3 +140,15 @@ def test_auto_decides_as_the_analysis(scene, monkeypatch) -> None:
         assert np.abs(sol.pressure - ref.pressure).max() <= 1e-9 * scale
         for key in ("l2_error", "a", "p0"):
             assert out["hertz"][key] == pytest.approx(ref_json["hertz"][key], rel=1e-6)
+
+
+def test_auto_model_refuses_without_a_diagonal_d(scene, monkeypatch) -> None:
+    """The standard basis where even the model's bound does not fit: the one-line refusal,
+    before any analysis."""
+    calls: list[int] = []
+    monkeypatch.setattr(SaddleSolver, "mumps_estimate", lambda lin: calls.append(1))
+    monkeypatch.setattr(mumps_model, "MODEL_MIN_DOFS", 0)
+    request = SolveRequest.parse("mortar", basis="standard", solver="auto", available_mb=1.0)
+    with pytest.raises(InputError, match=r"would not fit: MUMPS estimates >= .*--basis dual"):
+        run_scene(scene, request)
+    assert not calls
