@@ -22,7 +22,7 @@ import math
 FIT: dict[int, tuple[float, float]] = {1: (1.38, 0.11), 2: (1.47, 0.11)}
 # Below the sweep's smallest estimate over the rounded model (0.977, 1.72M on 2 ranks), with
 # 2-3 % to spare: model x LOWER is below MUMPS' estimate at every size measured on the
-# accurate families, 30k to 10.46M DOFs, by 4 % at least.
+# accurate families, 30k to 10.46M DOFs, by 2.8 % at least (benchmarks/mumps_model.json).
 LOWER = 0.95
 # The sizes whose growth was fitted: below them a rank's fixed share makes the estimate per
 # DOF fall with N, and the analysis is cheap anyway.
