@@ -31,7 +31,7 @@ MODEL_MIN_DOFS = 400_000
 # or sparser graph fills differently, and the model does not apply.
 NNZ_PER_DOF = (17.5, 18.1)
 # The accurate families measured have cells up to 20:1 (structured, --h-far 10H) and 2.3:1
-# (gmsh); the default grading's, stretched 600:1 and more, fill less per DOF (down to 0.86x
+# (gmsh); the default grading's, stretched 600:1 and more, fill less per DOF (0.90x
 # the fit at 584k): the model applies up to this aspect only.
 MODEL_MAX_ASPECT = 100.0
 
