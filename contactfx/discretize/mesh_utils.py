@@ -15,12 +15,18 @@ def scene_dofs(scene: Scene) -> int:
 
 def max_cell_aspect(msh: mesh.Mesh) -> float:
     """The largest longest-to-shortest edge ratio of the local cells (Q1 quadrilaterals)."""
-    x = msh.geometry.x[msh.geometry.dofmaps[0], :2]  # (cells, 4, 2): tensor-product order
-    if len(x) == 0:
+    x, cells = msh.geometry.x[:, :2], msh.geometry.dofmaps[0]  # tensor-product order
+    if len(cells) == 0:
         return 1.0
-    # The edges of a DOLFINx quadrilateral: 0-1, 1-3, 3-2, 2-0.
-    edges = np.linalg.norm(x[:, [1, 3, 2, 0]] - x[:, [0, 1, 3, 2]], axis=2)
-    return float(np.max(edges.max(axis=1) / edges.min(axis=1)))
+    # The edges of a DOLFINx quadrilateral: 0-1, 1-3, 3-2, 2-0; squared lengths, one edge
+    # at a time (`auto` asks this of 10M-DOF meshes: a third of the (cells, 4, 2) version).
+    sq = []
+    for i, j in ((1, 0), (3, 1), (2, 3), (0, 2)):
+        v = x[cells[:, i]] - x[cells[:, j]]
+        sq.append(np.einsum("ij,ij->i", v, v))
+    longest = np.maximum(np.maximum(sq[0], sq[1]), np.maximum(sq[2], sq[3]))
+    shortest = np.minimum(np.minimum(sq[0], sq[1]), np.minimum(sq[2], sq[3]))
+    return float(np.sqrt(np.max(longest / shortest)))
 
 
 def vertex_to_block(V: fem.FunctionSpace) -> np.ndarray:

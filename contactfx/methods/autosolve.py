@@ -5,7 +5,9 @@ Before any factorization MUMPS' analysis alone runs on the loop's own saddle-poi
 On each node the ranks' estimates add up against the memory available there; with room (the
 SAFETY factor) the direct path runs and its first factorization reuses that analysis, else
 the condensed path runs (multipliers eliminated, CG + GAMG) where D is diagonal, and
-elsewhere the run is refused before factorizing. On a large scene the analysis of the
+elsewhere the run is refused before factorizing. First, on the family it was measured on,
+a model of MUMPS' estimate from the graph (`mumps_model`) decides without any analysis
+where even its lower bound does not fit. On a large scene the analysis of the
 same scene meshed coarser (a quarter of the DOFs) comes first: its estimate scaled to the
 fine DOFs is a lower bound, and where even that does not fit the fine analysis is skipped.
 The rule and its measurements: docs/scale.md, "The default solver".
@@ -15,9 +17,11 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, replace
+from typing import Any, cast
 
 from dolfinx import mesh
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from ..discretize.mesh_utils import max_cell_aspect, scene_dofs
 from ..discretize.setup import ContactSetup, prepare_contact
@@ -29,6 +33,7 @@ from ..request import SolveRequest, direct_path
 from ..scenes import Scene
 from ..timers import Timers
 from .cleanup import dropped, released
+from .mumps_model import MODEL_MAX_ASPECT, model_bound
 from .solver_choice import (
     CHECK_KB_PER_DOF,
     COARSE_BOUND_DOFS,
@@ -70,6 +75,10 @@ def prepare_solver(
     if request.solver.kind is not SolverKind.AUTO:
         return Prepared(setup, request)
     try:
+        with timers("solve"):  # the decision's cost, as the analyses' below
+            modelled = _model_bound(setup, scene, request)
+        if modelled is not None:
+            return modelled
         coarse = _coarse_bound(setup, scene, request, penetration_tol, timers)
         if coarse is not None:
             return coarse
@@ -77,6 +86,34 @@ def prepare_solver(
     except BaseException:
         dropped(scene.comm, setup)
         raise
+
+
+def _model_bound(setup: ContactSetup, scene: Scene, request: SolveRequest) -> Prepared | None:
+    """The choice without any analysis where even the model's lower bound does not fit.
+
+    `mumps_model.model_bound` bounds MUMPS' estimate from below from the graph (DOFs, K's
+    nonzeros, the ranks) on the family it was measured on, with auto's own MUMPS options;
+    where 1.25 x that bound exceeds the memory available, the analysis would choose the
+    condensed path (or refuse) too. None (an analysis decides) where it fits or does not apply.
+    """
+    if request.solver.petsc != SOLVERS["auto"].petsc:
+        return None  # other MUMPS options (ordering, out-of-core) estimate otherwise
+    comm = scene.comm
+    K = setup.elasticity.K
+    nnz = int(K.getInfo(cast(Any, PETSc.Mat.InfoType.GLOBAL_SUM))["nz_used"])
+    bound = model_bound(K.getSize()[0], nnz, comm.size)
+    if bound is None:
+        return None
+    needed, avail = node_budget(comm, bound / comm.size, request.available_mb)
+    choice = choose(needed, avail, request.diagonal)
+    if choice is Choice.DIRECT:
+        return None
+    # Checked only where it would decide (a pass over the cells): stretched cells fill less.
+    if comm.allreduce(max_cell_aspect(scene.mesh), op=MPI.MAX) > MODEL_MAX_ASPECT:
+        return None
+    assert needed is not None and avail is not None
+    ran = CONDENSED if choice is Choice.CONDENSED else direct_path(request.solver).name
+    return _condensed(setup, comm, request, SolverChoice(ran, needed, avail, None, model=True))
 
 
 def _coarse_bound(
@@ -155,7 +192,7 @@ def _condensed(
     """The condensed path where MUMPS does not fit; a one-line refusal where D is not diagonal."""
     if record.ran != CONDENSED:
         assert record.needed_mb is not None and record.available_mb is not None
-        bound = ">= " if record.coarse_dofs is not None else ""
+        bound = ">= " if record.coarse_dofs is not None or record.model else ""
         raise InputError(
             f"the direct solver would not fit: MUMPS estimates {bound}"
             f"{record.needed_mb / 1e3:.2f} GB, {record.available_mb / 1e3:.2f} GB available "

@@ -75,6 +75,8 @@ class SolverChoice:
     # DOFs of the coarse system whose analysis, scaled, bounds the estimate from below (None:
     # the estimate is the fine system's own).
     coarse_dofs: int | None = None
+    # The estimate is the graph model's lower bound (methods/mumps_model.py): no analysis ran.
+    model: bool = False
 
     @property
     def reason(self) -> str:
@@ -85,6 +87,8 @@ class SolverChoice:
         amount = f"{self.needed_mb / 1e3:.2f} GB"
         if self.coarse_dofs is not None:
             amount = f">= {amount} (analysis of the {self.coarse_dofs:,}-DOF coarse system, scaled)"
+        elif self.model:
+            amount = f">= {amount} (the model of its estimate from the graph, a lower bound)"
         return (
             f"MUMPS {verb} {amount}, {self.available_mb / 1e3:.2f} GB "
             f"available; margin x{self.safety:g}"
@@ -100,9 +104,16 @@ class SolverChoice:
             "available_mb": self.available_mb,
             "safety": self.safety,
             "analysis_seconds": self.analysis_seconds,
-            "estimate_of": "fine" if self.coarse_dofs is None else "coarse, scaled (a lower bound)",
+            "estimate_of": self._estimate_of,
             "coarse_dofs": self.coarse_dofs,
         }
+
+    @property
+    def _estimate_of(self) -> str:
+        """Which system's estimate was compared (the JSON's `estimate_of`)."""
+        if self.coarse_dofs is not None:
+            return "coarse, scaled (a lower bound)"
+        return "graph model (a lower bound)" if self.model else "fine"
 
 
 def mem_available_mb() -> float | None:
