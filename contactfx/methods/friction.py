@@ -39,9 +39,10 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..contact import ContactOperator
-from ..contact.friction import FrictionResult, Status, classify, ncp
+from ..contact.friction import FrictionResult, RowState, Status, classify, damped_length, ncp
 from ..contact.sparse import CSR
 from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
+from ..discretize.obstacles import node_free_rows
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
 from ..discretize.tangents import tangent_rows
 from ..errors import InputError, SolverError
@@ -138,7 +139,15 @@ def tangent_constraint(
     B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
     mine = setup.order[setup.layout.mine]
     moving = CSR.vstack(columns).rows(setup.order) if scene.obstacles else None
-    return B, shift[mine], Bt.rows(setup.order), constrained_rows(op, dirichlet)[mine], moving
+    # A row whose own node cannot move along it (a symmetry line, the axis) carries no
+    # shear: with the standard basis it still touches its neighbour's dof, and its stick
+    # multiplier, duplicating the support's reaction, was an alternating shear of mu p
+    # decaying along the rows (docs/friction.md, "How it is solved").
+    own = node_free_rows(
+        op, np.vstack([p.active.surface.dofs for p in setup.pairs]), setup.pairs, dirichlet, True
+    )
+    free = constrained_rows(op, dirichlet) & own
+    return B, shift[mine], Bt.rows(setup.order), free[mine], moving
 
 
 def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
@@ -177,10 +186,15 @@ class FrictionIteration:
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
         self.offset = layout.offset
+        # The iterate the next Newton step starts from (None: the first solve of the step)
+        # and how many steps have lowered the merit (the cycle key's epoch).
+        self.state: RowState | None = None
+        self.epoch = 0
 
     def key(self, active: np.ndarray) -> np.ndarray:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
-        return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+        rows = np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+        return rows + 4 * self.epoch
 
     def solve(self, active: np.ndarray, it: int) -> Step:
         """One LU solve of the frictional saddle point on `active` and the friction sets."""
@@ -235,16 +249,25 @@ class FrictionIteration:
         for obj in (ksp, A, nest, Bn_a, Bt_a, BnT, BtT, Cnn, Ctn, Ctt, b, x):
             obj.destroy()
         u, mu_n, mu_t = out
-        self.u.x.petsc_vec.array[:] = u
-        self.u.x.scatter_forward()
         lam_n, lam_t = np.where(active, -mu_n, 0.0), np.where(active, mu_t, 0.0)
-        gap = setup.normalized_gap(self.u)
-        y = self.Bt.createVecLeft()
-        self.Bt.mult(self.u.x.petsc_vec, y)
-        ut = y.array_r + self.shift_t
-        y.destroy()
         w = setup.w
-        inc = np.where(self.free_t, (ut - self.ut_prev) / w, 0.0)  # fixed rows: no slip
+        start = self.u.x.petsc_vec.array_r.copy()
+        target = self._rows(u, lam_n, lam_t)
+        alpha = 1.0
+        if self.state is not None:
+            # The solve is the full semismooth Newton step from the last iterate; shortened
+            # where it does not lower the complementarity residual (docs/friction.md, "How
+            # it is solved"). A lowered residual cannot come back: a new epoch of the key.
+            alpha, lowered = damped_length(
+                self.state, target, self.mu, self.c, self.c, w, lambda x: comm.allreduce(x)
+            )
+            self.epoch += lowered
+            if alpha < 1.0:
+                lam = self.state.toward(target, alpha)
+                target = self._rows(start + alpha * (u - start), lam.lam_n, lam.lam_t)
+        self.state = target
+        lam_n, lam_t, gap, inc = target.arrays()
+        ut = self._slip()
         status = classify(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
         tau = lam_t + self.c * inc
         new_active = status != Status.OPEN
@@ -265,9 +288,37 @@ class FrictionIteration:
         self.lam_t, self.slip, self.status = lam_t, ut / w, status
         n_stick = comm.allreduce(int(np.sum(status == Status.STICK)))
         n_slip = comm.allreduce(int(np.sum(status == Status.SLIP)))
-        record: dict[str, float] = {"stick": n_stick, "slip": n_slip, "friction_changed": n_changed}
-        text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, complementarity {resid:.2e}, "
-        return Step(lam_n, gap, new_active, float(resid), record, text, True, n_changed)
+        record: dict[str, float] = {
+            "stick": n_stick,
+            "slip": n_slip,
+            "friction_changed": n_changed,
+            "step_length": alpha,
+        }
+        damped = f", step {alpha:g}" if alpha < 1.0 else ""
+        text = (
+            f"{n_stick} stick, {n_slip} slip, {n_changed} changed{damped}, "
+            f"complementarity {resid:.2e}, "
+        )
+        return Step(
+            lam_n, gap, new_active, float(resid), record, text, True, n_changed + (alpha < 1.0)
+        )
+
+    def _rows(self, u: np.ndarray, lam_n: np.ndarray, lam_t: np.ndarray) -> RowState:
+        """The rows' state of a solution `u` with its multipliers."""
+        self.u.x.petsc_vec.array[:] = u
+        self.u.x.scatter_forward()
+        gap = self.setup.normalized_gap(self.u)
+        ut = self._slip()
+        inc = np.where(self.free_t, (ut - self.ut_prev) / self.setup.w, 0.0)  # fixed: no slip
+        return RowState(lam_n, lam_t, gap, inc)
+
+    def _slip(self) -> np.ndarray:
+        """The rows' weighted tangential displacement B_t u (+ prescribed) of the iterate."""
+        y = self.Bt.createVecLeft()
+        self.Bt.mult(self.u.x.petsc_vec, y)
+        ut = y.array_r + self.shift_t
+        y.destroy()
+        return ut
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The update's set (no probes on the frictional path)."""
