@@ -267,7 +267,8 @@ class FrictionIteration:
                 target = self._rows(start + alpha * (u - start), lam.lam_n, lam.lam_t)
         self.state = target
         lam_n, lam_t, gap, inc = target.arrays()
-        ut = self._slip()
+        # A row held along its tangent does not slip: its weighted slip is its neighbour's.
+        ut = np.where(self.free_t, self._slip(), self.ut_prev)
         status = classify(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
         tau = lam_t + self.c * inc
         new_active = status != Status.OPEN

@@ -162,7 +162,8 @@ class PenaltyFrictionIteration:
         gap = setup.normalized_gap(self.u)
         y = self.Bt.createVecLeft()
         self.Bt.mult(self.u.x.petsc_vec, y)
-        ut = y.array_r + self.shift_t
+        # A row held along its tangent does not slip (methods/friction.py).
+        ut = np.where(self.free_t, y.array_r + self.shift_t, self.ut_prev)
         y.destroy()
         w = setup.w
         p = -self.eps_n * gap
