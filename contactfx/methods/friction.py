@@ -41,10 +41,14 @@ from petsc4py import PETSc
 from ..contact import ContactOperator
 from ..contact.friction import FrictionResult, RowState, Status, classify, damped_length, ncp
 from ..contact.sparse import CSR
-from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
-from ..discretize.obstacles import node_free_rows
+from ..discretize.coupling import (
+    column_mask,
+    constrained_rows,
+    global_dirichlet_dofs,
+    petsc_constraint,
+)
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
-from ..discretize.tangents import tangent_rows
+from ..discretize.tangents import held_rows, tangent_rows
 from ..errors import InputError, SolverError
 from ..linalg.blocks import diagonal_matrix
 from ..options import Basis, Discretization, Enforcement, SolverKind
@@ -136,17 +140,12 @@ def tangent_constraint(
     )
     shift = prescribed_gap_shift(scene, el, op, dofs) + np.concatenate(motion)
     dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
+    fixed = column_mask(dirichlet, Bt.shape[1])
     B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
     mine = setup.order[setup.layout.mine]
     moving = CSR.vstack(columns).rows(setup.order) if scene.obstacles else None
-    # A row whose own node cannot move along it (a symmetry line, the axis) carries no
-    # shear: with the standard basis it still touches its neighbour's dof, and its stick
-    # multiplier, duplicating the support's reaction, was an alternating shear of mu p
-    # decaying along the rows (docs/friction.md, "How it is solved").
-    own = node_free_rows(
-        op, np.vstack([p.active.surface.dofs for p in setup.pairs]), setup.pairs, dirichlet, True
-    )
-    free = constrained_rows(op, dirichlet) & own
+    held = held_rows(Bt, np.vstack([p.active.surface.dofs for p in setup.pairs]), fixed)
+    free = constrained_rows(op, dirichlet) & ~held
     return B, shift[mine], Bt.rows(setup.order), free[mine], moving
 
 
