@@ -98,25 +98,19 @@ def moved(op: ContactOperator, pairs: list[PairData]) -> ContactOperator:
 
 
 def node_free_rows(
-    op: ContactOperator,
-    node_dofs: np.ndarray,
-    pairs: list[PairData],
-    dirichlet: np.ndarray,
-    bodies: bool = False,
+    op: ContactOperator, node_dofs: np.ndarray, pairs: list[PairData], dirichlet: np.ndarray
 ) -> np.ndarray:
     """False on the obstacle rows whose own node cannot move along them (prescribed).
 
     Such a row still touches the neighbours' dofs (STS, mortar), but with a rigid side
     that has no dofs the rows outnumber the free normal motions they constrain: the
-    multipliers would not be unique (a singular saddle point). Body pairs keep their normal
-    rows: the passive body's dofs take up the slack. `bodies`: body pairs' rows too (the
-    tangential rows: on a symmetry line or the axis both bodies' tangential dofs are held,
-    and with the standard basis the row there would still touch its neighbour's).
+    multipliers would not be unique (a singular saddle point). Body pairs keep theirs: the
+    passive body's dofs take up the slack.
     """
     keep = np.ones(op.B.shape[0], dtype=bool)
     fixed = column_mask(dirichlet, op.B.shape[1])
     for p in pairs:
-        if p.obstacle is None and not bodies:
+        if p.obstacle is None:
             continue
         rows = np.arange(p.first_row, p.first_row + p.active.surface.n_nodes)
         sub = op.B.rows(rows)
