@@ -116,8 +116,10 @@ def classify(
     c_n: float,
     c_t: float,
 ) -> np.ndarray:
-    """Each row's set: open where xi <= 0, else stick where |tau| < mu xi (up to round-off:
-    STICK_MARGIN), else slip."""
+    """Each row's set: open where xi <= 0, else stick where |tau| < mu xi, else slip.
+
+    "<" up to round-off: STICK_MARGIN.
+    """
     xi, tau, r = _state(lam_n, lam_t, g_n, u_t, mu, c_n, c_t)
     status = np.full(xi.shape, Status.SLIP, dtype=np.int64)
     status[np.abs(tau) < (1.0 + STICK_MARGIN) * r] = Status.STICK
@@ -211,9 +213,7 @@ class RowState:
         return self.lam_n, self.lam_t, self.g_n, self.u_t
 
 
-def merit(
-    state: RowState, mu: float | np.ndarray, c_n: float, c_t: float, w: np.ndarray
-) -> float:
+def merit(state: RowState, mu: float | np.ndarray, c_n: float, c_t: float, w: np.ndarray) -> float:
     """This rank's sum of w (C_n^2 + C_t^2): zero exactly where Coulomb's law holds."""
     cn, ct = ncp(*state.arrays(), mu, c_n, c_t)
     return float(np.sum(w * (cn**2 + ct**2)))

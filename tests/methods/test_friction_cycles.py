@@ -33,6 +33,7 @@ SCENES = ROOT / "tests" / "scenes"
 # The penalty's distance from the multipliers at its default stiffness: 1.28e-3 of the
 # largest pressure on the pushed block (docs/friction.md, "The penalty baseline").
 PENALTY_ERROR = 2e-3
+CASES = [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")]
 
 
 def frictional(name: str, mu: float = MU) -> Scene:
@@ -67,7 +68,9 @@ def wall_forces(sol: Solution) -> np.ndarray:
     return np.array([w[side] @ sol.pressure[side] for side in (x < 1.0, x > 1.0)])
 
 
-@pytest.mark.parametrize(("method", "basis"), [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")])
+@pytest.mark.parametrize(
+    ("method", "basis"), [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")]
+)
 def test_heated_block_between_frictional_walls(method: str, basis: str) -> None:
     """The heated block pressing on two frictional walls: no cycle, Coulomb at every node,
     and each wall's normal force the same as nts's (the dual basis and nts coincide on a
@@ -108,7 +111,9 @@ def test_shrink_fit_has_no_shear(method: str) -> None:
     np.testing.assert_allclose(sol.pressure, plain.pressure, rtol=0, atol=1e-5 * scale)
 
 
-@pytest.mark.parametrize(("method", "basis"), [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")])
+@pytest.mark.parametrize(
+    ("method", "basis"), [("mortar", "standard"), ("mortar", "dual"), ("nts", "standard")]
+)
 def test_long_hub_mid_plane_carries_no_shear(method: str, basis: str) -> None:
     """The axisymmetric long hub: the ends slip outwards, the middle sticks; the rows near the
     mid-plane (z < 1), where symmetry rules a shear out, carry less than 1 % of mu p (3e-4
