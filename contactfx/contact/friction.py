@@ -229,20 +229,54 @@ def damped_length(
     total: Callable[[float], float] = float,
     sigma: float = 1e-4,
     shortest: float = 2.0**-10,
-) -> tuple[float, bool]:
+) -> tuple[float, float, float]:
     """The semismooth Newton step's length from `start` toward `target` (Armijo backtracking).
 
     `target` is the solution on the set `start` classifies into (the full Newton step, as
     C is piecewise linear); the step is halved until the merit w (C_n^2 + C_t^2), summed over
-    the ranks by `total`, falls by the fraction 2 sigma alpha. Returns the length and whether
-    it lowered the merit: the full step and False where no length down to `shortest` does (a
-    kink of C, where the set's derivative is not a descent direction: the undamped update).
+    the ranks by `total`, falls by the fraction 2 sigma alpha (`armijo`: the length, the
+    merit at the start and at the step's end). Where no length down to `shortest` does (a
+    kink of C, where the set's derivative is not a descent direction), the full step.
     """
-    theta0 = total(merit(start, mu, c_n, c_t, w))
+    return armijo(
+        lambda alpha: total(merit(start.toward(target, alpha), mu, c_n, c_t, w)), sigma, shortest
+    )
+
+
+def armijo(
+    theta: Callable[[float], float], sigma: float = 1e-4, shortest: float = 2.0**-10
+) -> tuple[float, float, float]:
+    """A step length by backtracking, with the merit before and after the step.
+
+    The longest of 1, 1/2, 1/4, ... down to `shortest` with theta(alpha) <= (1 - 2 sigma
+    alpha) theta(0); 1 where none is.
+    """
+    theta0 = theta(0.0)
     alpha = 1.0
     while alpha >= shortest:
-        theta = total(merit(start.toward(target, alpha), mu, c_n, c_t, w))
-        if theta <= (1.0 - 2.0 * sigma * alpha) * theta0:
-            return alpha, theta < theta0
+        value = theta(alpha)
+        if value <= (1.0 - 2.0 * sigma * alpha) * theta0:
+            return alpha, theta0, value
         alpha /= 2.0
-    return 1.0, False
+    return 1.0, theta0, theta(1.0)
+
+
+class Epochs:
+    """The cycle key's epoch of a damped iteration: how many iterates set a record low.
+
+    A damped step lowers the merit, so its iterate is never met again and meeting its set
+    again is no cycle; a full step where no length lowers it (a kink) may raise it. Iterates
+    that come round again set no new record: their sets repeat within one epoch, which the
+    active-set loop reports as a cycle.
+    """
+
+    def __init__(self) -> None:
+        self.epoch = 0
+        self.best = np.inf
+
+    def update(self, before: float, after: float) -> None:
+        """A step from merit `before` to `after`."""
+        self.best = min(self.best, before)
+        if after < self.best:
+            self.best = after
+            self.epoch += 1

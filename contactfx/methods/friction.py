@@ -38,7 +38,15 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from ..contact.friction import FrictionResult, RowState, Status, classify, damped_length, ncp
+from ..contact.friction import (
+    Epochs,
+    FrictionResult,
+    RowState,
+    Status,
+    classify,
+    damped_length,
+    ncp,
+)
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import InputError, SolverError
 from ..linalg.blocks import diagonal_matrix
@@ -140,14 +148,14 @@ class FrictionIteration:
         self.status = np.zeros(m, dtype=np.int64)
         self.offset = layout.offset
         # The iterate the next Newton step starts from (None: the first solve of the step)
-        # and how many steps have lowered the merit (the cycle key's epoch).
+        # and the cycle key's epoch.
         self.state: RowState | None = None
-        self.epoch = 0
+        self.epochs = Epochs()
 
     def key(self, active: np.ndarray) -> np.ndarray:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
         rows = np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
-        return rows + 4 * self.epoch
+        return rows + 4 * self.epochs.epoch
 
     def solve(self, active: np.ndarray, it: int) -> Step:
         """One LU solve of the frictional saddle point on `active` and the friction sets."""
@@ -210,11 +218,11 @@ class FrictionIteration:
         if self.state is not None:
             # The solve is the full semismooth Newton step from the last iterate; shortened
             # where it does not lower the complementarity residual (docs/friction.md, "How
-            # it is solved"). A lowered residual cannot come back: a new epoch of the key.
-            alpha, lowered = damped_length(
+            # it is solved"); the key's epoch: contact/friction.py, Epochs.
+            alpha, before, after = damped_length(
                 self.state, target, self.mu, self.c, self.c, w, lambda x: comm.allreduce(x)
             )
-            self.epoch += lowered
+            self.epochs.update(before, after)
             if alpha < 1.0:
                 lam = self.state.toward(target, alpha)
                 target = self._rows(start + alpha * (u - start), lam.lam_n, lam.lam_t)

@@ -6,6 +6,7 @@ import numpy as np
 
 from contactfx.contact.friction import (
     STICK_MARGIN,
+    Epochs,
     RowState,
     Status,
     classify,
@@ -38,21 +39,37 @@ def test_an_overshooting_step_is_halved_until_the_merit_falls() -> None:
     start, target = row(1.0, 0.4, 0.0, 0.3), row(1.0, 2.0, 0.0, -3.0)
     assert np.isclose(merit(start, MU, C, C, W), 0.01)
     assert merit(target, MU, C, C, W) == 6.25
-    alpha, lowered = damped_length(start, target, MU, C, C, W)
-    assert alpha == 1 / 16 and lowered
-    assert merit(start.toward(target, alpha), MU, C, C, W) < 1e-30
+    alpha, before, after = damped_length(start, target, MU, C, C, W)
+    assert alpha == 1 / 16 and np.isclose(before, 0.01) and after < 1e-30
+    assert merit(start.toward(target, alpha), MU, C, C, W) == after
 
 
 def test_a_step_to_the_root_is_taken_in_full() -> None:
-    """The set's solution satisfying Coulomb: the full step, which lowered the merit."""
-    alpha, lowered = damped_length(row(1.0, 0.7, 0.0, 0.0), row(1.0, 0.5, 0.0, 0.3), MU, C, C, W)
-    assert (alpha, lowered) == (1.0, True)
+    """The set's solution satisfying Coulomb: the full step, to merit 0."""
+    alpha, before, after = damped_length(
+        row(1.0, 0.7, 0.0, 0.0), row(1.0, 0.5, 0.0, 0.3), MU, C, C, W
+    )
+    assert (alpha, after) == (1.0, 0.0) and before > 0.0
 
 
 def test_from_a_root_no_step_lowers_the_merit() -> None:
-    """Already at a root: no length lowers the merit, the undamped update is left to run."""
-    alpha, lowered = damped_length(row(1.0, 0.2, 0.0, 0.0), row(1.0, 2.0, 0.0, -3.0), MU, C, C, W)
-    assert (alpha, lowered) == (1.0, False)
+    """Already at a root: no length lowers the merit, the full step is taken (a kink's)."""
+    alpha, before, after = damped_length(
+        row(1.0, 0.2, 0.0, 0.0), row(1.0, 2.0, 0.0, -3.0), MU, C, C, W
+    )
+    assert (alpha, before, after) == (1.0, 0.0, 6.25)
+
+
+def test_an_iterate_that_comes_round_sets_no_new_epoch() -> None:
+    """Epochs count record lows: a merit falling 4, 2, 1 makes three; rising back to 4 and
+    falling to 2 and 1 again (a cycle of iterates) none, so the loop sees its sets repeat."""
+    epochs = Epochs()
+    for before, after in ((8, 4), (4, 2), (2, 1)):
+        epochs.update(before, after)
+    assert epochs.epoch == 3
+    for before, after in ((1, 4), (4, 2), (2, 1), (1, 4)):
+        epochs.update(before, after)
+    assert epochs.epoch == 3
 
 
 def test_a_slip_row_with_round_off_slip_sticks() -> None:

@@ -87,9 +87,29 @@ def test_heated_block_between_frictional_walls(method: str, basis: str) -> None:
     assert np.all(wall_forces(sol) > 1.01 * 1.4285714285714286)
 
 
+def test_heated_block_penalty_converges_to_the_multipliers() -> None:
+    """The penalty's regularized law (damped as the multipliers) on the heated block: the
+    multipliers' statuses, and pressures and shears that approach theirs like 1 / eps
+    (2.1e-3 of the largest pressure at the default eps, 2.1e-4 at ten times it)."""
+    scene = frictional("heated_block")
+    sol = solve(scene, "mortar")
+    assert sol.friction is not None
+    scale = sol.pressure.max()
+    default = solve(scene, "penalty")
+    assert default.penalty is not None
+    stiff = solve(scene, "penalty", penalty=10.0 * default.penalty.eps)
+    gaps = []
+    for pen in (default, stiff):
+        assert pen.friction is not None
+        np.testing.assert_array_equal(pen.friction.status, sol.friction.status)
+        gaps.append(np.abs(pen.pressure - sol.pressure).max() / scale)
+        assert np.abs(pen.friction.shear - sol.friction.shear).max() < gaps[-1]
+    assert gaps[0] < 3e-3 and gaps[1] < gaps[0] / 5.0
+
+
 def test_heated_block_cycled_with_the_undamped_update(monkeypatch: pytest.MonkeyPatch) -> None:
     """What the damped step is for: with every step taken in full the sets cycle."""
-    monkeypatch.setattr(friction_method, "damped_length", lambda *args, **kw: (1.0, False))
+    monkeypatch.setattr(friction_method, "damped_length", lambda *args, **kw: (1.0, 0.0, 0.0))
     with pytest.raises(ActiveSetError, match="cycles"):
         solve(frictional("heated_block"), "mortar")
 
