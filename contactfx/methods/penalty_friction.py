@@ -238,7 +238,7 @@ class PenaltyFrictionIteration:
             vt.array[:] = lam_t
             self.BtT.mult(vt, tmp)
             r.axpy(1.0, tmp)
-            return float(r.norm() ** 2)
+            return float(r.dot(r))
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The return map's set."""
