@@ -238,7 +238,7 @@ class PenaltyFrictionIteration:
             vt.array[:] = lam_t
             self.BtT.mult(vt, tmp)
             r.axpy(1.0, tmp)
-            return float(r.dot(r))
+            return comm.allreduce(float(np.sum(r.array_r**2)))
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The return map's set."""
