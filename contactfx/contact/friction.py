@@ -29,12 +29,19 @@ lambda_t: the frictionless rows.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import IntEnum
 
 import numpy as np
 
 from .sparse import CSR
+
+#: A contact row sticks where |tau| < (1 + STICK_MARGIN) r: a slip row whose slip increment is
+#: round-off (|tau| = r to round-off; a row at a symmetry line or the axis with the standard
+#: basis, whose neighbours stick) is a stick row, not a slip row with an arbitrary direction
+#: (docs/friction.md, "How it is solved").
+STICK_MARGIN = 1e-10
 
 #: Column order of the rows' derivatives: d/d(lambda_n, lambda_t, g_n, u_t).
 VARIABLES = ("lambda_n", "lambda_t", "g_n", "u_t")
@@ -109,10 +116,13 @@ def classify(
     c_n: float,
     c_t: float,
 ) -> np.ndarray:
-    """Each row's set: open where xi <= 0, else stick where |tau| < mu xi, else slip."""
+    """Each row's set: open where xi <= 0, else stick where |tau| < mu xi, else slip.
+
+    "<" up to round-off: STICK_MARGIN.
+    """
     xi, tau, r = _state(lam_n, lam_t, g_n, u_t, mu, c_n, c_t)
     status = np.full(xi.shape, Status.SLIP, dtype=np.int64)
-    status[np.abs(tau) < r] = Status.STICK
+    status[np.abs(tau) < (1.0 + STICK_MARGIN) * r] = Status.STICK
     status[xi <= 0.0] = Status.OPEN
     return status
 
@@ -181,3 +191,92 @@ def displacement_rows(rows: FrictionRows, normal: CSR, tangent: CSR) -> tuple[CS
         )
         out.append(CSR.from_coo(r, c, vals, normal.shape, drop_zeros=True))
     return out[0], out[1]
+
+
+@dataclass(frozen=True)
+class RowState:
+    """One iterate's row variables (lambda_n, lambda_t, g_n, u_t), each (m,)."""
+
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+    g_n: np.ndarray
+    u_t: np.ndarray
+
+    def toward(self, other: RowState, alpha: float) -> RowState:
+        """The state alpha of the way from this one to `other` (all four are linear in u)."""
+        return RowState(
+            *(a + alpha * (b - a) for a, b in zip(self.arrays(), other.arrays(), strict=True))
+        )
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The four arrays in VARIABLES order."""
+        return self.lam_n, self.lam_t, self.g_n, self.u_t
+
+
+def merit(state: RowState, mu: float | np.ndarray, c_n: float, c_t: float, w: np.ndarray) -> float:
+    """This rank's sum of w (C_n^2 + C_t^2): zero exactly where Coulomb's law holds."""
+    cn, ct = ncp(*state.arrays(), mu, c_n, c_t)
+    return float(np.sum(w * (cn**2 + ct**2)))
+
+
+def damped_length(
+    start: RowState,
+    target: RowState,
+    mu: float | np.ndarray,
+    c_n: float,
+    c_t: float,
+    w: np.ndarray,
+    total: Callable[[float], float] = float,
+    sigma: float = 1e-4,
+    shortest: float = 2.0**-10,
+) -> tuple[float, float, float]:
+    """The semismooth Newton step's length from `start` toward `target` (Armijo backtracking).
+
+    `target` is the solution on the set `start` classifies into (the full Newton step, as
+    C is piecewise linear); the step is halved until the merit w (C_n^2 + C_t^2), summed over
+    the ranks by `total`, falls by the fraction 2 sigma alpha (`armijo`: the length, the
+    merit at the start and at the step's end). Where no length down to `shortest` does (a
+    kink of C, where the set's derivative is not a descent direction), the full step.
+    """
+    return armijo(
+        lambda alpha: total(merit(start.toward(target, alpha), mu, c_n, c_t, w)), sigma, shortest
+    )
+
+
+def armijo(
+    theta: Callable[[float], float], sigma: float = 1e-4, shortest: float = 2.0**-10
+) -> tuple[float, float, float]:
+    """A step length by backtracking, with the merit before and after the step.
+
+    The longest of 1, 1/2, 1/4, ... down to `shortest` with theta(alpha) <= (1 - 2 sigma
+    alpha) theta(0); 1 where none is.
+    """
+    theta0 = theta(0.0)
+    alpha = 1.0
+    while alpha >= shortest:
+        value = theta(alpha)
+        if value <= (1.0 - 2.0 * sigma * alpha) * theta0:
+            return alpha, theta0, value
+        alpha /= 2.0
+    return 1.0, theta0, theta(1.0)
+
+
+class Epochs:
+    """The cycle key's epoch of a damped iteration: how many iterates set a record low.
+
+    A damped step lowers the merit, so its iterate is never met again and meeting its set
+    again is no cycle; a full step where no length lowers it (a kink) may raise it. Iterates
+    that come round again set no new record: their sets repeat within one epoch, which the
+    active-set loop reports as a cycle.
+    """
+
+    def __init__(self) -> None:
+        self.epoch = 0
+        self.best = np.inf
+
+    def update(self, before: float, after: float) -> None:
+        """A step from merit `before` to `after`."""
+        self.best = min(self.best, before)
+        if after < self.best:
+            self.best = after
+            self.epoch += 1

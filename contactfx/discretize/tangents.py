@@ -63,3 +63,29 @@ def tangent_rows(
             empty = np.zeros(0, dtype=np.int64)
             columns.append(CSR.from_coo(empty, empty, np.zeros(0), (n, 2)))
     return TangentRows(CSR.vstack(ops) if len(ops) > 1 else ops[0], motion, columns)
+
+
+# A tangential row whose own node moves along it by less than this fraction of the row's
+# own entries is held: a node on a symmetry line or the axis, whose row in the bisector
+# frame is tilted from the line by half a segment's angle (2 % on the shrink fit's 41-node
+# quarter), not by a real freedom (docs/friction.md, "How it is solved").
+HELD_FRACTION = 0.1
+
+
+def held_rows(B: CSR, node_dofs: np.ndarray, fixed: np.ndarray) -> np.ndarray:
+    """True on the rows of B_t (stacked order) whose own node is held along them.
+
+    `node_dofs` ((m, 2)): each row's own (active) node's dofs; `fixed`: a column mask of the
+    prescribed dofs. Such a row's stick multiplier duplicates the support's reaction (with
+    the standard basis the row still touches its neighbour's dof, and the multipliers came
+    out as an alternating shear of mu p decaying along the rows): it carries no shear.
+    """
+    r = B.entry_rows
+    own = np.zeros(B.shape[0])
+    free = np.zeros(B.shape[0])
+    for c in (0, 1):
+        at = B.indices == node_dofs[r, c]
+        np.maximum.at(own, r[at], np.abs(B.data[at]))
+        at &= ~fixed[B.indices]
+        np.maximum.at(free, r[at], np.abs(B.data[at]))
+    return (own > 0.0) & (free <= HELD_FRACTION * own)

@@ -38,39 +38,31 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from ..contact import ContactOperator
-from ..contact.friction import FrictionResult, Status, classify, ncp
-from ..contact.sparse import CSR
-from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
-from ..discretize.obstacles import node_free_rows
-from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
-from ..discretize.tangents import tangent_rows
+from ..contact.friction import (
+    Epochs,
+    FrictionResult,
+    RowState,
+    Status,
+    classify,
+    damped_length,
+    ncp,
+)
+from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import InputError, SolverError
 from ..linalg.blocks import diagonal_matrix
-from ..options import Basis, Discretization, Enforcement, SolverKind
+from ..options import Discretization, Enforcement, SolverKind
 from ..request import SolveRequest
 from ..scenes import Scene
 from ..scenes.steps import step_scenes
 from ..timers import Timers
 from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .friction_tangents import FRAME, tangent_constraint
 from .solution import Solution, finish
 
 log = logging.getLogger("contactfx")
 
 # The first set's band of normalized gaps, relative to the contact element size.
 START_BAND = 0.1
-
-# The rows' frame: the bisector of the two surfaces (contact/operator.bisector_normals). In
-# the passive surface's frame, mirrored cylinders pressed with friction locked in a shear that
-# their symmetry rules out, and the pushed stick zone sat off-centre (docs/friction.md).
-FRAME = "bisector"
-
-# A tangential row against an obstacle whose own node moves along it by less than this
-# fraction of the row's largest entry has no free tangential dof (its lambda_t is 0): a node
-# on a symmetry line (ux fixed) whose mortar row reaches the tangent's tilt (~h/R) across its
-# support. Kept, such a row outnumbered the free tangential motions: its multipliers went to
-# +-1e14 in a checkerboard and the stick/slip sets cycled (docs/friction.md, Spence).
-TANGENT_OWN_RTOL = 0.1
 
 SUPPORTED = (
     "nts or mortar (standard or dual) with multipliers and a direct solver (mumps), "
@@ -119,40 +111,6 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
         )
 
 
-def tangent_constraint(
-    scene: Scene, setup: ContactSetup, basis: Basis, kernel: object
-) -> tuple[PETSc.Mat, np.ndarray, CSR, np.ndarray, CSR | None]:
-    """This rank's rows of B_t and the weighted slip that prescribed displacements add.
-
-    B_t: the tangential rows of the same kernel, in the layout's order (owned rows); also
-    all of them as a CSR, and which owned rows have a free tangential dof (a node on a
-    symmetry line or the axis has none: it cannot slip, its row carries no shear). Against
-    an obstacle the rows follow its exact tangent, and its prescribed rigid motion (this
-    step's) enters the weighted slip: the body's motion relative to the obstacle; the last
-    item is the rows' obstacle-motion columns (all rows, layout order; None: no obstacle).
-    """
-    el = setup.elasticity
-    V = el.V
-    ndofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-    rows = setup.tangent or tangent_rows(setup.pairs, kernel, basis, FRAME, ndofs)
-    Bt, motion, columns = rows.B, rows.motion, rows.columns
-    op = ContactOperator(Bt, np.zeros(Bt.shape[0]), setup.operator.weights)
-    dofs = np.vstack(
-        [p.active.surface.dofs for p in setup.pairs]
-        + [p.passive.surface.dofs for p in setup.pairs if p.passive is not None]
-    )
-    shift = prescribed_gap_shift(scene, el, op, dofs) + np.concatenate(motion)
-    dirichlet = global_dirichlet_dofs(V, el.bc_dofs)
-    B = petsc_constraint(V, op, setup.order, setup.layout, dirichlet)
-    mine = setup.order[setup.layout.mine]
-    moving = CSR.vstack(columns).rows(setup.order) if scene.obstacles else None
-    own = np.vstack([p.active.surface.dofs for p in setup.pairs])
-    free = constrained_rows(op, dirichlet) & node_free_rows(
-        op, own, setup.pairs, dirichlet, TANGENT_OWN_RTOL
-    )
-    return B, shift[mine], Bt.rows(setup.order), free[mine], moving
-
-
 def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
     """A distributed vector holding this rank's `values`."""
     v = PETSc.Vec().createMPI((len(values), PETSc.DETERMINE), comm=comm)  # type: ignore[arg-type]
@@ -189,10 +147,15 @@ class FrictionIteration:
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
         self.offset = layout.offset
+        # The iterate the next Newton step starts from (None: the first solve of the step)
+        # and the cycle key's epoch.
+        self.state: RowState | None = None
+        self.epochs = Epochs()
 
     def key(self, active: np.ndarray) -> np.ndarray:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
-        return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+        rows = np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+        return rows + 4 * self.epochs.epoch
 
     def solve(self, active: np.ndarray, it: int) -> Step:
         """One LU solve of the frictional saddle point on `active` and the friction sets."""
@@ -247,16 +210,26 @@ class FrictionIteration:
         for obj in (ksp, A, nest, Bn_a, Bt_a, BnT, BtT, Cnn, Ctn, Ctt, b, x):
             obj.destroy()
         u, mu_n, mu_t = out
-        self.u.x.petsc_vec.array[:] = u
-        self.u.x.scatter_forward()
         lam_n, lam_t = np.where(active, -mu_n, 0.0), np.where(active, mu_t, 0.0)
-        gap = setup.normalized_gap(self.u)
-        y = self.Bt.createVecLeft()
-        self.Bt.mult(self.u.x.petsc_vec, y)
-        ut = y.array_r + self.shift_t
-        y.destroy()
         w = setup.w
-        inc = np.where(self.free_t, (ut - self.ut_prev) / w, 0.0)  # fixed rows: no slip
+        start = self.u.x.petsc_vec.array_r.copy()
+        target = self._rows(u, lam_n, lam_t)
+        alpha = 1.0
+        if self.state is not None:
+            # The solve is the full semismooth Newton step from the last iterate; shortened
+            # where it does not lower the complementarity residual (docs/friction.md, "How
+            # it is solved"); the key's epoch: contact/friction.py, Epochs.
+            alpha, before, after = damped_length(
+                self.state, target, self.mu, self.c, self.c, w, lambda x: comm.allreduce(x)
+            )
+            self.epochs.update(before, after)
+            if alpha < 1.0:
+                lam = self.state.toward(target, alpha)
+                target = self._rows(start + alpha * (u - start), lam.lam_n, lam.lam_t)
+        self.state = target
+        lam_n, lam_t, gap, inc = target.arrays()
+        # A row held along its tangent does not slip: its weighted slip is its neighbour's.
+        ut = np.where(self.free_t, self._slip(), self.ut_prev)
         status = classify(lam_n, lam_t, gap, inc, self.mu, self.c, self.c)
         tau = lam_t + self.c * inc
         new_active = status != Status.OPEN
@@ -277,9 +250,37 @@ class FrictionIteration:
         self.lam_t, self.slip, self.status = lam_t, ut / w, status
         n_stick = comm.allreduce(int(np.sum(status == Status.STICK)))
         n_slip = comm.allreduce(int(np.sum(status == Status.SLIP)))
-        record: dict[str, float] = {"stick": n_stick, "slip": n_slip, "friction_changed": n_changed}
-        text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, complementarity {resid:.2e}, "
-        return Step(lam_n, gap, new_active, float(resid), record, text, True, n_changed)
+        record: dict[str, float] = {
+            "stick": n_stick,
+            "slip": n_slip,
+            "friction_changed": n_changed,
+            "step_length": alpha,
+        }
+        damped = f", step {alpha:g}" if alpha < 1.0 else ""
+        text = (
+            f"{n_stick} stick, {n_slip} slip, {n_changed} changed{damped}, "
+            f"complementarity {resid:.2e}, "
+        )
+        return Step(
+            lam_n, gap, new_active, float(resid), record, text, True, n_changed + (alpha < 1.0)
+        )
+
+    def _rows(self, u: np.ndarray, lam_n: np.ndarray, lam_t: np.ndarray) -> RowState:
+        """The rows' state of a solution `u` with its multipliers."""
+        self.u.x.petsc_vec.array[:] = u
+        self.u.x.scatter_forward()
+        gap = self.setup.normalized_gap(self.u)
+        ut = self._slip()
+        inc = np.where(self.free_t, (ut - self.ut_prev) / self.setup.w, 0.0)  # fixed: no slip
+        return RowState(lam_n, lam_t, gap, inc)
+
+    def _slip(self) -> np.ndarray:
+        """The rows' weighted tangential displacement B_t u (+ prescribed) of the iterate."""
+        y = self.Bt.createVecLeft()
+        self.Bt.mult(self.u.x.petsc_vec, y)
+        ut = y.array_r + self.shift_t
+        y.destroy()
+        return ut
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The update's set (no probes on the frictional path)."""

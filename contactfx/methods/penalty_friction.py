@@ -34,7 +34,7 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from ..contact.friction import FrictionResult, Status
+from ..contact.friction import Epochs, FrictionResult, Status, armijo
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import SingularSystemError, SolverError
 from ..request import SolveRequest
@@ -102,6 +102,10 @@ class PenaltyFrictionIteration:
         self.lam_t = np.zeros(m)
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
+        # The iterate the next Newton step starts from (None: the step's first solve) and the
+        # cycle key's epoch (contact/friction.py, Epochs).
+        self.x: np.ndarray | None = None
+        self.epochs = Epochs()
 
     def destroy(self) -> None:
         """Free the transposes."""
@@ -110,7 +114,8 @@ class PenaltyFrictionIteration:
 
     def key(self, active: np.ndarray) -> np.ndarray:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
-        return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+        rows = np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
+        return rows + 4 * self.epochs.epoch
 
     def _system(self, active: np.ndarray) -> tuple[PETSc.Mat, PETSc.Vec, bool]:
         """The set's matrix and right-hand side (module docstring), and whether a row slips.
@@ -157,20 +162,17 @@ class PenaltyFrictionIteration:
         setup, comm = self.setup, self.setup.comm
         A, rhs, slips = self._system(active)
         x, info = factor_solve(A, rhs, self.lu if slips else self.options)
-        self.u.x.petsc_vec.array[:] = x
-        self.u.x.scatter_forward()
-        gap = setup.normalized_gap(self.u)
-        y = self.Bt.createVecLeft()
-        self.Bt.mult(self.u.x.petsc_vec, y)
-        ut = y.array_r + self.shift_t
-        y.destroy()
+        alpha = 1.0
+        if self.x is not None:
+            # The set's solution is the full Newton step on the piecewise linear residual:
+            # shortened where it does not lower it (methods/friction.py).
+            start, full = self.x, x
+            alpha, before, after = armijo(lambda a: self._residual(start + a * (full - start)))
+            self.epochs.update(before, after)
+            x = start + alpha * (full - start)
+        self.x = x
+        gap, ut, p, contact, stick, sign, lam_t = self._return_map(x)
         w = setup.w
-        p = -self.eps_n * gap
-        contact = gap < 0.0
-        trial = np.where(self.free_t, self.shear_prev + self.eps_t * (ut - self.ut_prev) / w, 0.0)
-        stick = np.abs(trial) < self.mu * p
-        sign = np.where(trial >= 0.0, 1.0, -1.0)
-        lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
         # A row solved as slipping whose trial turns against its direction sticks next: a
         # reversal passes through stick. Flipping it straight to the other direction made an
         # unloading step cycle (tests/methods/test_penalty_friction.py, the pull back).
@@ -193,8 +195,50 @@ class PenaltyFrictionIteration:
             "penalty": self.eps_n,
             **info,
         }
-        text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, max penetration {pen:.3e}, "
-        return Step(p, gap, contact, 0.0, record, text, True, n_changed)
+        record["step_length"] = alpha
+        damped = f", step {alpha:g}" if alpha < 1.0 else ""
+        text = (
+            f"{n_stick} stick, {n_slip} slip, {n_changed} changed{damped}, "
+            f"max penetration {pen:.3e}, "
+        )
+        return Step(p, gap, contact, 0.0, record, text, True, n_changed + (alpha < 1.0))
+
+    def _return_map(self, x: np.ndarray) -> tuple[np.ndarray, ...]:
+        """At displacement `x`: gap, weighted slip, p, contact, stick, sign, lambda_t."""
+        setup = self.setup
+        self.u.x.petsc_vec.array[:] = x
+        self.u.x.scatter_forward()
+        gap = setup.normalized_gap(self.u)
+        y = self.Bt.createVecLeft()
+        self.Bt.mult(self.u.x.petsc_vec, y)
+        # A row held along its tangent does not slip (methods/friction.py).
+        ut = np.where(self.free_t, y.array_r + self.shift_t, self.ut_prev)
+        y.destroy()
+        w = setup.w
+        p = -self.eps_n * gap
+        contact = gap < 0.0
+        trial = np.where(self.free_t, self.shear_prev + self.eps_t * (ut - self.ut_prev) / w, 0.0)
+        stick = np.abs(trial) < self.mu * p
+        sign = np.where(trial >= 0.0, 1.0, -1.0)
+        lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
+        return gap, ut, p, contact, stick, sign, lam_t
+
+    def _residual(self, x: np.ndarray) -> float:
+        """|K x - f - B_n^T p + B_t^T lambda_t|^2 at `x` (all ranks): zero at the answer."""
+        _, _, p, contact, _, _, lam_t = self._return_map(x)
+        el, comm = self.setup.elasticity, self.setup.comm
+        r, tmp = el.f.duplicate(), el.f.duplicate()
+        vn, vt = self.setup.B.createVecLeft(), self.Bt.createVecLeft()
+        with released(comm, r, tmp, vn, vt):
+            el.K.mult(self.u.x.petsc_vec, r)
+            r.axpy(-1.0, el.f)
+            vn.array[:] = -np.where(contact, p, 0.0)
+            self.BnT.mult(vn, tmp)
+            r.axpy(1.0, tmp)
+            vt.array[:] = lam_t
+            self.BtT.mult(vt, tmp)
+            r.axpy(1.0, tmp)
+            return comm.allreduce(float(np.sum(r.array_r**2)))
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The return map's set."""

@@ -45,8 +45,8 @@ METHODS = [("nts", "standard"), ("mortar", "standard"), ("mortar", "dual")]
 def test_spence_stick_ratio_at_every_step(method: str, basis: str) -> None:
     """c within 1.5 cells of Spence's (c/a) a from step 2 on, at a/h up to 23; step 1 (the
     whole contact at once) sticks far less than Spence's; every step converges (no cycle:
-    with the symmetry node's tangential row kept, methods/friction.py's TANGENT_OWN_RTOL at
-    round-off, dual mortar cycled here)."""
+    with the symmetry node's tangential row kept (discretize/tangents.held_rows off), dual
+    mortar cycled here)."""
     scene = replace(load_scene_file(SCENE, size_factor=2.0), steps=STEPS)
     _, run = run_scene(scene, SolveRequest.parse(method, basis=basis))
     checks = [s.spence[0] for s in run.steps]
