@@ -60,6 +60,26 @@ def lu_options(petsc: Mapping[str, object]) -> dict[str, object]:
     return {**petsc, "pc_type": "lu"} if petsc.get("pc_type") == "cholesky" else dict(petsc)
 
 
+ARMIJO = 1e-4
+"""Armijo's sufficient decrease of the residual norm per unit step length."""
+MAX_HALVINGS = 20
+"""Step halvings tried before the line search takes the whole Newton step."""
+
+
+@dataclass(frozen=True)
+class Point:
+    """An iterate (owned dofs) and the return map there (owned rows), with |R|."""
+
+    x: np.ndarray
+    gap: np.ndarray
+    ut: np.ndarray
+    contact: np.ndarray
+    stick: np.ndarray
+    sign: np.ndarray
+    lam_t: np.ndarray
+    norm: float
+
+
 @dataclass(frozen=True)
 class PenaltyState:
     """What a converged load step hands the next (owned rows)."""
@@ -102,6 +122,7 @@ class PenaltyFrictionIteration:
         self.lam_t = np.zeros(m)
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
+        self.point: Point | None = None  # the current iterate (None before the first solve)
 
     def destroy(self) -> None:
         """Free the transposes."""
@@ -152,35 +173,78 @@ class PenaltyFrictionIteration:
         A.axpy(1.0, el.K, structure=DIFFERENT)
         return A, rhs, slips
 
+    def _at(self, x: np.ndarray) -> Point:
+        """The return map at the displacement `x` (owned dofs) and the residual R(x)'s norm."""
+        setup, el, w = self.setup, self.setup.elasticity, self.setup.w
+        X = el.K.createVecRight()
+        X.array[:] = x
+        yn, yt = setup.B.createVecLeft(), self.Bt.createVecLeft()
+        r, tmp = el.K.createVecLeft(), el.K.createVecLeft()
+        with released(setup.comm, X, yn, yt, r, tmp):
+            setup.B.mult(X, yn)
+            self.Bt.mult(X, yt)
+            gap = (setup.g + yn.array_r) / w
+            ut = yt.array_r + self.shift_t
+            p = -self.eps_n * gap
+            contact = gap < 0.0
+            trial = np.where(
+                self.free_t, self.shear_prev + self.eps_t * (ut - self.ut_prev) / w, 0.0
+            )
+            stick = np.abs(trial) < self.mu * p
+            sign = np.where(trial >= 0.0, 1.0, -1.0)
+            lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
+            # R(x) = K x - f - B_n^T p + B_t^T lambda_t over the rows in contact: the set's
+            # A x - rhs where the set is x's own (the module's docstring).
+            el.K.mult(X, r)
+            r.axpy(-1.0, el.f)
+            yn.array[:] = np.where(contact, -p, 0.0)
+            self.BnT.mult(yn, tmp)
+            r.axpy(1.0, tmp)
+            yt.array[:] = np.where(self.mu > 0.0, lam_t, 0.0)
+            self.BtT.mult(yt, tmp)
+            r.axpy(1.0, tmp)
+            norm = float(r.norm())
+        return Point(x, gap, ut, contact, stick, sign, lam_t, norm)
+
+    def _search(self, x: np.ndarray) -> tuple[Point, float, bool]:
+        """The iterate along the Newton step to the set's solution `x`, its length, and
+        whether it passed the line search.
+
+        The first solve of a load step takes it whole (its set is a guess, not an iterate's);
+        then Armijo's rule on the residual: the first of t = 1, 1/2, ... 1/2^MAX_HALVINGS
+        with |R(u + t d)| <= (1 - 1e-4 t) |R(u)|, and the whole step where none is (then a
+        set met again is a cycle, as without the search).
+        """
+        full = self._at(x)
+        here = self.point
+        if here is None:
+            return full, 1.0, False
+        if full.norm <= (1.0 - ARMIJO) * here.norm:
+            return full, 1.0, True
+        d, t = x - here.x, 1.0
+        for _ in range(MAX_HALVINGS):
+            t *= 0.5
+            cut = self._at(here.x + t * d)
+            if cut.norm <= (1.0 - ARMIJO * t) * here.norm:
+                return cut, t, True
+        return full, 1.0, False
+
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One factorization on `active` and its friction sets; the next set by the return map."""
+        """One factorization on `active` and its friction sets, a line search along the
+        Newton step; the next set is the return map's at the iterate."""
         setup, comm = self.setup, self.setup.comm
         A, rhs, slips = self._system(active)
         x, info = factor_solve(A, rhs, self.lu if slips else self.options)
-        self.u.x.petsc_vec.array[:] = x
+        pt, t, searched = self._search(x)
+        self.point = pt
+        self.u.x.petsc_vec.array[:] = pt.x
         self.u.x.scatter_forward()
-        gap = setup.normalized_gap(self.u)
-        y = self.Bt.createVecLeft()
-        self.Bt.mult(self.u.x.petsc_vec, y)
-        ut = y.array_r + self.shift_t
-        y.destroy()
-        w = setup.w
-        p = -self.eps_n * gap
-        contact = gap < 0.0
-        trial = np.where(self.free_t, self.shear_prev + self.eps_t * (ut - self.ut_prev) / w, 0.0)
-        stick = np.abs(trial) < self.mu * p
-        sign = np.where(trial >= 0.0, 1.0, -1.0)
-        lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
-        # A row solved as slipping whose trial turns against its direction sticks next: a
-        # reversal passes through stick. Flipping it straight to the other direction made an
-        # unloading step cycle (tests/methods/test_penalty_friction.py, the pull back).
-        reversed_ = active & ~self.stick & ~stick & (sign != self.sign) & (self.mu > 0.0)
-        stick = stick | reversed_
+        gap, contact, stick, sign = pt.gap, pt.contact, pt.stick, pt.sign
         changed = contact & active & ((stick != self.stick) | (~stick & (sign != self.sign)))
         n_changed = comm.allreduce(int(changed.sum()))
         self.stick = np.where(contact, stick, self.stick)
         self.sign = np.where(contact & ~stick, sign, self.sign)
-        self.lam_t, self.slip = lam_t, ut / w
+        self.lam_t, self.slip = pt.lam_t, pt.ut / setup.w
         self.status = np.where(contact, np.where(stick, Status.STICK, Status.SLIP), Status.OPEN)
         pen = max(comm.allreduce(float(np.max(-gap, initial=0.0)), op=MPI.MAX), 0.0)
         n_stick = comm.allreduce(int(np.sum(self.status == Status.STICK)))
@@ -191,10 +255,15 @@ class PenaltyFrictionIteration:
             "friction_changed": n_changed,
             "penetration": pen,
             "penalty": self.eps_n,
+            "step_length": t,
             **info,
         }
         text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, max penetration {pen:.3e}, "
-        return Step(p, gap, contact, 0.0, record, text, True, n_changed)
+        text += "" if t == 1.0 else f"step {t:g}, "
+        p = -self.eps_n * gap
+        return Step(
+            p, gap, contact, 0.0, record, text, True, n_changed, searched, damped=t < 1.0
+        )
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The return map's set."""
