@@ -27,7 +27,7 @@ shear / eps_t is then of the penetration's size (docs/friction.md, "The penalty 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from dolfinx import fem
@@ -62,8 +62,10 @@ def lu_options(petsc: Mapping[str, object]) -> dict[str, object]:
 
 ARMIJO = 1e-4
 """Armijo's sufficient decrease of the residual norm per unit step length."""
-MAX_HALVINGS = 20
-"""Step halvings tried before the line search takes the whole Newton step."""
+MAX_HALVINGS = 4
+"""Step halvings of the Coulomb step before the Tresca-Coulomb fixed point takes over."""
+MAX_HALVINGS_TRESCA = 30
+"""Step halvings of a Tresca step (its energy falls along it: round-off stops it)."""
 
 
 @dataclass(frozen=True)
@@ -78,6 +80,7 @@ class Point:
     sign: np.ndarray
     lam_t: np.ndarray
     norm: float
+    trial: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -123,6 +126,8 @@ class PenaltyFrictionIteration:
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
         self.point: Point | None = None  # the current iterate (None before the first solve)
+        self.bound: np.ndarray | None = None  # Tresca's fixed mu p (None: Newton on Coulomb)
+        self.probe = False  # Tresca's problem is solved: try the Coulomb set's solution
 
     def destroy(self) -> None:
         """Free the transposes."""
@@ -133,8 +138,12 @@ class PenaltyFrictionIteration:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
         return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
 
-    def _system(self, active: np.ndarray) -> tuple[PETSc.Mat, PETSc.Vec, bool]:
-        """The set's matrix and right-hand side (module docstring), and whether a row slips.
+    def _system(
+        self, active: np.ndarray, bound: np.ndarray | None = None
+    ) -> tuple[PETSc.Mat, PETSc.Vec, bool]:
+        """The set's matrix and right-hand side (module docstring), and whether a row slips
+        (an unsymmetric matrix). `bound`: Tresca's, the slip rows carry bound * sign, fixed
+        (the matrix is symmetric), and the stick rows are the rows with a bound.
 
         Without a stick or slip row carrying a shear (mu = 0, or every row open) the system
         is the frictionless penalty's, assembled as it is.
@@ -142,14 +151,20 @@ class PenaltyFrictionIteration:
         setup, el = self.setup, self.setup.elasticity
         w, g0 = setup.w, setup.g
         rubs = self.free_t & (self.mu > 0.0)  # a row that can carry a shear
-        stick = active & self.stick & rubs
-        slip = active & ~self.stick & rubs
+        if bound is None:
+            stick = active & self.stick & rubs
+            slip = active & ~self.stick & rubs
+            fixed = np.zeros_like(w)
+        else:
+            stick = self.stick & rubs & (bound > 0.0)
+            slip = np.zeros_like(stick)
+            fixed = np.where(rubs & ~stick, bound * self.sign, 0.0)
         cn = np.where(active, self.eps_n / w, 0.0)
         ctt = np.where(stick, self.eps_t / w, 0.0)
         ctn = np.where(slip, -self.mu * self.sign * self.eps_n / w, 0.0)
         comm = setup.comm
         slips = comm.allreduce(bool(slip.any()), op=MPI.LOR)
-        sheared = slips or comm.allreduce(bool(stick.any()), op=MPI.LOR)
+        sheared = slips or comm.allreduce(bool(stick.any() or fixed.any()), op=MPI.LOR)
         Bn, Bt = setup.B, self.Bt
         BnT, BtT, An = self.BnT, self.BtT, scaled_rows(Bn, cn)
         A = add_product(None, BnT, An)
@@ -164,7 +179,7 @@ class PenaltyFrictionIteration:
                 a = self.shear_prev + self.eps_t * (self.shift_t - self.ut_prev) / w
                 M, Mn = scaled_rows(Bt, ctt), scaled_rows(Bn, ctn)
                 dt = Bt.createVecLeft()
-                dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0
+                dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0 - fixed
                 with released(comm, M, Mn, dt):
                     M.axpy(1.0, Mn, structure=DIFFERENT)
                     A = add_product(A, BtT, M)
@@ -173,14 +188,31 @@ class PenaltyFrictionIteration:
         A.axpy(1.0, el.K, structure=DIFFERENT)
         return A, rhs, slips
 
+    def _residual(self, X: PETSc.Vec, contact: np.ndarray, lam_t: np.ndarray) -> PETSc.Vec:
+        """R = K x - f + B_n^T (eps_n g over the rows in contact) + B_t^T lam_t: the set's
+        A x - rhs where the set is x's own (the module's docstring)."""
+        setup, el = self.setup, self.setup.elasticity
+        r, tmp = el.K.createVecLeft(), el.K.createVecLeft()
+        yn, yt = setup.B.createVecLeft(), self.Bt.createVecLeft()
+        with released(setup.comm, tmp, yn, yt):
+            el.K.mult(X, r)
+            r.axpy(-1.0, el.f)
+            setup.B.mult(X, yn)
+            yn.array[:] = np.where(contact, self.eps_n * (setup.g + yn.array_r) / setup.w, 0.0)
+            self.BnT.mult(yn, tmp)
+            r.axpy(1.0, tmp)
+            yt.array[:] = np.where(self.mu > 0.0, lam_t, 0.0)
+            self.BtT.mult(yt, tmp)
+            r.axpy(1.0, tmp)
+        return r
+
     def _at(self, x: np.ndarray) -> Point:
         """The return map at the displacement `x` (owned dofs) and the residual R(x)'s norm."""
-        setup, el, w = self.setup, self.setup.elasticity, self.setup.w
-        X = el.K.createVecRight()
+        setup, w = self.setup, self.setup.w
+        X = setup.elasticity.K.createVecRight()
         X.array[:] = x
         yn, yt = setup.B.createVecLeft(), self.Bt.createVecLeft()
-        r, tmp = el.K.createVecLeft(), el.K.createVecLeft()
-        with released(setup.comm, X, yn, yt, r, tmp):
+        with released(setup.comm, X, yn, yt):
             setup.B.mult(X, yn)
             self.Bt.mult(X, yt)
             gap = (setup.g + yn.array_r) / w
@@ -193,27 +225,18 @@ class PenaltyFrictionIteration:
             stick = np.abs(trial) < self.mu * p
             sign = np.where(trial >= 0.0, 1.0, -1.0)
             lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
-            # R(x) = K x - f - B_n^T p + B_t^T lambda_t over the rows in contact: the set's
-            # A x - rhs where the set is x's own (the module's docstring).
-            el.K.mult(X, r)
-            r.axpy(-1.0, el.f)
-            yn.array[:] = np.where(contact, -p, 0.0)
-            self.BnT.mult(yn, tmp)
-            r.axpy(1.0, tmp)
-            yt.array[:] = np.where(self.mu > 0.0, lam_t, 0.0)
-            self.BtT.mult(yt, tmp)
-            r.axpy(1.0, tmp)
+            r = self._residual(X, contact, lam_t)
             norm = float(r.norm())
-        return Point(x, gap, ut, contact, stick, sign, lam_t, norm)
+            r.destroy()
+        return Point(x, gap, ut, contact, stick, sign, lam_t, norm, trial)
 
     def _search(self, x: np.ndarray) -> tuple[Point, float, bool]:
         """The iterate along the Newton step to the set's solution `x`, its length, and
-        whether it passed the line search.
+        whether it passed the line search (None: no step lowers |R|).
 
         The first solve of a load step takes it whole (its set is a guess, not an iterate's);
         then Armijo's rule on the residual: the first of t = 1, 1/2, ... 1/2^MAX_HALVINGS
-        with |R(u + t d)| <= (1 - 1e-4 t) |R(u)|, and the whole step where none is (then a
-        set met again is a cycle, as without the search).
+        with |R(u + t d)| <= (1 - 1e-4 t) |R(u)|.
         """
         full = self._at(x)
         here = self.point
@@ -227,21 +250,135 @@ class PenaltyFrictionIteration:
             cut = self._at(here.x + t * d)
             if cut.norm <= (1.0 - ARMIJO * t) * here.norm:
                 return cut, t, True
-        return full, 1.0, False
+        return here, 0.0, True
+
+    def _energy(self, x: np.ndarray, bound: np.ndarray) -> tuple[float, PETSc.Vec, Point]:
+        """Tresca's energy at `x` with the fixed bound, its gradient R_T, and the point
+        (its stick and sign by the bound: Tresca's set)."""
+        setup, el, w = self.setup, self.setup.elasticity, self.setup.w
+        pt = self._at(x)
+        z = pt.trial
+        stick = np.abs(z) < bound
+        sign = np.where(z >= 0.0, 1.0, -1.0)
+        lam = np.where(stick, z, bound * sign)
+        huber = np.where(stick, 0.5 * z * z, bound * np.abs(z) - 0.5 * bound * bound)
+        X, Kx = el.K.createVecRight(), el.K.createVecLeft()
+        X.array[:] = x
+        with released(setup.comm, X, Kx):
+            el.K.mult(X, Kx)
+            r = self._residual(X, pt.contact, lam)
+            local = 0.5 * float(Kx.array_r @ x) - float(el.f.array_r @ x)
+        gn = np.minimum(pt.gap, 0.0)
+        local += float(np.sum(0.5 * self.eps_n * w * gn * gn + (w / self.eps_t) * huber))
+        energy = setup.comm.allreduce(local)
+        tset = replace(pt, stick=stick, sign=sign)
+        return energy, r, tset
+
+    def _tresca(self, active: np.ndarray) -> tuple[Point, float, dict[str, float], bool]:
+        """One Newton step on Tresca's problem (the bound mu p fixed): Armijo on its energy.
+
+        Returns the iterate, the step length, the solve's info and whether Tresca's set
+        (contact, stick, direction) stayed: the inner problem is solved.
+        """
+        here, bound = self.point, self.bound
+        assert here is not None and bound is not None
+        e0, r0, t0 = self._energy(here.x, bound)
+        self.stick, self.sign = t0.stick, t0.sign
+        A, rhs, _ = self._system(active, bound)
+        x, info = factor_solve(A, rhs, self.options)
+        d = x - here.x
+        D = r0.duplicate()
+        D.array[:] = d
+        slope = float(r0.dot(D))
+        with released(self.setup.comm, r0, D):
+            t = 1.0
+            for _ in range(MAX_HALVINGS_TRESCA):
+                e, r, pt = self._energy(here.x + t * d, bound)
+                r.destroy()
+                same = bool(
+                    self.setup.comm.allreduce(
+                        bool(
+                            np.array_equal(pt.contact, t0.contact)
+                            and np.array_equal(pt.stick, t0.stick)
+                            and np.array_equal(pt.sign[~pt.stick], t0.sign[~t0.stick])
+                        ),
+                        op=MPI.LAND,
+                    )
+                )
+                if (t == 1.0 and same) or e <= e0 + ARMIJO * t * slope:
+                    break
+                t *= 0.5
+        return self._at(here.x + t * d), t, info, t == 1.0 and same
 
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One factorization on `active` and its friction sets, a line search along the
-        Newton step; the next set is the return map's at the iterate."""
+        """One factorization: a Newton step on the Coulomb set with a line search on |R|;
+        where none lowers |R|, the Tresca-Coulomb fixed point (module docstring)."""
         setup, comm = self.setup, self.setup.comm
-        A, rhs, slips = self._system(active)
-        x, info = factor_solve(A, rhs, self.lu if slips else self.options)
-        pt, t, searched = self._search(x)
+        searched, done, t, stay = True, False, 1.0, False
+        if self.bound is not None and not self.probe:
+            pt, t, info, inner = self._tresca(active)
+            self.probe = inner
+            stay = True
+        else:
+            A, rhs, slips = self._system(active)
+            x, info = factor_solve(A, rhs, self.lu if slips else self.options)
+            if self.probe:
+                # The Tresca problem is solved: the Coulomb set's solution ends the step if
+                # its set is its own; else the bound takes the iterate's mu p.
+                assert self.point is not None
+                full = self._at(x)
+                if self._keeps(full, active):
+                    pt, done = full, True
+                else:
+                    pt, stay = self.point, True
+                    done = self._fixed(pt)
+                    self.bound = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
+                    self.probe = False
+            else:
+                pt, t, searched = self._search(x)
+                if t == 0.0:
+                    # No step lowers |R| (an iterate at a kink of |R|, a row at the cone's
+                    # edge): the Tresca-Coulomb fixed point from this iterate.
+                    self.bound = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
+                    stay = True
+        return self._step(active, pt, t, info, searched, done, stay)
+
+    def _keeps(self, pt: Point, active: np.ndarray) -> bool:
+        """Whether `pt`'s Coulomb set is the one solved (contact, stick, direction)."""
+        same = (
+            np.array_equal(pt.contact, active)
+            and np.array_equal(pt.stick[active], self.stick[active])
+            and np.array_equal((pt.sign * ~pt.stick)[active], (self.sign * ~self.stick)[active])
+        )
+        return bool(self.setup.comm.allreduce(bool(same), op=MPI.LAND))
+
+    def _fixed(self, pt: Point) -> bool:
+        """Whether the bound is the iterate's mu p to round-off: the fixed point."""
+        assert self.bound is not None
+        mup = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
+        comm = self.setup.comm
+        diff = comm.allreduce(float(np.max(np.abs(mup - self.bound), initial=0.0)), op=MPI.MAX)
+        scale = comm.allreduce(float(np.max(mup, initial=0.0)), op=MPI.MAX)
+        return diff <= 1e-12 * scale
+
+    def _step(
+        self,
+        active: np.ndarray,
+        pt: Point,
+        t: float,
+        info: dict[str, float],
+        searched: bool,
+        done: bool,
+        stay: bool,
+    ) -> Step:
+        """Take the iterate `pt`: its Coulomb set is the next; the loop's Step."""
+        setup, comm = self.setup, self.setup.comm
         self.point = pt
         self.u.x.petsc_vec.array[:] = pt.x
         self.u.x.scatter_forward()
         gap, contact, stick, sign = pt.gap, pt.contact, pt.stick, pt.sign
         changed = contact & active & ((stick != self.stick) | (~stick & (sign != self.sign)))
-        n_changed = comm.allreduce(int(changed.sum()))
+        n_changed = 0 if done else comm.allreduce(int(changed.sum()))
         self.stick = np.where(contact, stick, self.stick)
         self.sign = np.where(contact & ~stick, sign, self.sign)
         self.lam_t, self.slip = pt.lam_t, pt.ut / setup.w
@@ -256,13 +393,15 @@ class PenaltyFrictionIteration:
             "penetration": pen,
             "penalty": self.eps_n,
             "step_length": t,
+            "tresca": float(self.bound is not None),
             **info,
         }
         text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, max penetration {pen:.3e}, "
         text += "" if t == 1.0 else f"step {t:g}, "
-        p = -self.eps_n * gap
+        text += "tresca, " if self.bound is not None and not done else ""
+        damped = (t < 1.0 or stay) and not done
         return Step(
-            p, gap, contact, 0.0, record, text, True, n_changed, searched, damped=t < 1.0
+            -self.eps_n * gap, gap, contact, 0.0, record, text, True, n_changed, searched, damped
         )
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
