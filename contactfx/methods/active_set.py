@@ -186,11 +186,11 @@ class Step:
     text: str = ""  # extra words for the log line
     final: bool = True  # the solve reached the final tolerance (not a loop's loose answer)
     changed: int = 0  # rows (all ranks) whose other set changed: friction's stick/slip
-    # Penalty friction's line search on its residual R(u): an iterate that passed its test
-    # (`searched`) lowered |R|, so no set can lead back to an earlier iterate: a set met again
-    # is met from another iterate, not a cycle (it does not settle); a damped one (a part of
-    # the Newton step) is not the solved set's solution and does not end the loop.
-    searched: bool = False
+    # The iteration guards against cycles itself (penalty friction: a set met again turns it
+    # to steps searched along the Newton step, which come back to sets from other iterates):
+    # the loop does not settle its sets. A damped step (a part of the Newton step, or the
+    # iterate kept) is not the solved set's solution and does not end the loop.
+    guarded: bool = False
     damped: bool = False
 
 
@@ -268,7 +268,7 @@ def run_active_set(
         t0 = time.perf_counter()
         with timers("solve"):
             step = iteration.solve(active, it)
-        if step.final and not step.searched:
+        if step.final and not step.guarded:
             state.settle()
         t_solve = time.perf_counter() - t0
         resid = step.residual

@@ -62,7 +62,7 @@ def lu_options(petsc: Mapping[str, object]) -> dict[str, object]:
 
 ARMIJO = 1e-4
 """Armijo's sufficient decrease of the residual norm per unit step length."""
-MAX_HALVINGS = 4
+MAX_HALVINGS = 12
 """Step halvings of the Coulomb step before the Tresca-Coulomb fixed point takes over."""
 MAX_HALVINGS_TRESCA = 30
 """Step halvings of a Tresca step (its energy falls along it: round-off stops it)."""
@@ -128,6 +128,8 @@ class PenaltyFrictionIteration:
         self.point: Point | None = None  # the current iterate (None before the first solve)
         self.bound: np.ndarray | None = None  # Tresca's fixed mu p (None: Newton on Coulomb)
         self.probe = False  # Tresca's problem is solved: try the Coulomb set's solution
+        self.plain = True  # full steps to each set's solution until a set comes back
+        self.seen: set[bytes] = set()  # the sets the plain iteration solved
 
     def destroy(self) -> None:
         """Free the transposes."""
@@ -230,27 +232,22 @@ class PenaltyFrictionIteration:
             r.destroy()
         return Point(x, gap, ut, contact, stick, sign, lam_t, norm, trial)
 
-    def _search(self, x: np.ndarray) -> tuple[Point, float, bool]:
-        """The iterate along the Newton step to the set's solution `x`, its length, and
-        whether it passed the line search (None: no step lowers |R|).
-
-        The first solve of a load step takes it whole (its set is a guess, not an iterate's);
-        then Armijo's rule on the residual: the first of t = 1, 1/2, ... 1/2^MAX_HALVINGS
-        with |R(u + t d)| <= (1 - 1e-4 t) |R(u)|.
-        """
+    def _search(self, x: np.ndarray) -> tuple[Point, float]:
+        """The iterate along the Newton step to the set's solution `x` and its length: by
+        Armijo's rule on the residual, the first of t = 1, 1/2, ... 1/2^MAX_HALVINGS with
+        |R(u + t d)| <= (1 - 1e-4 t) |R(u)|; 0 (the iterate stays) where none is."""
         full = self._at(x)
         here = self.point
-        if here is None:
-            return full, 1.0, False
+        assert here is not None
         if full.norm <= (1.0 - ARMIJO) * here.norm:
-            return full, 1.0, True
+            return full, 1.0
         d, t = x - here.x, 1.0
         for _ in range(MAX_HALVINGS):
             t *= 0.5
             cut = self._at(here.x + t * d)
             if cut.norm <= (1.0 - ARMIJO * t) * here.norm:
-                return cut, t, True
-        return here, 0.0, True
+                return cut, t
+        return here, 0.0
 
     def _energy(self, x: np.ndarray, bound: np.ndarray) -> tuple[float, PETSc.Vec, Point]:
         """Tresca's energy at `x` with the fixed bound, its gradient R_T, and the point
@@ -311,10 +308,10 @@ class PenaltyFrictionIteration:
         return self._at(here.x + t * d), t, info, t == 1.0 and same
 
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One factorization: a Newton step on the Coulomb set with a line search on |R|;
-        where none lowers |R|, the Tresca-Coulomb fixed point (module docstring)."""
-        setup, comm = self.setup, self.setup.comm
-        searched, done, t, stay = True, False, 1.0, False
+        """One factorization: the set's solution while no set comes back; then a Newton step
+        on the Coulomb set with a line search on |R|; where none lowers |R|, the
+        Tresca-Coulomb fixed point (module docstring)."""
+        done, t, stay, solved = False, 1.0, False, b""
         if self.bound is not None and not self.probe:
             pt, t, info, inner = self._tresca(active)
             self.probe = inner
@@ -322,7 +319,11 @@ class PenaltyFrictionIteration:
         else:
             A, rhs, slips = self._system(active)
             x, info = factor_solve(A, rhs, self.lu if slips else self.options)
-            if self.probe:
+            if self.plain:
+                solved = self._global_key(active)
+                self.seen.add(solved)
+                pt = self._at(x)
+            elif self.probe:
                 # The Tresca problem is solved: the Coulomb set's solution ends the step if
                 # its set is its own; else the bound takes the iterate's mu p.
                 assert self.point is not None
@@ -335,13 +336,30 @@ class PenaltyFrictionIteration:
                     self.bound = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
                     self.probe = False
             else:
-                pt, t, searched = self._search(x)
+                pt, t = self._search(x)
                 if t == 0.0:
                     # No step lowers |R| (an iterate at a kink of |R|, a row at the cone's
                     # edge): the Tresca-Coulomb fixed point from this iterate.
                     self.bound = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
                     stay = True
-        return self._step(active, pt, t, info, searched, done, stay)
+        step = self._step(active, pt, t, info, done, stay)
+        after = self._global_key(step.new_active) if self.plain else b""
+        if self.plain and after != solved and after in self.seen:
+            # The next set was solved before: a cycle of full steps. From this iterate on,
+            # the next set is its own (no reversal through stick) and steps are searched.
+            self.plain = False
+            self.stick = np.where(pt.contact, pt.stick, self.stick)
+            self.sign = np.where(pt.contact & ~pt.stick, pt.sign, self.sign)
+            step.changed = max(step.changed, 1)
+        return step
+
+    def _global_key(self, active: np.ndarray) -> bytes:
+        """The whole set on every rank (cycle detection of the plain iteration)."""
+        keys = self.setup.comm.allgather((self.setup.layout.mine, self.key(active)))
+        out = np.zeros(self.setup.layout.size, dtype=np.int64)
+        for idx, vals in keys:
+            out[idx] = vals
+        return out.tobytes()
 
     def _keeps(self, pt: Point, active: np.ndarray) -> bool:
         """Whether `pt`'s Coulomb set is the one solved (contact, stick, direction)."""
@@ -367,7 +385,6 @@ class PenaltyFrictionIteration:
         pt: Point,
         t: float,
         info: dict[str, float],
-        searched: bool,
         done: bool,
         stay: bool,
     ) -> Step:
@@ -377,6 +394,11 @@ class PenaltyFrictionIteration:
         self.u.x.petsc_vec.array[:] = pt.x
         self.u.x.scatter_forward()
         gap, contact, stick, sign = pt.gap, pt.contact, pt.stick, pt.sign
+        if self.plain:
+            # A row solved as slipping whose trial turns against its direction sticks next:
+            # a reversal passes through stick (without it, the pull back of
+            # tests/methods/test_penalty_friction.py's steps cycled).
+            stick = stick | (active & ~self.stick & ~stick & (sign != self.sign) & (self.mu > 0))
         changed = contact & active & ((stick != self.stick) | (~stick & (sign != self.sign)))
         n_changed = 0 if done else comm.allreduce(int(changed.sum()))
         self.stick = np.where(contact, stick, self.stick)
@@ -401,7 +423,7 @@ class PenaltyFrictionIteration:
         text += "tresca, " if self.bound is not None and not done else ""
         damped = (t < 1.0 or stay) and not done
         return Step(
-            -self.eps_n * gap, gap, contact, 0.0, record, text, True, n_changed, searched, damped
+            -self.eps_n * gap, gap, contact, 0.0, record, text, True, n_changed, True, damped
         )
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
