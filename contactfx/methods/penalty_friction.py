@@ -27,7 +27,7 @@ shear / eps_t is then of the penetration's size (docs/friction.md, "The penalty 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import fem
@@ -50,37 +50,14 @@ from .penalty import (
     factor_solve,
     penetration,
     scaled_rows,
-    transposed,
 )
+from .penalty_return import ARMIJO, MAX_HALVINGS_TRESCA, Point, ReturnMap
 from .solution import PenaltyResult, Solution, finish
 
 
 def lu_options(petsc: Mapping[str, object]) -> dict[str, object]:
     """The request's factorization as LU: the frictional system is unsymmetric where a row slips."""
     return {**petsc, "pc_type": "lu"} if petsc.get("pc_type") == "cholesky" else dict(petsc)
-
-
-ARMIJO = 1e-4
-"""Armijo's sufficient decrease of the residual norm per unit step length."""
-MAX_HALVINGS = 12
-"""Step halvings of the Coulomb step before the Tresca-Coulomb fixed point takes over."""
-MAX_HALVINGS_TRESCA = 30
-"""Step halvings of a Tresca step (its energy falls along it: round-off stops it)."""
-
-
-@dataclass(frozen=True)
-class Point:
-    """An iterate (owned dofs) and the return map there (owned rows), with |R|."""
-
-    x: np.ndarray
-    gap: np.ndarray
-    ut: np.ndarray
-    contact: np.ndarray
-    stick: np.ndarray
-    sign: np.ndarray
-    lam_t: np.ndarray
-    norm: float
-    trial: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -93,7 +70,7 @@ class PenaltyState:
     shear: np.ndarray  # lambda_t at its end (0 where open)
 
 
-class PenaltyFrictionIteration:
+class PenaltyFrictionIteration(ReturnMap):
     """Penalty solves on a set (open, stick, slip and direction) and the return map's update."""
 
     label = "penalty friction"
@@ -107,34 +84,23 @@ class PenaltyFrictionIteration:
         eps: float,
         options: Mapping[str, object],
     ) -> None:
-        self.setup, self.eps_n, self.eps_t = setup, eps, eps
-        self.Bt, self.shift_t, self.free_t = tangential
-        # B_n^T and B_t^T: the same in every solve of the step (freed by `destroy`).
-        self.BnT, self.BtT = transposed(setup.B), transposed(self.Bt)
-        self.options, self.lu = options, lu_options(options)
-        layout = setup.layout
         mus = pair_mu(scene)
-        self.mu = np.array([mus[int(k)] for k in layout.pair[layout.mine]])
+        layout = setup.layout
+        super().__init__(
+            setup, tangential, eps, np.array([mus[int(k)] for k in layout.pair[layout.mine]])
+        )
+        self.options, self.lu = options, lu_options(options)
         m = len(layout.mine)
         # The first set sticks wherever friction acts (as the multipliers' does).
         self.stick = self.mu > 0.0
         self.sign = np.ones(m)
-        self.ut_prev = np.zeros(m)
-        self.shear_prev = np.zeros(m)
         self.u = fem.Function(setup.elasticity.V, name="u")
         self.lam_t = np.zeros(m)
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
-        self.point: Point | None = None  # the current iterate (None before the first solve)
-        self.bound: np.ndarray | None = None  # Tresca's fixed mu p (None: Newton on Coulomb)
         self.probe = False  # Tresca's problem is solved: try the Coulomb set's solution
         self.plain = True  # full steps to each set's solution until a set comes back
         self.seen: set[bytes] = set()  # the sets the plain iteration solved
-
-    def destroy(self) -> None:
-        """Free the transposes."""
-        self.BnT.destroy()
-        self.BtT.destroy()
 
     def key(self, active: np.ndarray) -> np.ndarray:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
@@ -143,9 +109,10 @@ class PenaltyFrictionIteration:
     def _system(
         self, active: np.ndarray, bound: np.ndarray | None = None
     ) -> tuple[PETSc.Mat, PETSc.Vec, bool]:
-        """The set's matrix and right-hand side (module docstring), and whether a row slips
-        (an unsymmetric matrix). `bound`: Tresca's, the slip rows carry bound * sign, fixed
-        (the matrix is symmetric), and the stick rows are the rows with a bound.
+        """The set's matrix and right-hand side (module docstring), whether a row slips.
+
+        A slipping row makes the matrix unsymmetric. `bound`: Tresca's problem, the slip
+        rows carry bound * sign, fixed (the matrix is symmetric); only rows with a bound stick.
 
         Without a stick or slip row carrying a shear (mu = 0, or every row open) the system
         is the frictionless penalty's, assembled as it is.
@@ -190,87 +157,6 @@ class PenaltyFrictionIteration:
         A.axpy(1.0, el.K, structure=DIFFERENT)
         return A, rhs, slips
 
-    def _residual(self, X: PETSc.Vec, contact: np.ndarray, lam_t: np.ndarray) -> PETSc.Vec:
-        """R = K x - f + B_n^T (eps_n g over the rows in contact) + B_t^T lam_t: the set's
-        A x - rhs where the set is x's own (the module's docstring)."""
-        setup, el = self.setup, self.setup.elasticity
-        r, tmp = el.K.createVecLeft(), el.K.createVecLeft()
-        yn, yt = setup.B.createVecLeft(), self.Bt.createVecLeft()
-        with released(setup.comm, tmp, yn, yt):
-            el.K.mult(X, r)
-            r.axpy(-1.0, el.f)
-            setup.B.mult(X, yn)
-            yn.array[:] = np.where(contact, self.eps_n * (setup.g + yn.array_r) / setup.w, 0.0)
-            self.BnT.mult(yn, tmp)
-            r.axpy(1.0, tmp)
-            yt.array[:] = np.where(self.mu > 0.0, lam_t, 0.0)
-            self.BtT.mult(yt, tmp)
-            r.axpy(1.0, tmp)
-        return r
-
-    def _at(self, x: np.ndarray) -> Point:
-        """The return map at the displacement `x` (owned dofs) and the residual R(x)'s norm."""
-        setup, w = self.setup, self.setup.w
-        X = setup.elasticity.K.createVecRight()
-        X.array[:] = x
-        yn, yt = setup.B.createVecLeft(), self.Bt.createVecLeft()
-        with released(setup.comm, X, yn, yt):
-            setup.B.mult(X, yn)
-            self.Bt.mult(X, yt)
-            gap = (setup.g + yn.array_r) / w
-            ut = yt.array_r + self.shift_t
-            p = -self.eps_n * gap
-            contact = gap < 0.0
-            trial = np.where(
-                self.free_t, self.shear_prev + self.eps_t * (ut - self.ut_prev) / w, 0.0
-            )
-            stick = np.abs(trial) < self.mu * p
-            sign = np.where(trial >= 0.0, 1.0, -1.0)
-            lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
-            r = self._residual(X, contact, lam_t)
-            norm = float(r.norm())
-            r.destroy()
-        return Point(x, gap, ut, contact, stick, sign, lam_t, norm, trial)
-
-    def _search(self, x: np.ndarray) -> tuple[Point, float]:
-        """The iterate along the Newton step to the set's solution `x` and its length: by
-        Armijo's rule on the residual, the first of t = 1, 1/2, ... 1/2^MAX_HALVINGS with
-        |R(u + t d)| <= (1 - 1e-4 t) |R(u)|; 0 (the iterate stays) where none is."""
-        full = self._at(x)
-        here = self.point
-        assert here is not None
-        if full.norm <= (1.0 - ARMIJO) * here.norm:
-            return full, 1.0
-        d, t = x - here.x, 1.0
-        for _ in range(MAX_HALVINGS):
-            t *= 0.5
-            cut = self._at(here.x + t * d)
-            if cut.norm <= (1.0 - ARMIJO * t) * here.norm:
-                return cut, t
-        return here, 0.0
-
-    def _energy(self, x: np.ndarray, bound: np.ndarray) -> tuple[float, PETSc.Vec, Point]:
-        """Tresca's energy at `x` with the fixed bound, its gradient R_T, and the point
-        (its stick and sign by the bound: Tresca's set)."""
-        setup, el, w = self.setup, self.setup.elasticity, self.setup.w
-        pt = self._at(x)
-        z = pt.trial
-        stick = np.abs(z) < bound
-        sign = np.where(z >= 0.0, 1.0, -1.0)
-        lam = np.where(stick, z, bound * sign)
-        huber = np.where(stick, 0.5 * z * z, bound * np.abs(z) - 0.5 * bound * bound)
-        X, Kx = el.K.createVecRight(), el.K.createVecLeft()
-        X.array[:] = x
-        with released(setup.comm, X, Kx):
-            el.K.mult(X, Kx)
-            r = self._residual(X, pt.contact, lam)
-            local = 0.5 * float(Kx.array_r @ x) - float(el.f.array_r @ x)
-        gn = np.minimum(pt.gap, 0.0)
-        local += float(np.sum(0.5 * self.eps_n * w * gn * gn + (w / self.eps_t) * huber))
-        energy = setup.comm.allreduce(local)
-        tset = replace(pt, stick=stick, sign=sign)
-        return energy, r, tset
-
     def _tresca(self, active: np.ndarray) -> tuple[Point, float, dict[str, float], bool]:
         """One Newton step on Tresca's problem (the bound mu p fixed): Armijo on its energy.
 
@@ -279,18 +165,18 @@ class PenaltyFrictionIteration:
         """
         here, bound = self.point, self.bound
         assert here is not None and bound is not None
-        e0, r0, t0 = self._energy(here.x, bound)
+        e0, r0, t0 = self.energy(here.x, bound)
         self.stick, self.sign = t0.stick, t0.sign
         A, rhs, _ = self._system(active, bound)
         x, info = factor_solve(A, rhs, self.options)
         d = x - here.x
         D = r0.duplicate()
         D.array[:] = d
-        slope = float(r0.dot(D))
+        slope = float(np.real(r0.dot(D)))
         with released(self.setup.comm, r0, D):
             t = 1.0
             for _ in range(MAX_HALVINGS_TRESCA):
-                e, r, pt = self._energy(here.x + t * d, bound)
+                e, r, pt = self.energy(here.x + t * d, bound)
                 r.destroy()
                 same = bool(
                     self.setup.comm.allreduce(
@@ -305,12 +191,15 @@ class PenaltyFrictionIteration:
                 if (t == 1.0 and same) or e <= e0 + ARMIJO * t * slope:
                     break
                 t *= 0.5
-        return self._at(here.x + t * d), t, info, t == 1.0 and same
+        return self.at(here.x + t * d), t, info, t == 1.0 and same
 
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One factorization: the set's solution while no set comes back; then a Newton step
-        on the Coulomb set with a line search on |R|; where none lowers |R|, the
-        Tresca-Coulomb fixed point (module docstring)."""
+        """One factorization on `active` and its friction sets; the next set by the return map.
+
+        Full steps to the set's solution while no set comes back; then a Newton step on the
+        Coulomb set with a line search on |R|; where none lowers |R|, the Tresca-Coulomb
+        fixed point (module docstring).
+        """
         done, t, stay, solved = False, 1.0, False, b""
         if self.bound is not None and not self.probe:
             pt, t, info, inner = self._tresca(active)
@@ -322,21 +211,21 @@ class PenaltyFrictionIteration:
             if self.plain:
                 solved = self._global_key(active)
                 self.seen.add(solved)
-                pt = self._at(x)
+                pt = self.at(x)
             elif self.probe:
                 # The Tresca problem is solved: the Coulomb set's solution ends the step if
                 # its set is its own; else the bound takes the iterate's mu p.
                 assert self.point is not None
-                full = self._at(x)
+                full = self.at(x)
                 if self._keeps(full, active):
                     pt, done = full, True
                 else:
                     pt, stay = self.point, True
-                    done = self._fixed(pt)
+                    done = self.fixed(pt)
                     self.bound = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
                     self.probe = False
             else:
-                pt, t = self._search(x)
+                pt, t = self.search(x)
                 if t == 0.0:
                     # No step lowers |R| (an iterate at a kink of |R|, a row at the cone's
                     # edge): the Tresca-Coulomb fixed point from this iterate.
@@ -369,15 +258,6 @@ class PenaltyFrictionIteration:
             and np.array_equal((pt.sign * ~pt.stick)[active], (self.sign * ~self.stick)[active])
         )
         return bool(self.setup.comm.allreduce(bool(same), op=MPI.LAND))
-
-    def _fixed(self, pt: Point) -> bool:
-        """Whether the bound is the iterate's mu p to round-off: the fixed point."""
-        assert self.bound is not None
-        mup = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
-        comm = self.setup.comm
-        diff = comm.allreduce(float(np.max(np.abs(mup - self.bound), initial=0.0)), op=MPI.MAX)
-        scale = comm.allreduce(float(np.max(mup, initial=0.0)), op=MPI.MAX)
-        return diff <= 1e-12 * scale
 
     def _step(
         self,
