@@ -1,0 +1,125 @@
+"""Penalty friction on coarse blocks (methods/penalty_friction.py, penalty_return.py): no cycle.
+
+On the built-in blocks with one to three cm elements the plain set iteration of the
+regularized Coulomb law met a set twice (`contactfx solve blocks --mu 0.2 --size1 1 --size2 1
+--method penalty`); from the set met again the iteration takes searched Newton steps (Armijo
+on |R|) and, where no step lowers |R|, the Tresca-Coulomb fixed point. Each case is checked
+against the law itself and against the multipliers on the same mesh (the displacement and
+the pressure within the penalty's O(1 / eps) error; the statuses where a row is not at the
+edge of the cone).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import cli
+
+import contactfx.methods.penalty_return as penalty_return
+from contactfx import SolveRequest, solve
+from contactfx.contact.friction import Status
+from contactfx.methods.solution import Solution
+from contactfx.scenes.builtin import BlockParams, blocks
+
+# (method, size1, size2, mu): the command's case first, then sizes and mus on which the
+# multipliers converge (mortar's cycles on some others: docs/friction.md, "The penalty
+# baseline").
+CASES = [
+    ("mortar", 1.0, 1.0, 0.2),
+    ("nts", 1.0, 1.0, 0.2),
+    ("mortar", 2.0, 1.0, 0.1),
+    ("mortar", 1.0, 3.0, 0.1),
+    ("nts", 3.0, 1.0, 0.1),
+    ("mortar", 3.0, 2.0, 0.3),
+    ("mortar", 3.0, 3.0, 0.2),
+    ("nts", 2.0, 2.0, 0.5),
+    ("mortar", 2.0, 3.0, 0.5),
+]
+
+
+def coulomb(sol: Solution, mu: float) -> None:
+    """The regularized Coulomb law at every node: open rows carry nothing, |shear| < mu p
+    where a row sticks and = mu p (to round-off) where it slips."""
+    fr = sol.friction
+    assert fr is not None and sol.penalty is not None
+    p, q, status = sol.pressure, fr.shear, fr.status
+    scale = p.max()
+    slip, stick, open_ = (status == s for s in (Status.SLIP, Status.STICK, Status.OPEN))
+    assert np.all(p[open_] == 0.0) and np.all(q[open_] == 0.0)
+    assert np.all(p[~open_] > 0.0)
+    assert np.all(np.abs(q[stick]) < mu * p[stick])
+    assert np.abs(np.abs(q[slip]) - mu * p[slip]).max(initial=0.0) < 1e-12 * scale
+
+
+@pytest.mark.parametrize(("method", "size1", "size2", "mu"), CASES)
+def test_coarse_blocks_converge_to_the_multipliers_within_the_penalty_error(
+    method: str, size1: float, size2: float, mu: float
+) -> None:
+    """No cycle; Coulomb's law at every node; against the multipliers on the same mesh the
+    displacement and the pressure differ by the penalty's error, which falls like 1 / eps
+    (at ten times eps a tenth: 7 to 13 times less); the statuses are the multipliers' except
+    at a row the multipliers hold at the cone's edge (mu p - |shear| within 1e-3 of the
+    largest pressure: the penalty's error there picks a side). For nts the shear is the
+    multipliers' within the same error; mortar's stick rows on these meshes leave the
+    multipliers' shear undetermined (several shears, one displacement), so its shear is
+    checked through the displacement only."""
+    scene = blocks(BlockParams(size1=size1, size2=size2, mu=mu))
+    pen = solve(scene, SolveRequest.parse(method, enforcement="penalty"))
+    ref = solve(scene, method)
+    coulomb(pen, mu)
+    assert pen.penalty is not None and pen.friction is not None and ref.friction is not None
+    scale, umax = ref.pressure.max(), np.abs(ref.u.x.array).max()
+    du = np.abs(pen.u.x.array - ref.u.x.array).max() / umax
+    dp = np.abs(pen.pressure - ref.pressure).max() / scale
+    assert du < 1e-3 and dp < 1e-3
+    stiff = solve(
+        scene, SolveRequest.parse(method, enforcement="penalty", penalty=10 * pen.penalty.eps)
+    )
+    assert stiff.friction is not None
+    du10 = np.abs(stiff.u.x.array - ref.u.x.array).max() / umax
+    assert 7.0 < du / du10 < 13.0, (du, du10)
+    differ = pen.friction.status != ref.friction.status
+    edge = np.abs(mu * ref.pressure - np.abs(ref.friction.shear)) <= 1e-3 * scale
+    assert np.all(edge[differ])
+    np.testing.assert_array_equal(stiff.friction.status, pen.friction.status)
+    if method == "nts":
+        assert not differ.any()
+        assert np.abs(pen.friction.shear - ref.friction.shear).max() < 1e-3 * scale
+
+
+def test_the_first_try_takes_searched_steps_and_converges() -> None:
+    """The command's case (blocks, 1 cm elements, mu = 0.2, the penalty on mortar rows): the
+    plain iteration meets a set again at its fifth solve; from there a searched step (a
+    sixteenth of the Newton step) and one full step end it in 7 solves."""
+    sol = solve(blocks(BlockParams(size1=1.0, size2=1.0, mu=0.2)), "penalty")
+    lengths = [r["step_length"] for r in sol.history]
+    assert lengths == [1.0, 1.0, 1.0, 1.0, 1.0, 0.0625, 1.0]
+    coulomb(sol, 0.2)
+
+
+def test_tresca_coulomb_fixed_point_reaches_the_same_solution(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """With no step halving allowed the searched step fails at once and the Tresca-Coulomb
+    fixed point (the bound mu p frozen, a convex energy's line search, then the Coulomb
+    set's own solve) takes over: the same statuses, and the displacement to 1e-9."""
+    scene = blocks(BlockParams(size1=1.0, size2=1.0, mu=0.2))
+    searched = solve(scene, "penalty")
+    monkeypatch.setattr(penalty_return, "MAX_HALVINGS", 0)
+    tresca = solve(scene, "penalty")
+    assert any(r["tresca"] for r in tresca.history)
+    assert not any(r["tresca"] for r in searched.history)
+    coulomb(tresca, 0.2)
+    assert tresca.friction is not None and searched.friction is not None
+    np.testing.assert_array_equal(tresca.friction.status, searched.friction.status)
+    umax = np.abs(searched.u.x.array).max()
+    np.testing.assert_allclose(tresca.u.x.array, searched.u.x.array, rtol=0, atol=1e-9 * umax)
+
+
+def test_cli_first_try_of_mu_with_the_penalty() -> None:
+    """`contactfx solve blocks --mu 0.2 --size1 1 --size2 1 --method penalty` succeeds."""
+    proc = cli(
+        "solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1", "--method", "penalty"
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "2 stick, 2 slip" in proc.stdout
