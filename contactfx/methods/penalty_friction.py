@@ -14,10 +14,31 @@ With a row's set (open, stick, slip and its direction) fixed, lambda_t is linear
 set's system is K + B_n^T (eps_n / w) B_n + B_t^T (eps_t / w) B_t on stick rows and
 + B_t^T (-mu s eps_n / w) B_n on slip rows: the consistent tangent of the return map (in 2D
 the direction's derivative vanishes), unsymmetric where a row slips: factored by LU then,
-by the request's factorization (LDL^T by default) while no row slips. The loop
-is active_set.py's, as for the multipliers: the set of the solution is the next set, and the
-loop stops when no row changes. The history carried from step to step is the traction
-lambda_t and the slip s at the step's end (an open row keeps none: its lambda_t is 0).
+by the request's factorization (LDL^T by default) while no row slips. The loop is
+active_set.py's; it stops when the solution's set is the set solved (its residual R below
+is then 0 to round-off). Three stages, each from where the one before left:
+
+1. Full steps: the set of the solution is the next set (a slipping row whose trial turns
+   against its direction sticks first), as long as no set comes back. With eps_t per row
+   far stiffer than the bodies (1e3 E / h), releasing a row can move its neighbours' trials
+   past the cone, and on coarse meshes the sets cycle (the blocks with 1 cm elements).
+2. From the iterate u whose next set was solved before: the set is u's own and its solve is
+   the semismooth Newton step of the piecewise linear R(u) = K u - f - B_n^T p(u) +
+   B_t^T lambda_t(u), damped by Armijo's rule on |R| (penalty_return.py; Pang 1990, the
+   damped Newton method for B-differentiable equations, as Christensen, Klarbring, Pang and
+   Stromberg 1998 apply it to frictional contact). |R| falls at every step, so no iterate
+   comes back.
+3. Where no step of 1/2^MAX_HALVINGS or longer lowers |R| (an iterate at a kink of |R|, a
+   row at the cone's edge): the Tresca-Coulomb fixed point. With the bound mu p of the
+   iterate frozen, Tresca's problem is the minimum of a convex energy (a Huber term per
+   row); Newton steps on it with Armijo's rule on that energy (each a descent direction,
+   the matrix symmetric) until its set stays; then the Coulomb set's own solve ends the
+   step if its set is its own, else the bound takes the new mu p (the outer fixed point:
+   a contraction for small mu, Necas, Jarusek and Haslinger 1980).
+
+The counts on the built-in blocks are in docs/friction.md, "The penalty baseline". The
+history carried from step to step is the traction lambda_t and the slip s at the step's end
+(an open row keeps none: its lambda_t is 0).
 
 eps_t = eps_n = the request's penalty, by default 1e3 E_max / h (penalty.default_penalty):
 both are stiffnesses per unit area of the interface, and the stick state's elastic slip
