@@ -18,6 +18,7 @@ from conftest import cli
 import contactfx.methods.penalty_return as penalty_return
 from contactfx import SolveRequest, solve
 from contactfx.contact.friction import Status
+from contactfx.errors import ActiveSetError
 from contactfx.methods.solution import Solution
 from contactfx.scenes.builtin import BlockParams, blocks
 
@@ -123,3 +124,27 @@ def test_cli_first_try_of_mu_with_the_penalty() -> None:
     )
     assert proc.returncode == 0, proc.stderr
     assert "2 stick, 2 slip" in proc.stdout
+
+
+def test_where_the_multipliers_cycle_the_penalty_converges_like_one_over_eps() -> None:
+    """Blocks with 2 cm elements, mu = 0.2, mortar rows: the plain penalty iteration and the
+    multipliers both meet a set again (the multipliers' error is asserted); the penalty
+    converges (a searched step, then a full one), holds Coulomb's law at every node, and ten
+    times eps keeps its statuses and moves its displacement ten times less than the step
+    from eps / 10 to eps (7 to 13): a limit exists and the default is within O(1 / eps) of it."""
+    scene = blocks(BlockParams(size1=2.0, size2=2.0, mu=0.2))
+    with pytest.raises(ActiveSetError, match="cycles"):
+        solve(scene, "mortar")
+    sol = solve(scene, "penalty")
+    assert sol.penalty is not None and sol.friction is not None
+    assert any(r["step_length"] < 1.0 for r in sol.history)
+    coulomb(sol, 0.2)
+    eps = sol.penalty.eps
+    soft, stiff = (solve(scene, "penalty", penalty=f * eps) for f in (0.1, 10.0))
+    assert soft.friction is not None and stiff.friction is not None
+    np.testing.assert_array_equal(stiff.friction.status, sol.friction.status)
+    np.testing.assert_array_equal(soft.friction.status, sol.friction.status)
+    coulomb(stiff, 0.2)
+    far = np.abs(sol.u.x.array - soft.u.x.array).max()
+    near = np.abs(stiff.u.x.array - sol.u.x.array).max()
+    assert 7.0 < far / near < 13.0, (far, near)
