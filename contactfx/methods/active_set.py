@@ -186,6 +186,12 @@ class Step:
     text: str = ""  # extra words for the log line
     final: bool = True  # the solve reached the final tolerance (not a loop's loose answer)
     changed: int = 0  # rows (all ranks) whose other set changed: friction's stick/slip
+    # The iteration guards against cycles itself (penalty friction: a set met again turns it
+    # to steps searched along the Newton step, which come back to sets from other iterates):
+    # the loop does not settle its sets. A damped step (a part of the Newton step, or the
+    # iterate kept) is not the solved set's solution and does not end the loop.
+    guarded: bool = False
+    damped: bool = False
 
 
 @dataclass(frozen=True)
@@ -262,7 +268,7 @@ def run_active_set(
         t0 = time.perf_counter()
         with timers("solve"):
             step = iteration.solve(active, it)
-        if step.final:
+        if step.final and not step.guarded:
             state.settle()
         t_solve = time.perf_counter() - t0
         resid = step.residual
@@ -278,7 +284,7 @@ def run_active_set(
             "solve_time": t_solve,
         }
         history.append(record)
-        stationary = entered == 0 and left == 0 and step.changed == 0
+        stationary = entered == 0 and left == 0 and step.changed == 0 and not step.damped
         proposal = None if stationary else iteration.next_set(active, step, entered)
         after = ""
         if proposal is not None:

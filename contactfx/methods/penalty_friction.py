@@ -14,10 +14,31 @@ With a row's set (open, stick, slip and its direction) fixed, lambda_t is linear
 set's system is K + B_n^T (eps_n / w) B_n + B_t^T (eps_t / w) B_t on stick rows and
 + B_t^T (-mu s eps_n / w) B_n on slip rows: the consistent tangent of the return map (in 2D
 the direction's derivative vanishes), unsymmetric where a row slips: factored by LU then,
-by the request's factorization (LDL^T by default) while no row slips. The loop
-is active_set.py's, as for the multipliers: the set of the solution is the next set, and the
-loop stops when no row changes. The history carried from step to step is the traction
-lambda_t and the slip s at the step's end (an open row keeps none: its lambda_t is 0).
+by the request's factorization (LDL^T by default) while no row slips. The loop is
+active_set.py's; it stops when the solution's set is the set solved (its residual R below
+is then 0 to round-off). Three stages, each from where the one before left:
+
+1. Full steps: the set of the solution is the next set (a slipping row whose trial turns
+   against its direction sticks first), as long as no set comes back. With eps_t per row
+   far stiffer than the bodies (1e3 E / h), releasing a row can move its neighbours' trials
+   past the cone, and on coarse meshes the sets cycle (the blocks with 1 cm elements).
+2. From the iterate u whose next set was solved before: the set is u's own and its solve is
+   the semismooth Newton step of the piecewise linear R(u) = K u - f - B_n^T p(u) +
+   B_t^T lambda_t(u), damped by Armijo's rule on |R| (penalty_return.py; Pang 1990, the
+   damped Newton method for B-differentiable equations, as Christensen, Klarbring, Pang and
+   Stromberg 1998 apply it to frictional contact). |R| falls at every step, so no iterate
+   comes back.
+3. Where no step of 1/2^MAX_HALVINGS or longer lowers |R| (an iterate at a kink of |R|, a
+   row at the cone's edge): the Tresca-Coulomb fixed point. With the bound mu p of the
+   iterate frozen, Tresca's problem is the minimum of a convex energy (a Huber term per
+   row); Newton steps on it with Armijo's rule on that energy (each a descent direction,
+   the matrix symmetric) until its set stays; then the Coulomb set's own solve ends the
+   step if its set is its own, else the bound takes the new mu p (the outer fixed point:
+   a contraction for small mu, Necas, Jarusek and Haslinger 1980).
+
+The counts on the built-in blocks are in docs/friction.md, "The penalty baseline". The
+history carried from step to step is the traction lambda_t and the slip s at the step's end
+(an open row keeps none: its lambda_t is 0).
 
 eps_t = eps_n = the request's penalty, by default 1e3 E_max / h (penalty.default_penalty):
 both are stiffnesses per unit area of the interface, and the stick state's elastic slip
@@ -34,7 +55,7 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from ..contact.friction import Epochs, FrictionResult, Status, armijo
+from ..contact.friction import FrictionResult, Status
 from ..discretize.setup import ContactSetup, prepare_contact
 from ..errors import SingularSystemError, SolverError
 from ..request import SolveRequest
@@ -50,8 +71,8 @@ from .penalty import (
     factor_solve,
     penetration,
     scaled_rows,
-    transposed,
 )
+from .penalty_return import ARMIJO, MAX_HALVINGS_TRESCA, Point, ReturnMap
 from .solution import PenaltyResult, Solution, finish
 
 
@@ -70,7 +91,7 @@ class PenaltyState:
     shear: np.ndarray  # lambda_t at its end (0 where open)
 
 
-class PenaltyFrictionIteration:
+class PenaltyFrictionIteration(ReturnMap):
     """Penalty solves on a set (open, stick, slip and direction) and the return map's update."""
 
     label = "penalty friction"
@@ -84,41 +105,35 @@ class PenaltyFrictionIteration:
         eps: float,
         options: Mapping[str, object],
     ) -> None:
-        self.setup, self.eps_n, self.eps_t = setup, eps, eps
-        self.Bt, self.shift_t, self.free_t = tangential
-        # B_n^T and B_t^T: the same in every solve of the step (freed by `destroy`).
-        self.BnT, self.BtT = transposed(setup.B), transposed(self.Bt)
-        self.options, self.lu = options, lu_options(options)
-        layout = setup.layout
         mus = pair_mu(scene)
-        self.mu = np.array([mus[int(k)] for k in layout.pair[layout.mine]])
+        layout = setup.layout
+        super().__init__(
+            setup, tangential, eps, np.array([mus[int(k)] for k in layout.pair[layout.mine]])
+        )
+        self.options, self.lu = options, lu_options(options)
         m = len(layout.mine)
         # The first set sticks wherever friction acts (as the multipliers' does).
         self.stick = self.mu > 0.0
         self.sign = np.ones(m)
-        self.ut_prev = np.zeros(m)
-        self.shear_prev = np.zeros(m)
         self.u = fem.Function(setup.elasticity.V, name="u")
         self.lam_t = np.zeros(m)
         self.slip = np.zeros(m)
         self.status = np.zeros(m, dtype=np.int64)
-        # The iterate the next Newton step starts from (None: the step's first solve) and the
-        # cycle key's epoch (contact/friction.py, Epochs).
-        self.x: np.ndarray | None = None
-        self.epochs = Epochs()
-
-    def destroy(self) -> None:
-        """Free the transposes."""
-        self.BnT.destroy()
-        self.BtT.destroy()
+        self.probe = False  # Tresca's problem is solved: try the Coulomb set's solution
+        self.plain = True  # full steps to each set's solution until a set comes back
+        self.seen: set[bytes] = set()  # the sets the plain iteration solved
 
     def key(self, active: np.ndarray) -> np.ndarray:
         """The rows' full set: contact, stick, and the slip direction (for cycle detection)."""
-        rows = np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
-        return rows + 4 * self.epochs.epoch
+        return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
 
-    def _system(self, active: np.ndarray) -> tuple[PETSc.Mat, PETSc.Vec, bool]:
-        """The set's matrix and right-hand side (module docstring), and whether a row slips.
+    def _system(
+        self, active: np.ndarray, bound: np.ndarray | None = None
+    ) -> tuple[PETSc.Mat, PETSc.Vec, bool]:
+        """The set's matrix and right-hand side (module docstring), whether a row slips.
+
+        A slipping row makes the matrix unsymmetric. `bound`: Tresca's problem, the slip
+        rows carry bound * sign, fixed (the matrix is symmetric); only rows with a bound stick.
 
         Without a stick or slip row carrying a shear (mu = 0, or every row open) the system
         is the frictionless penalty's, assembled as it is.
@@ -126,14 +141,20 @@ class PenaltyFrictionIteration:
         setup, el = self.setup, self.setup.elasticity
         w, g0 = setup.w, setup.g
         rubs = self.free_t & (self.mu > 0.0)  # a row that can carry a shear
-        stick = active & self.stick & rubs
-        slip = active & ~self.stick & rubs
+        if bound is None:
+            stick = active & self.stick & rubs
+            slip = active & ~self.stick & rubs
+            fixed = np.zeros_like(w)
+        else:
+            stick = self.stick & rubs & (bound > 0.0)
+            slip = np.zeros_like(stick)
+            fixed = np.where(rubs & ~stick, bound * self.sign, 0.0)
         cn = np.where(active, self.eps_n / w, 0.0)
         ctt = np.where(stick, self.eps_t / w, 0.0)
         ctn = np.where(slip, -self.mu * self.sign * self.eps_n / w, 0.0)
         comm = setup.comm
         slips = comm.allreduce(bool(slip.any()), op=MPI.LOR)
-        sheared = slips or comm.allreduce(bool(stick.any()), op=MPI.LOR)
+        sheared = slips or comm.allreduce(bool(stick.any() or fixed.any()), op=MPI.LOR)
         Bn, Bt = setup.B, self.Bt
         BnT, BtT, An = self.BnT, self.BtT, scaled_rows(Bn, cn)
         A = add_product(None, BnT, An)
@@ -148,7 +169,7 @@ class PenaltyFrictionIteration:
                 a = self.shear_prev + self.eps_t * (self.shift_t - self.ut_prev) / w
                 M, Mn = scaled_rows(Bt, ctt), scaled_rows(Bn, ctn)
                 dt = Bt.createVecLeft()
-                dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0
+                dt.array[:] = -np.where(stick, a, 0.0) - ctn * g0 - fixed
                 with released(comm, M, Mn, dt):
                     M.axpy(1.0, Mn, structure=DIFFERENT)
                     A = add_product(A, BtT, M)
@@ -157,32 +178,133 @@ class PenaltyFrictionIteration:
         A.axpy(1.0, el.K, structure=DIFFERENT)
         return A, rhs, slips
 
+    def _tresca(self, active: np.ndarray) -> tuple[Point, float, dict[str, float], bool]:
+        """One Newton step on Tresca's problem (the bound mu p fixed): Armijo on its energy.
+
+        Returns the iterate, the step length, the solve's info and whether Tresca's set
+        (contact, stick, direction) stayed: the inner problem is solved.
+        """
+        here, bound = self.point, self.bound
+        assert here is not None and bound is not None
+        e0, r0, t0 = self.energy(here.x, bound)
+        self.stick, self.sign = t0.stick, t0.sign
+        A, rhs, _ = self._system(active, bound)
+        x, info = factor_solve(A, rhs, self.options)
+        d = x - here.x
+        D = r0.duplicate()
+        D.array[:] = d
+        slope = float(np.real(r0.dot(D)))
+        with released(self.setup.comm, r0, D):
+            t = 1.0
+            for _ in range(MAX_HALVINGS_TRESCA):
+                e, r, pt = self.energy(here.x + t * d, bound)
+                r.destroy()
+                same = bool(
+                    self.setup.comm.allreduce(
+                        bool(
+                            np.array_equal(pt.contact, t0.contact)
+                            and np.array_equal(pt.stick, t0.stick)
+                            and np.array_equal(pt.sign[~pt.stick], t0.sign[~t0.stick])
+                        ),
+                        op=MPI.LAND,
+                    )
+                )
+                if (t == 1.0 and same) or e <= e0 + ARMIJO * t * slope:
+                    break
+                t *= 0.5
+        return self.at(here.x + t * d), t, info, t == 1.0 and same
+
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One factorization on `active` and its friction sets; the next set by the return map."""
+        """One factorization on `active` and its friction sets; the next set by the return map.
+
+        Full steps to the set's solution while no set comes back; then a Newton step on the
+        Coulomb set with a line search on |R|; where none lowers |R|, the Tresca-Coulomb
+        fixed point (module docstring).
+        """
+        done, t, stay, solved = False, 1.0, False, b""
+        if self.bound is not None and not self.probe:
+            pt, t, info, inner = self._tresca(active)
+            self.probe = inner
+            stay = True
+        else:
+            A, rhs, slips = self._system(active)
+            x, info = factor_solve(A, rhs, self.lu if slips else self.options)
+            if self.plain:
+                solved = self._global_key(active)
+                self.seen.add(solved)
+                pt = self.at(x)
+            elif self.probe:
+                # The Tresca problem is solved: the Coulomb set's solution ends the step if
+                # its set is its own; else the bound takes the iterate's mu p.
+                assert self.point is not None
+                full = self.at(x)
+                if self._keeps(full, active):
+                    pt, done = full, True
+                else:
+                    pt, stay = self.point, True
+                    done = self.fixed(pt)
+                    self.bound = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
+                    self.probe = False
+            else:
+                pt, t = self.search(x)
+                if t == 0.0:
+                    # No step lowers |R| (an iterate at a kink of |R|, a row at the cone's
+                    # edge): the Tresca-Coulomb fixed point from this iterate.
+                    self.bound = self.mu * np.where(pt.contact, -self.eps_n * pt.gap, 0.0)
+                    stay = True
+        step = self._step(active, pt, t, info, done, stay)
+        after = self._global_key(step.new_active) if self.plain else b""
+        if self.plain and after != solved and after in self.seen:
+            # The next set was solved before: a cycle of full steps. From this iterate on,
+            # the next set is its own (no reversal through stick) and steps are searched.
+            self.plain = False
+            self.stick = np.where(pt.contact, pt.stick, self.stick)
+            self.sign = np.where(pt.contact & ~pt.stick, pt.sign, self.sign)
+            step.changed = max(step.changed, 1)
+        return step
+
+    def _global_key(self, active: np.ndarray) -> bytes:
+        """The whole set on every rank (cycle detection of the plain iteration)."""
+        keys = self.setup.comm.allgather((self.setup.layout.mine, self.key(active)))
+        out = np.zeros(self.setup.layout.size, dtype=np.int64)
+        for idx, vals in keys:
+            out[idx] = vals
+        return out.tobytes()
+
+    def _keeps(self, pt: Point, active: np.ndarray) -> bool:
+        """Whether `pt`'s Coulomb set is the one solved (contact, stick, direction)."""
+        same = (
+            np.array_equal(pt.contact, active)
+            and np.array_equal(pt.stick[active], self.stick[active])
+            and np.array_equal((pt.sign * ~pt.stick)[active], (self.sign * ~self.stick)[active])
+        )
+        return bool(self.setup.comm.allreduce(bool(same), op=MPI.LAND))
+
+    def _step(
+        self,
+        active: np.ndarray,
+        pt: Point,
+        t: float,
+        info: dict[str, float],
+        done: bool,
+        stay: bool,
+    ) -> Step:
+        """Take the iterate `pt`: its Coulomb set is the next; the loop's Step."""
         setup, comm = self.setup, self.setup.comm
-        A, rhs, slips = self._system(active)
-        x, info = factor_solve(A, rhs, self.lu if slips else self.options)
-        alpha = 1.0
-        if self.x is not None:
-            # The set's solution is the full Newton step on the piecewise linear residual:
-            # shortened where it does not lower it (methods/friction.py).
-            start, full = self.x, x
-            alpha, before, after = armijo(lambda a: self._residual(start + a * (full - start)))
-            self.epochs.update(before, after)
-            x = start + alpha * (full - start)
-        self.x = x
-        gap, ut, p, contact, stick, sign, lam_t = self._return_map(x)
-        w = setup.w
-        # A row solved as slipping whose trial turns against its direction sticks next: a
-        # reversal passes through stick. Flipping it straight to the other direction made an
-        # unloading step cycle (tests/methods/test_penalty_friction.py, the pull back).
-        reversed_ = active & ~self.stick & ~stick & (sign != self.sign) & (self.mu > 0.0)
-        stick = stick | reversed_
+        self.point = pt
+        self.u.x.petsc_vec.array[:] = pt.x
+        self.u.x.scatter_forward()
+        gap, contact, stick, sign = pt.gap, pt.contact, pt.stick, pt.sign
+        if self.plain:
+            # A row solved as slipping whose trial turns against its direction sticks next:
+            # a reversal passes through stick (without it, the pull back of
+            # tests/methods/test_penalty_friction.py's steps cycled).
+            stick = stick | (active & ~self.stick & ~stick & (sign != self.sign) & (self.mu > 0))
         changed = contact & active & ((stick != self.stick) | (~stick & (sign != self.sign)))
-        n_changed = comm.allreduce(int(changed.sum()))
+        n_changed = 0 if done else comm.allreduce(int(changed.sum()))
         self.stick = np.where(contact, stick, self.stick)
         self.sign = np.where(contact & ~stick, sign, self.sign)
-        self.lam_t, self.slip = lam_t, ut / w
+        self.lam_t, self.slip = pt.lam_t, pt.ut / setup.w
         self.status = np.where(contact, np.where(stick, Status.STICK, Status.SLIP), Status.OPEN)
         pen = max(comm.allreduce(float(np.max(-gap, initial=0.0)), op=MPI.MAX), 0.0)
         n_stick = comm.allreduce(int(np.sum(self.status == Status.STICK)))
@@ -193,52 +315,17 @@ class PenaltyFrictionIteration:
             "friction_changed": n_changed,
             "penetration": pen,
             "penalty": self.eps_n,
+            "step_length": t,
+            "tresca": float(self.bound is not None),
             **info,
         }
-        record["step_length"] = alpha
-        damped = f", step {alpha:g}" if alpha < 1.0 else ""
-        text = (
-            f"{n_stick} stick, {n_slip} slip, {n_changed} changed{damped}, "
-            f"max penetration {pen:.3e}, "
+        text = f"{n_stick} stick, {n_slip} slip, {n_changed} changed, max penetration {pen:.3e}, "
+        text += "" if t == 1.0 else f"step {t:g}, "
+        text += "tresca, " if self.bound is not None and not done else ""
+        damped = (t < 1.0 or stay) and not done
+        return Step(
+            -self.eps_n * gap, gap, contact, 0.0, record, text, True, n_changed, True, damped
         )
-        return Step(p, gap, contact, 0.0, record, text, True, n_changed + (alpha < 1.0))
-
-    def _return_map(self, x: np.ndarray) -> tuple[np.ndarray, ...]:
-        """At displacement `x`: gap, weighted slip, p, contact, stick, sign, lambda_t."""
-        setup = self.setup
-        self.u.x.petsc_vec.array[:] = x
-        self.u.x.scatter_forward()
-        gap = setup.normalized_gap(self.u)
-        y = self.Bt.createVecLeft()
-        self.Bt.mult(self.u.x.petsc_vec, y)
-        # A row held along its tangent does not slip (methods/friction.py).
-        ut = np.where(self.free_t, y.array_r + self.shift_t, self.ut_prev)
-        y.destroy()
-        w = setup.w
-        p = -self.eps_n * gap
-        contact = gap < 0.0
-        trial = np.where(self.free_t, self.shear_prev + self.eps_t * (ut - self.ut_prev) / w, 0.0)
-        stick = np.abs(trial) < self.mu * p
-        sign = np.where(trial >= 0.0, 1.0, -1.0)
-        lam_t = np.where(contact, np.where(stick, trial, self.mu * p * sign), 0.0)
-        return gap, ut, p, contact, stick, sign, lam_t
-
-    def _residual(self, x: np.ndarray) -> float:
-        """|K x - f - B_n^T p + B_t^T lambda_t|^2 at `x` (all ranks): zero at the answer."""
-        _, _, p, contact, _, _, lam_t = self._return_map(x)
-        el, comm = self.setup.elasticity, self.setup.comm
-        r, tmp = el.f.duplicate(), el.f.duplicate()
-        vn, vt = self.setup.B.createVecLeft(), self.Bt.createVecLeft()
-        with released(comm, r, tmp, vn, vt):
-            el.K.mult(self.u.x.petsc_vec, r)
-            r.axpy(-1.0, el.f)
-            vn.array[:] = -np.where(contact, p, 0.0)
-            self.BnT.mult(vn, tmp)
-            r.axpy(1.0, tmp)
-            vt.array[:] = lam_t
-            self.BtT.mult(vt, tmp)
-            r.axpy(1.0, tmp)
-            return comm.allreduce(float(np.sum(r.array_r**2)))
 
     def next_set(self, active: np.ndarray, step: Step, entered: int) -> Proposal | None:
         """The return map's set."""
