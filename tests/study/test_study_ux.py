@@ -76,7 +76,7 @@ def test_missing_half_width_says_why() -> None:
     run: Any = SimpleNamespace(
         scene="hertz", method=SimpleNamespace(value="mortar"), dofs=10, multipliers=3,
         iterations=2, times={"total": 1.0}, contacts=[contact], patch=None, hertz=[h],
-        estimate=None, lame=(), cattaneo=(), probes=(), steps=(),
+        estimate=None, lame=(), cattaneo=(), pushout=(), spence=(), probes=(), steps=(),
     )  # fmt: skip
     line = next(ln for ln in terminal_summary(run) if ln.startswith("Hertz"))
     assert "nan" not in line and "a: n/a (3 active nodes" in line, line
