@@ -42,14 +42,16 @@ from ..contact.sparse import CSR
 from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
 from ..errors import InputError, SingularSystemError, SolverError
-from ..linalg.blocks import diagonal_matrix
-from ..options import Basis, Discretization, Enforcement, SolverKind
+from ..linalg.condensed_friction import FrictionCondensedSolver
+from ..options import Basis, Discretization, Enforcement, SolverKind, System
 from ..request import SolveRequest
 from ..scenes import Scene
 from ..scenes.steps import step_scenes
 from ..timers import Timers
 from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .friction_linear import CondensedFriction, DirectFriction, FrictionSystem
 from .solution import Solution, finish
+from .solvers import setup_solver
 
 log = logging.getLogger("contactfx")
 
@@ -61,7 +63,10 @@ START_BAND = 0.1
 # their symmetry rules out, and the pushed stick zone sat off-centre (docs/friction.md).
 FRAME = "bisector"
 
-SUPPORTED = "nts or mortar (standard or dual) with multipliers and a direct solver (mumps)"
+SUPPORTED = (
+    "nts or mortar (standard or dual) with multipliers and a direct solver (mumps), or dual "
+    "mortar with the condensed solver"
+)
 
 
 def pair_mu(scene: Scene) -> list[float]:
@@ -89,11 +94,15 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
     if not pairs:
         return
     why = ""
+    dual = request.discretization is Discretization.MORTAR and request.basis is Basis.DUAL
     if request.enforcement is not Enforcement.MULTIPLIERS:
         why = f"the {request.enforcement.value} enforcement"
     elif request.discretization is Discretization.STS:
         why = "sts"
-    elif request.solver.kind not in (SolverKind.DIRECT, SolverKind.AUTO):
+    elif request.solver.kind is SolverKind.CONDENSED and not dual:
+        how = f"{request.discretization.value} ({request.basis.value} basis)"
+        why = f"the {request.solver.name} solver on {how}, which needs dual mortar"
+    elif request.solver.kind not in (SolverKind.DIRECT, SolverKind.AUTO, SolverKind.CONDENSED):
         why = f"the {request.solver.name} solver"
     if why:
         raise InputError(
@@ -170,8 +179,11 @@ class FrictionIteration:
         Bt: PETSc.Mat,
         shift_t: np.ndarray,
         free_t: np.ndarray,
+        linear: DirectFriction | CondensedFriction,
     ) -> None:
         self.setup, self.Bt, self.shift_t, self.free_t = setup, Bt, shift_t, free_t
+        self.linear = linear
+        self.krylov = 0
         layout = setup.layout
         mus = pair_mu(scene)
         self.mu = np.array([mus[int(k)] for k in layout.pair[layout.mine]])
@@ -192,58 +204,16 @@ class FrictionIteration:
         return np.where(active, np.where(self.stick, 1, 2 + (self.sign > 0)), 0)
 
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One LU solve of the frictional saddle point on `active` and the friction sets."""
+        """One solve of the frictional saddle point on `active` and the friction sets."""
         setup, comm = self.setup, self.setup.comm
-        el = setup.elasticity
-        on = np.asarray(active, dtype=float)
         # A row without a free tangential dof neither sticks nor slips: lambda_t = 0.
         stick = active & self.stick & self.free_t
         slip = active & ~self.stick & self.free_t
-        # Row blocks: the normal rows where in contact, the tangential rows where sticking.
-        Bn_a, Bt_a = setup.B.copy(), self.Bt.copy()
-        Bn_a.diagonalScale(L=_vec(comm, on))
-        Bt_a.diagonalScale(L=_vec(comm, stick.astype(float)))
-        BnT, BtT = setup.B.copy().transpose(), self.Bt.copy().transpose()
-        Cnn = diagonal_matrix(setup.B.getComm(), 1.0 - on, self.offset)
-        Ctn = diagonal_matrix(
-            setup.B.getComm(), np.where(slip, self.mu * self.sign, 0.0), self.offset
-        )
-        Ctt = diagonal_matrix(setup.B.getComm(), 1.0 - stick, self.offset)
-        nest = PETSc.Mat().createNest(
-            [[el.K, BnT, BtT], [Bn_a, Cnn, None], [Bt_a, Ctn, Ctt]],  # type: ignore[list-item]
-            comm=setup.B.getComm(),
-        )
-        rows, _ = nest.getNestISs()
-        A = nest.convert("aij", PETSc.Mat())
-        b = A.createVecRight()
-        parts = (
-            el.f.array_r,
-            np.where(active, -setup.g, 0.0),
-            np.where(stick, self.ut_prev - self.shift_t, 0.0),
-        )
-        for iset, values in zip(rows, parts, strict=True):
-            sub = b.getSubVector(iset)
-            sub.array[:] = values
-            b.restoreSubVector(iset, sub)
-        x = b.duplicate()
-        ksp = PETSc.KSP().create(A.getComm())
-        ksp.setOperators(A)
-        ksp.setType("preonly")
-        ksp.getPC().setType("lu")
-        ksp.getPC().setFactorSolverType("mumps")
-        ksp.solve(b, x)
-        if ksp.getConvergedReason() < 0:  # type: ignore[operator]
-            raise SolverError(
-                f"the frictional saddle point's LU failed ({ksp.getConvergedReason()})"
-            )
-        out = []
-        for iset in rows:
-            sub = x.getSubVector(iset)
-            out.append(sub.array_r.copy())
-            x.restoreSubVector(iset, sub)
-        for obj in (ksp, A, nest, Bn_a, Bt_a, BnT, BtT, Cnn, Ctn, Ctt, b, x):
-            obj.destroy()
-        u, mu_n, mu_t = out
+        coef = np.where(slip, self.mu * self.sign, 0.0)
+        system = FrictionSystem(active, stick, coef, setup.g, self.shift_t - self.ut_prev)
+        answer = self.linear.solve(system)
+        self.krylov += answer.iterations
+        u, mu_n, mu_t = answer.u, answer.mu_n, answer.mu_t
         self.u.x.petsc_vec.array[:] = u
         self.u.x.scatter_forward()
         lam_n, lam_t = np.where(active, -mu_n, 0.0), np.where(active, mu_t, 0.0)
@@ -302,11 +272,18 @@ def solve_friction(
     """
     sols: list[Solution] = []
     state: StepState | None = None
-    for k, step_scene in enumerate(step_scenes(scene)):
-        sol, state = _solve_step(step_scene, request, timers, aso, state)
-        if scene.steps and scene.comm.rank == 0:
-            log.info("step %d: %d iterations", k + 1, sol.iterations)
-        sols.append(sol)
+    condensed = request.solver.traits.system is System.CONDENSED
+    # One LU for the whole load history: its pattern and analysis outlive the steps.
+    direct = None if condensed else DirectFriction()
+    try:
+        for k, step_scene in enumerate(step_scenes(scene)):
+            sol, state = _solve_step(step_scene, request, timers, aso, state, direct)
+            if scene.steps and scene.comm.rank == 0:
+                log.info("step %d: %d iterations", k + 1, sol.iterations)
+            sols.append(sol)
+    finally:
+        if direct is not None:
+            direct.destroy()
     if scene.steps:
         sols[-1].steps = sols
     return sols[-1]
@@ -318,6 +295,7 @@ def _solve_step(
     timers: Timers,
     aso: ActiveSetOptions,
     before: StepState | None,
+    direct: DirectFriction | None,
 ) -> tuple[Solution, StepState]:
     """One load step of `solve_friction`, from the state the step before left."""
     kernel = request.discretization.kernel
@@ -332,7 +310,16 @@ def _solve_step(
             Bt, shift_t, tangent, free_t, moving = tangent_constraint(
                 scene, setup, request.basis, kernel
             )
-        iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t)
+        el = setup.elasticity
+        linear: DirectFriction | CondensedFriction
+        if direct is not None:
+            direct.bind(el.K, setup.B, Bt, el.f)
+            linear = direct
+        else:
+            solver = setup_solver(setup, request.solver, scene, reuse=True, tangent=Bt)
+            assert isinstance(solver, FrictionCondensedSolver)
+            linear = CondensedFriction(solver)
+        iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t, linear)
         # The first set: the rows within h / 10 of touching (no predictor on this path; a
         # curved contact touching at one node would leave the body free to rotate).
         active = setup.initial_active(START_BAND * setup.h)
@@ -348,6 +335,8 @@ def _solve_step(
             step, active, history = run_active_set(setup, iteration, active, aso, timers)
         finally:
             Bt.destroy()
+            if direct is None:
+                linear.destroy()
         sol = finish(
             setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
         )
