@@ -219,9 +219,9 @@ def stacked_blocks() -> tuple[Solution, Arrays]:
 CASES["cli-stacked-blocks"] = Case(stacked_blocks, {"forces": Abs(1e-8 * 10.0 * 2.0)})
 
 
-def friction_push() -> tuple[Solution, Arrays]:
+def friction_push(*options: str) -> tuple[Solution, Arrays]:
     """`contactfx solve friction_push.toml`: each load step's force, shear and statuses."""
-    sol, data = cli_json(["solve", str(SCENES / "friction_push.toml")])
+    sol, data = cli_json(["solve", str(SCENES / "friction_push.toml"), *options])
     pairs = [step["contacts"][0] for step in data["steps"]]
     names = ("open", "stick", "slip")
     return sol, {
@@ -234,6 +234,11 @@ def friction_push() -> tuple[Solution, Arrays]:
 # p = 10 on the block's width 1; the statuses exactly serial's.
 CASES["cli-friction-push"] = Case(
     friction_push, {"forces": Abs(1e-9 * 10.0), "shear": Abs(1e-9 * 10.0), "status": Exact()}
+)
+# The condensed dual path: GMRES to rtol 1e-9 (the frictionless condensed case's 1e-6).
+CASES["cli-friction-push-condensed"] = Case(
+    functools.partial(friction_push, "--basis", "dual", "--solver", "condensed"),
+    {"forces": Abs(1e-6 * 10.0), "shear": Abs(1e-6 * 10.0), "status": Exact()},
 )
 
 
