@@ -131,7 +131,7 @@ def make_solver(
         if reuse and K.getComm().tompi4py().rank == 0:
             how = f"geometric, {len(levels)} coarser levels" if levels else "GAMG (algebraic)"
             log.info("multigrid: %s", how)
-        cls = CondensedSolver
+        cls: type[CondensedSolver] = CondensedSolver
         extra: dict[str, PETSc.Mat] = {}
         if tangent is not None:
             from ..linalg.condensed_friction import FrictionCondensedSolver
