@@ -63,6 +63,17 @@ class FrictionOperator:
         self._w2.destroy()
 
 
+class _Cycle:
+    """A petsc4py Python PC: one application of an inner (preonly) KSP."""
+
+    def __init__(self, inner: PETSc.KSP) -> None:
+        self._inner = inner
+
+    def apply(self, pc: PETSc.PC, x: PETSc.Vec, y: PETSc.Vec) -> None:
+        """Apply the inner preconditioner to x, into y."""
+        self._inner.solve(x, y)
+
+
 class FrictionCondensedSolver(CondensedSolver):
     """The condensed solver with tangential rows `Bt` beside B's normal ones (same layout).
 
@@ -72,6 +83,22 @@ class FrictionCondensedSolver(CondensedSolver):
     def __init__(self, *args: Any, Bt: PETSc.Mat, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._t_rows = LocalRows.of(Bt, self._rows.node_dofs)
+        # GMRES outside; the multigrid (one cycle: the inherited KSP, preonly) on S inside.
+        outer = PETSc.KSP().create(self._comm)
+        outer.setType(PETSc.KSP.Type.GMRES)
+        outer.setGMRESRestart(RESTART)
+        outer.setPCSide(cast(Any, PETSc.PC.Side.RIGHT))
+        outer.setNormType(cast(Any, PETSc.KSP.NormType.UNPRECONDITIONED))
+        outer.setTolerances(rtol=self._rtol, max_it=5000)
+        pc = outer.getPC()
+        pc.setType(PETSc.PC.Type.PYTHON)
+        pc.setPythonContext(_Cycle(self._ksp))
+        self._outer = outer
+
+    def destroy(self) -> None:
+        """Free the PETSc objects."""
+        self._outer.destroy()
+        super().destroy()
 
     def solve_sets(
         self,
@@ -108,19 +135,15 @@ class FrictionCondensedSolver(CondensedSolver):
             cast(Any, self._K.getSizes()), FrictionOperator(self._K, EC, EG, d), comm=self._comm
         )
         A.setUp()
-        ksp = self._ksp
+        ksp = self._outer
         try:
             with self._options.inserted():
-                self._preconditioner(A, nb)
-                ksp.setType(PETSc.KSP.Type.GMRES)
-                ksp.setGMRESRestart(RESTART)
-                ksp.setPCSide(cast(Any, PETSc.PC.Side.RIGHT))
-                ksp.setNormType(cast(Any, PETSc.KSP.NormType.UNPRECONDITIONED))
-                ksp.setInitialGuessNonzero(True)
-                ksp.setTolerances(rtol=self._rtol)
-                ksp.setUp()
-                t1 = time.perf_counter()
-                ksp.solve(b, v)
+                self._preconditioner(nb)
+            ksp.setOperators(A)
+            ksp.setInitialGuessNonzero(True)
+            ksp.setUp()
+            t1 = time.perf_counter()
+            ksp.solve(b, v)
         except PETSc.Error as err:
             raise SolverError(petsc_error_message(err, "frictional condensed solve")) from None
         reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
@@ -137,16 +160,18 @@ class FrictionCondensedSolver(CondensedSolver):
         self.stats["setup_time"] += t1 - t0
         return FrictionSolve(self._u.array.copy(), mu_n, mu_t, its, t1 - t0, t2 - t1)
 
-    def _preconditioner(self, A: PETSc.Mat, nb: NodeBlocks) -> None:
-        """The multigrid on T^T K T + P (symmetric positive definite) for the operator A."""
+    def _preconditioner(self, nb: NodeBlocks) -> None:
+        """One multigrid cycle on T^T K T + P (symmetric positive definite), set up."""
         ksp, piv = self._ksp, nb.dofs
         S = condensed_matrix(self._K, nb.c_rows, self._r0, piv, self._diag)
         if self._modes:
             S.setNearNullSpace(self._near_nullspace(piv))
         if self._interp:  # before the operators: a rebuild resets the PC
             _geometric_levels(ksp.getPC(), self._interp, piv)
-        ksp.setOperators(A, S)
+        ksp.setOperators(S)
         ksp.setFromOptions()
+        ksp.setType(PETSc.KSP.Type.PREONLY)
+        ksp.setUp()
         if self._A is not None:
             self._A.destroy()
         self._A = S

@@ -42,10 +42,7 @@ class NodeBlocks:
             k = len(piv)
             x = np.linalg.solve(LG.T, residual[at : at + k])
             at += k
-            if k == 2:
-                mu_n[j], mu_t[j] = x
-            else:
-                mu_n[j], mu_t[j] = x[0], coef * x[0]
+            mu_n[j], mu_t[j] = (x[0], x[1]) if k == 2 else (x[0], coef * x[0])
         return mu_n, mu_t
 
 
@@ -56,6 +53,23 @@ def _dense(rows: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.nd
     for i, (c, v) in enumerate(rows):
         block[i, np.searchsorted(cols, c[v != 0.0])] = v[v != 0.0]
     return cols, block
+
+
+def _own(own: np.ndarray, row: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """A row's coefficients on the node's two dofs (0 where absent: a prescribed dof)."""
+    cols, vals = row
+    out = np.zeros(2)
+    for k, d in enumerate(own):
+        out[k] = vals[cols == d].sum()
+    return out
+
+
+def _both_free(
+    own: np.ndarray, n: tuple[np.ndarray, np.ndarray], t: tuple[np.ndarray, np.ndarray]
+) -> bool:
+    """Whether the normal and tangential rows can take both of the node's dofs as pivots."""
+    L = np.vstack([_own(own, n), _own(own, t)])
+    return bool(abs(np.linalg.det(L)) > DIAGONAL_TOL * np.abs(L).max() ** 2)
 
 
 def node_blocks(
@@ -85,7 +99,9 @@ def node_blocks(
         cn, vn = Bn.row(j)
         ct, vt = Bt.row(j)
         own = Bn.node_dofs[j]
-        if stick[j]:
+        # A node with a prescribed displacement (a symmetry line, the axis) has one free dof:
+        # its normal row takes it, its tangential row is dropped (no shear there).
+        if stick[j] and _both_free(own, (cn, vn), (ct, vt)):
             piv = np.asarray(own, dtype=np.int64)
             cols, C = _dense([(cn, vn), (ct, vt)])
             G, rhs = C, np.array([g_n[j], g_t[j]])
@@ -98,12 +114,10 @@ def node_blocks(
                 )
             k = np.flatnonzero(mine)[int(np.argmax(np.abs(vn[mine])))]
             piv = np.array([cn[k]], dtype=np.int64)
-            cols, both = _dense([(cn, vn), (ct, vt)])
-            C, G = both[:1], both[:1] + coef[j] * both[1:]
+            cols, rows = _dense([(cn, vn), (ct, vt)])
+            C, G = rows[:1], rows[:1] + (coef[j] if not stick[j] else 0.0) * rows[1:]
             rhs = np.array([g_n[j]])
         at = np.searchsorted(cols, piv)
-        if not np.array_equal(cols[np.minimum(at, len(cols) - 1)], piv):
-            raise SolverError("a sticking contact node has a prescribed displacement")
         LC, LG = C[:, at], G[:, at]
         EC, EG = -np.linalg.solve(LC, C), -np.linalg.solve(LG, G)
         EC[:, at] = EG[:, at] = -np.eye(len(piv))  # exactly: T and W vanish on the pivots
@@ -112,7 +126,7 @@ def node_blocks(
             g_rows[int(p - r0)] = (cols, EG[i])
         dofs.append(piv)
         shift.append(-np.linalg.solve(LC, rhs))
-        nodes.append((int(j), piv, LG, float(coef[j])))
+        nodes.append((int(j), piv, LG, 0.0 if stick[j] else float(coef[j])))
         others = np.ones(len(cols), dtype=bool)
         others[at] = False
         scale = float(np.abs(LC).max())

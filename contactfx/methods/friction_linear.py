@@ -26,6 +26,12 @@ from ..linalg.condensed_friction import FrictionCondensedSolver
 from ..linalg.petsc_options import PrefixedOptions
 from .solvers import with_ordering, with_sequential_analysis
 
+# A later set's solve on the kept factorization: GMRES, right-preconditioned by it, to this
+# residual (relative to the right-hand side's), in at most MAX_ITS iterations (else the set
+# is factored).
+KEPT_RTOL = 1e-15
+MAX_ITS = 100
+
 
 @dataclass(frozen=True)
 class FrictionSystem:
@@ -66,9 +72,11 @@ class DirectFriction:
         self._given = dict(options or {})
         self._options = PrefixedOptions({})
         self._A: PETSc.Mat | None = None
+        self._P: PETSc.Mat | None = None
         self._ksp: PETSc.KSP | None = None
         self._key: tuple[np.ndarray, ...] = ()
-        self.stats = {"analyses": 0, "factorizations": 0, "assembly": 0.0, "factor": 0.0}
+        self.stats = {"analyses": 0, "factorizations": 0, "gmres": 0, "assembly": 0.0}
+        self.stats["factor"] = 0.0
 
     def bind(self, K: PETSc.Mat, Bn: PETSc.Mat, Bt: PETSc.Mat, f: PETSc.Vec) -> None:
         """The step's operators; the monolithic pattern is rebuilt only where it changed."""
@@ -76,7 +84,7 @@ class DirectFriction:
         mpi = comm.tompi4py()
         self._f = f
         k, n, t = _csr(K), _csr(Bn), _csr(Bt)
-        self._parts = (k, n, t)
+        old, self._parts = getattr(self, "_parts", ()), (k, n, t)
         nu, m = K.getLocalSize()[0], Bn.getLocalSize()[0]
         self._nu, self._m = nu, m
         key = (k[0], k[1], n[0], n[1], t[0], t[1])
@@ -84,6 +92,9 @@ class DirectFriction:
             np.array_equal(a, b) for a, b in zip(key, self._key, strict=True)
         )
         if mpi.allreduce(same, op=MPI.LAND) and self._A is not None:
+            values = all(np.array_equal(a[2], b[2]) for a, b in zip(old, self._parts, strict=True))
+            if not mpi.allreduce(values, op=MPI.LAND):
+                self._law = None  # new values: the kept factorization is not this step's
             return
         self.destroy()
         self._key = key
@@ -116,67 +127,107 @@ class DirectFriction:
             [mapu(k[1]), mapu(n[1]), rows_n[n[0]], mapu(t[1]), rows_t[t[0]], rows_n, rows_n, rows_t]
         )
         size = nu + 2 * m
-        A = PETSc.Mat().create(comm)
-        A.setSizes(((size, PETSc.DETERMINE), (size, PETSc.DETERMINE)))
-        A.setType(PETSc.Mat.Type.AIJ)
         ij = (i.astype(PETSc.IntType), j.astype(PETSc.IntType))
-        A.setPreallocationCOO(cast(Any, ij[0]), cast(Any, ij[1]))
-        self._A = A
-        lu = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+        mats = []
+        for _ in range(2):  # the current set's matrix, and the one last factored
+            M = PETSc.Mat().create(comm)
+            M.setSizes(((size, PETSc.DETERMINE), (size, PETSc.DETERMINE)))
+            M.setType(PETSc.Mat.Type.AIJ)
+            # PETSc may reorder the index arrays in place: each matrix gets its own copy.
+            M.setPreallocationCOO(cast(Any, ij[0].copy()), cast(Any, ij[1].copy()))
+            mats.append(M)
+        self._A, self._P = mats
+        lu = {"pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
         ordered = with_ordering(lu | self._given, K.getSize()[0])
         self._options = PrefixedOptions(with_sequential_analysis(ordered, mpi.size))
         ksp = PETSc.KSP().create(comm)
         ksp.setOptionsPrefix(self._options.prefix)
-        ksp.setOperators(A)
         self._ksp = ksp
-        self._configured = False
+        self._law: np.ndarray | None = None  # the factored set's law per row
+        self._t_factor, self._t_its = 0.0, 0.0  # a numeric factorization, a GMRES iteration
 
     def solve(self, s: FrictionSystem) -> FrictionAnswer:
-        """Write the set's values, factor numerically (the analysis is kept) and solve."""
-        assert self._A is not None and self._ksp is not None
+        """Write the set's values and solve: by the kept factorization or a new one."""
+        assert self._A is not None and self._P is not None and self._ksp is not None
         t0 = time.perf_counter()
         (_, _, kv), (nr, _, nv), (tr, _, tv) = self._parts
         on, stick = s.active.astype(float), s.stick.astype(float)
         v = np.concatenate(
             [kv, nv * on[nr], nv, tv * stick[tr], tv, 1.0 - on, s.slip_coef, 1.0 - stick]
-        )
-        A, ksp = self._A, self._ksp
-        insert = cast(Any, PETSc.InsertMode.INSERT_VALUES)
-        A.setValuesCOO(cast(Any, v.astype(PETSc.ScalarType)), insert)
-        A.assemble()
-        b = A.createVecRight()
+        ).astype(PETSc.ScalarType)
+        self._A.setValuesCOO(cast(Any, v), cast(Any, PETSc.InsertMode.INSERT_VALUES))
+        self._A.assemble()
+        law = np.concatenate([on, stick, s.slip_coef])
+        mpi = self._A.getComm().tompi4py()
+        changed = -1
+        if self._law is not None:
+            rows = (law != self._law).reshape(3, -1).any(axis=0)
+            changed = mpi.allreduce(int(rows.sum()))
+        b = self._A.createVecRight()
         b.array[:] = np.concatenate(
             [self._f.array_r, np.where(s.active, -s.g_n, 0.0), np.where(s.stick, -s.g_t, 0.0)]
         )
         x = b.duplicate()
-        t1 = time.perf_counter()
-        with self._options.inserted():
-            if not self._configured:
-                ksp.setFromOptions()
-                self._configured = True
-                self.stats["analyses"] += 1
-            ksp.setUp()
-        t2 = time.perf_counter()
-        ksp.solve(b, x)
-        if ksp.getConvergedReason() < 0:  # type: ignore[operator]
-            raise SolverError(
-                f"the frictional saddle point's LU failed ({ksp.getConvergedReason()})"
-            )
+        self.stats["assembly"] += time.perf_counter() - t0
+        # GMRES on the kept factorization needs about two iterations per changed row.
+        if changed < 0 or (2 * changed + 2) * self._t_its > self._t_factor:
+            self._factor(v, law)
+            changed = 0
+        if not self._solve(b, x, changed):
+            self._factor(v, law)  # GMRES stalled: solve on a factorization of this set
+            self._solve(b, x, 0)
         nu, m = self._nu, self._m
         out = x.array_r.copy()
         b.destroy()
         x.destroy()
-        self.stats["factorizations"] += 1
-        self.stats["assembly"] += t1 - t0
-        self.stats["factor"] += t2 - t1
         return FrictionAnswer(out[:nu], out[nu : nu + m], out[nu + m :])
+
+    def _factor(self, v: np.ndarray, law: np.ndarray) -> None:
+        """A numeric factorization of the set `v` (the analysis is the first one's)."""
+        assert self._A is not None and self._P is not None and self._ksp is not None
+        t0 = time.perf_counter()
+        self._P.setValuesCOO(cast(Any, v), cast(Any, PETSc.InsertMode.INSERT_VALUES))
+        self._P.assemble()
+        ksp = self._ksp
+        ksp.setOperators(self._A, self._P)
+        with self._options.inserted():
+            if self._law is None:
+                ksp.setFromOptions()
+                self.stats["analyses"] += 1
+            ksp.getPC().setUp()
+        self._law = law.copy()
+        self._t_factor = time.perf_counter() - t0
+        self.stats["factorizations"] += 1
+        self.stats["factor"] += self._t_factor
+
+    def _solve(self, b: PETSc.Vec, x: PETSc.Vec, changed: int) -> bool:
+        """Solve for x: one back-substitution on the factored set, else GMRES (False: stalled)."""
+        assert self._ksp is not None
+        ksp = self._ksp
+        t0 = time.perf_counter()
+        if changed == 0:
+            ksp.setType(PETSc.KSP.Type.PREONLY)
+        else:
+            ksp.setType(PETSc.KSP.Type.GMRES)
+            ksp.setGMRESRestart(MAX_ITS)
+            ksp.setPCSide(cast(Any, PETSc.PC.Side.RIGHT))
+            ksp.setNormType(cast(Any, PETSc.KSP.NormType.UNPRECONDITIONED))
+            ksp.setTolerances(rtol=KEPT_RTOL, atol=0.0, max_it=MAX_ITS)
+        ksp.solve(b, x)
+        its = max(ksp.getIterationNumber(), 1)
+        self._t_its = (time.perf_counter() - t0) / its
+        self.stats["gmres"] += its if changed else 0
+        reason = cast(int, ksp.getConvergedReason())
+        if changed == 0 and reason < 0:
+            raise SolverError(f"the frictional saddle point's LU failed ({reason})")
+        return reason > 0
 
     def destroy(self) -> None:
         """Free the matrix and the factorization."""
-        for obj in (self._ksp, self._A):
+        for obj in (self._ksp, self._A, self._P):
             if obj is not None:
                 obj.destroy()
-        self._ksp, self._A = None, None
+        self._ksp, self._A, self._P = None, None, None
 
 
 class CondensedFriction:
