@@ -24,13 +24,8 @@ from petsc4py import PETSc
 from ..errors import SolverError
 from ..linalg.condensed_friction import FrictionCondensedSolver
 from ..linalg.petsc_options import PrefixedOptions
+from ..linalg.row_update import changed_row_solve
 from .solvers import with_ordering, with_sequential_analysis
-
-# A later set's solve on the kept factorization: GMRES, right-preconditioned by it, to this
-# residual (relative to the right-hand side's), in at most MAX_ITS iterations (else the set
-# is factored).
-KEPT_RTOL = 1e-15
-MAX_ITS = 100
 
 
 @dataclass(frozen=True)
@@ -75,7 +70,8 @@ class DirectFriction:
         self._P: PETSc.Mat | None = None
         self._ksp: PETSc.KSP | None = None
         self._key: tuple[np.ndarray, ...] = ()
-        self.stats = {"analyses": 0, "factorizations": 0, "gmres": 0, "assembly": 0.0}
+        self._law: np.ndarray | None = None  # the factored set's law per row
+        self.stats = {"analyses": 0, "factorizations": 0, "updated": 0, "assembly": 0.0}
         self.stats["factor"] = 0.0
 
     def bind(self, K: PETSc.Mat, Bn: PETSc.Mat, Bt: PETSc.Mat, f: PETSc.Vec) -> None:
@@ -111,6 +107,7 @@ class DirectFriction:
         rows_u = base + np.arange(nu)
         rows_n = base + nu + np.arange(m)
         rows_t = rows_n + m
+        self._rows_nt = (rows_n, rows_t)
         i = np.concatenate(
             [
                 rows_u[k[0]],
@@ -137,14 +134,15 @@ class DirectFriction:
             M.setPreallocationCOO(cast(Any, ij[0].copy()), cast(Any, ij[1].copy()))
             mats.append(M)
         self._A, self._P = mats
-        lu = {"pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+        lu = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
         ordered = with_ordering(lu | self._given, K.getSize()[0])
         self._options = PrefixedOptions(with_sequential_analysis(ordered, mpi.size))
         ksp = PETSc.KSP().create(comm)
         ksp.setOptionsPrefix(self._options.prefix)
         self._ksp = ksp
-        self._law: np.ndarray | None = None  # the factored set's law per row
-        self._t_factor, self._t_its = 0.0, 0.0  # a numeric factorization, a GMRES iteration
+        self._law = None
+        self._configured = False
+        self._t_factor, self._t_bs = 0.0, 0.0  # a numeric factorization, a back-substitution
 
     def solve(self, s: FrictionSystem) -> FrictionAnswer:
         """Write the set's values and solve: by the kept factorization or a new one."""
@@ -169,13 +167,18 @@ class DirectFriction:
         )
         x = b.duplicate()
         self.stats["assembly"] += time.perf_counter() - t0
-        # GMRES on the kept factorization needs about two iterations per changed row.
-        if changed < 0 or (2 * changed + 2) * self._t_its > self._t_factor:
+        # The kept factorization costs a back-substitution per changed row (two rows a node).
+        if changed < 0 or (2 * changed + 4) * self._t_bs > self._t_factor:
             self._factor(v, law)
-            changed = 0
-        if not self._solve(b, x, changed):
-            self._factor(v, law)  # GMRES stalled: solve on a factorization of this set
-            self._solve(b, x, 0)
+        if self._law is not None and np.array_equal(law, self._law):
+            self._back_substitution(b, x)
+        else:
+            assert self._law is not None
+            nodes = (law != self._law).reshape(3, -1).any(axis=0)
+            rows = np.sort(np.concatenate([r[nodes] for r in self._rows_nt]))
+            F = self._ksp.getPC().getFactorMatrix()
+            changed_row_solve(F, self._A, self._P, rows, b, x)
+            self.stats["updated"] += 1
         nu, m = self._nu, self._m
         out = x.array_r.copy()
         b.destroy()
@@ -189,38 +192,27 @@ class DirectFriction:
         self._P.setValuesCOO(cast(Any, v), cast(Any, PETSc.InsertMode.INSERT_VALUES))
         self._P.assemble()
         ksp = self._ksp
-        ksp.setOperators(self._A, self._P)
+        ksp.setOperators(self._P)
         with self._options.inserted():
-            if self._law is None:
+            if not self._configured:
                 ksp.setFromOptions()
+                self._configured = True
                 self.stats["analyses"] += 1
-            ksp.getPC().setUp()
+            ksp.setUp()
         self._law = law.copy()
         self._t_factor = time.perf_counter() - t0
         self.stats["factorizations"] += 1
         self.stats["factor"] += self._t_factor
 
-    def _solve(self, b: PETSc.Vec, x: PETSc.Vec, changed: int) -> bool:
-        """Solve for x: one back-substitution on the factored set, else GMRES (False: stalled)."""
+    def _back_substitution(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
+        """Solve on the factored set itself."""
         assert self._ksp is not None
-        ksp = self._ksp
         t0 = time.perf_counter()
-        if changed == 0:
-            ksp.setType(PETSc.KSP.Type.PREONLY)
-        else:
-            ksp.setType(PETSc.KSP.Type.GMRES)
-            ksp.setGMRESRestart(MAX_ITS)
-            ksp.setPCSide(cast(Any, PETSc.PC.Side.RIGHT))
-            ksp.setNormType(cast(Any, PETSc.KSP.NormType.UNPRECONDITIONED))
-            ksp.setTolerances(rtol=KEPT_RTOL, atol=0.0, max_it=MAX_ITS)
-        ksp.solve(b, x)
-        its = max(ksp.getIterationNumber(), 1)
-        self._t_its = (time.perf_counter() - t0) / its
-        self.stats["gmres"] += its if changed else 0
-        reason = cast(int, ksp.getConvergedReason())
-        if changed == 0 and reason < 0:
+        self._ksp.solve(b, x)
+        self._t_bs = time.perf_counter() - t0
+        reason = cast(int, self._ksp.getConvergedReason())
+        if reason < 0:
             raise SolverError(f"the frictional saddle point's LU failed ({reason})")
-        return reason > 0
 
     def destroy(self) -> None:
         """Free the matrix and the factorization."""
