@@ -6,8 +6,10 @@ A = P + E_R D, E_R the unit columns of the changed rows R, D = (A - P)_R. Woodbu
 
 one multi-right-hand-side solve for Z (|R| columns) and one back-substitution, exact as a
 factorization of A (the r x r capacitance matrix is dense and small); one step of iterative
-refinement on A's own residual follows. The frictional saddle point changes only in the
-multiplier rows of nodes whose law changed (methods/friction_linear.py).
+refinement on A's own residual follows. Z's columns depend on P and R only: they are kept
+for the later sets on the same factorization, which solve only for rows that are new. The
+frictional saddle point changes only in the multiplier rows of nodes whose law changed
+(methods/friction_linear.py).
 """
 
 from __future__ import annotations
@@ -18,58 +20,89 @@ import numpy as np
 from petsc4py import PETSc
 
 
-def changed_row_solve(
-    F: PETSc.Mat, A: PETSc.Mat, P: PETSc.Mat, rows: np.ndarray, b: PETSc.Vec, x: PETSc.Vec
-) -> None:
-    """Solve A x = b with F = the factorization of P; `rows`: owned global rows where A != P."""
-    comm = A.getComm()
-    mpi = comm.tompi4py()
-    r0, r1 = A.getOwnershipRange()
-    counts = mpi.allgather(len(rows))
-    r, off = sum(counts), sum(counts[: mpi.rank])
-    indptr, cols, vals = [0], [], []
-    for g in rows:
-        ca, va = A.getRow(int(g))
-        cp, vp = P.getRow(int(g))
-        assert np.array_equal(ca, cp)  # one pattern
-        d = np.asarray(va) - np.asarray(vp)
-        keep = d != 0.0
-        cols.append(np.asarray(ca)[keep])
-        vals.append(d[keep])
-        indptr.append(indptr[-1] + int(keep.sum()))
-    n_loc = r1 - r0
-    csr: Any = (
-        np.asarray(indptr, dtype=PETSc.IntType),
-        (np.concatenate(cols) if cols else np.zeros(0)).astype(PETSc.IntType),
-        (np.concatenate(vals) if vals else np.zeros(0)).astype(PETSc.ScalarType),
-    )
-    D = PETSc.Mat().createAIJ(size=((len(rows), r), (n_loc, PETSc.DETERMINE)), csr=csr, comm=comm)
-    D.assemble()
-    # The right-hand sides E_R: column off + k is the unit vector of this rank's row k.
-    E = PETSc.Mat().createDense(size=((n_loc, PETSc.DETERMINE), (PETSc.DECIDE, r)), comm=comm)
-    E.setUp()
-    for k, g in enumerate(rows):
-        E.setValue(int(g), off + k, 1.0)
-    E.assemble()
-    Z = E.duplicate()
-    F.matSolve(E, Z)
-    DZ = D.matMult(Z)
-    C = np.eye(r) + np.vstack(mpi.allgather(np.asarray(DZ.getDenseArray()).reshape(-1, r)))
-    Zl = np.asarray(Z.getDenseArray()).reshape(-1, r)
-    w = D.createVecLeft()
-    res = b.duplicate()
-    x.set(0.0)
-    res.set(0.0)
-    res.axpy(1.0, b)
-    for _ in range(2):  # the solve, then one refinement on A's residual
-        y = b.duplicate()
-        F.solve(res, y)
-        D.mult(y, w)
-        c = np.linalg.solve(C, np.concatenate(mpi.allgather(w.array_r.copy())))
-        y.array[:] = y.array_r - np.asarray(Zl @ c, dtype=float)
-        x.axpy(1.0, y)
-        y.destroy()
-        A.mult(x, res)
-        res.aypx(-1.0, b)
-    for obj in (D, E, Z, DZ, w, res):
-        obj.destroy()
+class KeptFactorization:
+    """Woodbury solves on one factorization F of P, Z's columns kept by row."""
+
+    def __init__(self, F: PETSc.Mat) -> None:
+        self._F = F
+        self._columns: dict[int, np.ndarray] = {}  # global row -> this rank's part of Z e_row
+        self.columns_solved = 0
+
+    def has(self, row: int) -> bool:
+        """Whether Z's column of global row `row` is kept."""
+        return row in self._columns
+
+    def _z(self, rows_all: np.ndarray, n_loc: int, comm: PETSc.Comm) -> np.ndarray:
+        """This rank's rows of Z = P^-1 E_R (R = `rows_all`, every rank's, in order)."""
+        new = [int(g) for g in rows_all if int(g) not in self._columns]
+        if new:
+            r0, r1 = self._F.getOwnershipRange()
+            E = PETSc.Mat().createDense(
+                size=((n_loc, PETSc.DETERMINE), (PETSc.DECIDE, len(new))), comm=comm
+            )
+            E.setUp()
+            for k, g in enumerate(new):
+                if r0 <= g < r1:
+                    E.setValue(g, k, 1.0)
+            E.assemble()
+            Z = E.duplicate()
+            self._F.matSolve(E, Z)
+            block = np.asarray(Z.getDenseArray()).reshape(n_loc, len(new))
+            for k, g in enumerate(new):
+                self._columns[g] = block[:, k].copy()
+            self.columns_solved += len(new)
+            E.destroy()
+            Z.destroy()
+        if not len(rows_all):
+            return np.zeros((n_loc, 0))
+        return np.column_stack([self._columns[int(g)] for g in rows_all])
+
+    def solve(
+        self, A: PETSc.Mat, P: PETSc.Mat, rows: np.ndarray, b: PETSc.Vec, x: PETSc.Vec
+    ) -> None:
+        """Solve A x = b; `rows`: this rank's global rows where A != P (same pattern)."""
+        comm = A.getComm()
+        mpi = comm.tompi4py()
+        r0, r1 = A.getOwnershipRange()
+        n_loc = r1 - r0
+        rows_all = np.concatenate(mpi.allgather(np.asarray(rows, dtype=np.int64)))
+        r = len(rows_all)
+        indptr, cols, vals = [0], [], []
+        for g in rows:
+            ca, va = A.getRow(int(g))
+            _, vp = P.getRow(int(g))
+            d = np.asarray(va) - np.asarray(vp)
+            keep = d != 0.0
+            cols.append(np.asarray(ca)[keep])
+            vals.append(d[keep])
+            indptr.append(indptr[-1] + int(keep.sum()))
+        csr: Any = (
+            np.asarray(indptr, dtype=PETSc.IntType),
+            (np.concatenate(cols) if cols else np.zeros(0)).astype(PETSc.IntType),
+            (np.concatenate(vals) if vals else np.zeros(0)).astype(PETSc.ScalarType),
+        )
+        size: Any = ((len(rows), r), (n_loc, PETSc.DETERMINE))
+        D = PETSc.Mat().createAIJ(size=size, csr=csr, comm=comm)
+        D.assemble()
+        Zl = self._z(rows_all, n_loc, comm)
+        # D Z, row by row of D: its columns' rows of Z may be another rank's (a vector each).
+        Zv, w = A.createVecRight(), D.createVecLeft()
+        DZ = np.zeros((r, r))
+        for k in range(r):
+            Zv.array[:] = Zl[:, k]
+            D.mult(Zv, w)
+            DZ[:, k] = np.concatenate(mpi.allgather(w.array_r.copy()))
+        C = np.eye(r) + DZ
+        res, y = b.duplicate(), b.duplicate()
+        x.set(0.0)
+        b.copy(res)
+        for _ in range(2):  # the solve, then one refinement on A's residual
+            self._F.solve(res, y)
+            D.mult(y, w)
+            c = np.linalg.solve(C, np.concatenate(mpi.allgather(w.array_r.copy())))
+            y.array[:] = y.array_r - np.asarray(Zl @ c, dtype=float)
+            x.axpy(1.0, y)
+            A.mult(x, res)
+            res.aypx(-1.0, b)
+        for obj in (D, Zv, w, res, y):
+            obj.destroy()

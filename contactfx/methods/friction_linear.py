@@ -24,8 +24,14 @@ from petsc4py import PETSc
 from ..errors import SolverError
 from ..linalg.condensed_friction import FrictionCondensedSolver
 from ..linalg.petsc_options import PrefixedOptions
-from ..linalg.row_update import changed_row_solve
+from ..linalg.row_update import KeptFactorization
 from .solvers import with_ordering, with_sequential_analysis
+
+# A column of the changed rows' block solve relative to one back-substitution (about 0.4
+# at 166k DOFs: benchmarks/README.md, friction_cost.py), and the most memory the kept
+# columns (a dense vector each) may take.
+COLUMN_COST = 0.4
+KEPT_BYTES = 2**28
 
 
 @dataclass(frozen=True)
@@ -71,6 +77,7 @@ class DirectFriction:
         self._ksp: PETSc.KSP | None = None
         self._key: tuple[np.ndarray, ...] = ()
         self._law: np.ndarray | None = None  # the factored set's law per row
+        self._kept: KeptFactorization | None = None
         self.stats = {"analyses": 0, "factorizations": 0, "updated": 0, "assembly": 0.0}
         self.stats["factor"] = 0.0
 
@@ -90,7 +97,7 @@ class DirectFriction:
         if mpi.allreduce(same, op=MPI.LAND) and self._A is not None:
             values = all(np.array_equal(a[2], b[2]) for a, b in zip(old, self._parts, strict=True))
             if not mpi.allreduce(values, op=MPI.LAND):
-                self._law = None  # new values: the kept factorization is not this step's
+                self._law, self._kept = None, None  # new values: not this factorization's
             return
         self.destroy()
         self._key = key
@@ -140,7 +147,7 @@ class DirectFriction:
         ksp = PETSc.KSP().create(comm)
         ksp.setOptionsPrefix(self._options.prefix)
         self._ksp = ksp
-        self._law = None
+        self._law, self._kept = None, None
         self._configured = False
         self._t_factor, self._t_bs = 0.0, 0.0  # a numeric factorization, a back-substitution
 
@@ -157,33 +164,45 @@ class DirectFriction:
         self._A.assemble()
         law = np.concatenate([on, stick, s.slip_coef])
         mpi = self._A.getComm().tompi4py()
-        changed = -1
-        if self._law is not None:
-            rows = (law != self._law).reshape(3, -1).any(axis=0)
-            changed = mpi.allreduce(int(rows.sum()))
         b = self._A.createVecRight()
         b.array[:] = np.concatenate(
             [self._f.array_r, np.where(s.active, -s.g_n, 0.0), np.where(s.stick, -s.g_t, 0.0)]
         )
         x = b.duplicate()
         self.stats["assembly"] += time.perf_counter() - t0
-        # The kept factorization costs a back-substitution per changed row (two rows a node).
-        if changed < 0 or (2 * changed + 4) * self._t_bs > self._t_factor:
-            self._factor(v, law)
-        if self._law is not None and np.array_equal(law, self._law):
-            self._back_substitution(b, x)
-        else:
-            assert self._law is not None
+        rows = np.zeros(0, dtype=np.int64)
+        if self._law is not None:
             nodes = (law != self._law).reshape(3, -1).any(axis=0)
             rows = np.sort(np.concatenate([r[nodes] for r in self._rows_nt]))
-            F = self._ksp.getPC().getFactorMatrix()
-            changed_row_solve(F, self._A, self._P, rows, b, x)
+        if self._refactor(rows, mpi):
+            self._factor(v, law)
+            rows = rows[:0]
+        if mpi.allreduce(len(rows)) == 0:
+            self._back_substitution(b, x)
+        else:
+            assert self._kept is not None
+            self._kept.solve(self._A, self._P, rows, b, x)
             self.stats["updated"] += 1
         nu, m = self._nu, self._m
         out = x.array_r.copy()
         b.destroy()
         x.destroy()
         return FrictionAnswer(out[:nu], out[nu : nu + m], out[nu + m :])
+
+    def _refactor(self, rows: np.ndarray, mpi: MPI.Comm) -> bool:
+        """Whether a new factorization costs less than a solve on the kept one.
+
+        That solve costs two back-substitutions and a block solve with a column per row
+        not met before on this factorization (each about COLUMN_COST of one); the kept
+        columns are bounded by KEPT_BYTES.
+        """
+        if self._kept is None:
+            return True
+        new = mpi.allreduce(sum(1 for g in rows if not self._kept.has(int(g))))
+        total = mpi.allreduce(len(rows))
+        if total * 8 * max(self._nu + 2 * self._m, 1) > KEPT_BYTES:
+            return True
+        return (2.0 + COLUMN_COST * new) * self._t_bs > self._t_factor
 
     def _factor(self, v: np.ndarray, law: np.ndarray) -> None:
         """A numeric factorization of the set `v` (the analysis is the first one's)."""
@@ -200,6 +219,7 @@ class DirectFriction:
                 self.stats["analyses"] += 1
             ksp.setUp()
         self._law = law.copy()
+        self._kept = KeptFactorization(ksp.getPC().getFactorMatrix())
         self._t_factor = time.perf_counter() - t0
         self.stats["factorizations"] += 1
         self.stats["factor"] += self._t_factor
