@@ -131,17 +131,25 @@ def mirrored_hertz(refine: float, mu: float) -> Any:
     return check_scene(scene)
 
 
-def one(refine: float, solver: str, mu: float) -> dict[str, Any]:
+def half_hertz(refine: float, mu: float) -> Any:
+    """The built-in Hertz half model (structured, its geometric levels), pressed only."""
+    from contactfx.scenes import HertzParams, hertz
+
+    return hertz(HertzParams(mesh="structured", refine=refine, h_far=10 * refine, mu=mu))
+
+
+def one(family: str, refine: float, solver: str, mu: float) -> dict[str, Any]:
     """One run: the scene meshed, then solved and timed; what it cost and found."""
     from contactfx import solve
 
     t0 = time.perf_counter()
-    scene = mirrored_hertz(refine, mu)
+    scene = mirrored_hertz(refine, mu) if family == "pushed" else half_hertz(refine, mu)
     t1 = time.perf_counter()
     sol = solve(scene, "mortar", basis="dual", solver=solver)
     t2 = time.perf_counter()
     steps = sol.steps or [sol]
     out: dict[str, Any] = {
+        "family": family,
         "refine": refine,
         "solver": solver,
         "mu": mu,
@@ -162,8 +170,10 @@ def one(refine: float, solver: str, mu: float) -> dict[str, Any]:
     return out
 
 
-def _child(refine: float, solver: str, mu: float, timeout: float) -> dict[str, Any] | None:
-    cmd = [sys.executable, __file__, "one", str(refine), solver, str(mu)]
+def _child(
+    family: str, refine: float, solver: str, mu: float, timeout: float
+) -> dict[str, Any] | None:
+    cmd = [sys.executable, __file__, "one", family, str(refine), solver, str(mu)]
     try:
         done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
@@ -231,7 +241,7 @@ def chart(rows: list[dict[str, Any]]) -> None:
 
 if __name__ == "__main__":
     if sys.argv[1] == "one":
-        print(json.dumps(one(float(sys.argv[2]), sys.argv[3], float(sys.argv[4]))))
+        print(json.dumps(one(sys.argv[2], float(sys.argv[3]), sys.argv[4], float(sys.argv[5]))))
     elif sys.argv[1] == "sweep":
         sweep([float(a) for a in sys.argv[2:]] or list(REFINES))
     else:

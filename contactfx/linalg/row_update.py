@@ -5,19 +5,26 @@ A = P + E_R D, E_R the unit columns of the changed rows R, D = (A - P)_R. Woodbu
     x = y - Z (I + D Z)^-1 D y,    y = P^-1 b,  Z = P^-1 E_R,
 
 one multi-right-hand-side solve for Z (|R| columns) and one back-substitution, exact as a
-factorization of A (the r x r capacitance matrix is dense and small); one step of iterative
-refinement on A's own residual follows. Z's columns depend on P and R only: they are kept
-for the later sets on the same factorization, which solve only for rows that are new. The
+factorization of A up to the capacitance matrix's conditioning (r x r, dense); iterative
+refinement on A's own residual follows, to a fresh factorization's residual. Z's columns
+depend on P and R only: they are kept for the later sets on the same factorization, which
+solve only for rows that are new. The
 frictional saddle point changes only in the multiplier rows of nodes whose law changed
 (methods/friction_linear.py).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from petsc4py import PETSc
+
+# Steps of iterative refinement at most after the Woodbury solve (one back-substitution each).
+# The residual's norm measures the displacement rows; the multipliers' own accuracy needs
+# the refinement to go on to round-off: until a step reduces it by less than 1 / STALL.
+REFINEMENTS = 4
+STALL = 0.5
 
 
 class KeptFactorization:
@@ -58,9 +65,18 @@ class KeptFactorization:
         return np.column_stack([self._columns[int(g)] for g in rows_all])
 
     def solve(
-        self, A: PETSc.Mat, P: PETSc.Mat, rows: np.ndarray, b: PETSc.Vec, x: PETSc.Vec
-    ) -> None:
-        """Solve A x = b; `rows`: this rank's global rows where A != P (same pattern)."""
+        self,
+        A: PETSc.Mat,
+        P: PETSc.Mat,
+        rows: np.ndarray,
+        b: PETSc.Vec,
+        x: PETSc.Vec,
+        rtol: float,
+    ) -> bool:
+        """Solve A x = b to A's relative residual `rtol` (False: refinement did not reach it).
+
+        `rows`: this rank's global rows where A != P (the same pattern).
+        """
         comm = A.getComm()
         mpi = comm.tompi4py()
         r0, r1 = A.getOwnershipRange()
@@ -96,7 +112,9 @@ class KeptFactorization:
         res, y = b.duplicate(), b.duplicate()
         x.set(0.0)
         b.copy(res)
-        for _ in range(2):  # the solve, then one refinement on A's residual
+        b_norm = max(float(cast(Any, b.norm())), 1e-300)
+        ok, last = False, float("inf")
+        for _ in range(REFINEMENTS + 1):  # the solve, then refinement on A's own residual
             self._F.solve(res, y)
             D.mult(y, w)
             c = np.linalg.solve(C, np.concatenate(mpi.allgather(w.array_r.copy())))
@@ -104,5 +122,11 @@ class KeptFactorization:
             x.axpy(1.0, y)
             A.mult(x, res)
             res.aypx(-1.0, b)
+            now = float(cast(Any, res.norm()))
+            ok = now <= rtol * b_norm
+            if now > STALL * last:  # round-off: more steps do not help
+                break
+            last = now
         for obj in (D, Zv, w, res, y):
             obj.destroy()
+        return ok

@@ -29,7 +29,7 @@ With every mu = 0 nothing here runs: the frictionless path is unchanged.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from dolfinx import fem
@@ -43,13 +43,14 @@ from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
 from ..errors import InputError, SingularSystemError, SolverError
 from ..linalg.condensed_friction import FrictionCondensedSolver
-from ..options import Basis, Discretization, Enforcement, SolverKind, System
+from ..options import Basis, Discretization, Enforcement, Predictor, SolverKind, System
 from ..request import SolveRequest
 from ..scenes import Scene
 from ..scenes.steps import step_scenes
 from ..timers import Timers
-from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .active_set import ActiveSetOptions, InitialSet, Proposal, Step, run_active_set
 from .friction_linear import CondensedFriction, DirectFriction, FrictionSystem
+from .predictor import predict
 from .solution import Solution, finish
 from .solvers import setup_solver
 
@@ -275,9 +276,24 @@ def solve_friction(
     condensed = request.solver.traits.system is System.CONDENSED
     # One LU for the whole load history: its pattern and analysis outlive the steps.
     direct = None if condensed else DirectFriction()
+    scenes = step_scenes(scene)
+    # The frictionless coarse predictor's contact set joins the first step's first set (a
+    # frictional set differs from it by the stick and slip zones): fewer sets to visit.
+    # No probes here: the coarse solve pays wherever the scene can be remeshed.
+    coarse = request.predictor is Predictor.AUTO and scenes[0].can_remesh
     try:
-        for k, step_scene in enumerate(step_scenes(scene)):
-            sol, state = _solve_step(step_scene, request, timers, aso, state, direct)
+        guess = predict(
+            scenes[0],
+            replace(request, predictor=Predictor.COARSE) if coarse else request,
+            aso,
+            timers,
+        )
+    except SingularSystemError as err:
+        raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
+    try:
+        for k, step_scene in enumerate(scenes):
+            sol, state = _solve_step(step_scene, request, timers, aso, state, direct, guess)
+            guess = None
             if scene.steps and scene.comm.rank == 0:
                 log.info("step %d: %d iterations", k + 1, sol.iterations)
             sols.append(sol)
@@ -296,6 +312,7 @@ def _solve_step(
     aso: ActiveSetOptions,
     before: StepState | None,
     direct: DirectFriction | None,
+    guess: InitialSet | None = None,
 ) -> tuple[Solution, StepState]:
     """One load step of `solve_friction`, from the state the step before left."""
     kernel = request.discretization.kernel
@@ -323,6 +340,8 @@ def _solve_step(
         # The first set: the rows within h / 10 of touching (no predictor on this path; a
         # curved contact touching at one node would leave the body free to rotate).
         active = setup.initial_active(START_BAND * setup.h)
+        if guess is not None:
+            active = active | np.asarray(guess.active(setup.layout.x[setup.layout.mine]), bool)
         if before is not None:
             if len(before.active) != len(active):
                 raise SolverError("the contact rows changed between load steps")

@@ -32,6 +32,10 @@ from .solvers import with_ordering, with_sequential_analysis
 # columns (a dense vector each) may take.
 COLUMN_COST = 0.4
 KEPT_BYTES = 2**28
+# A solve on the kept factorization is refined to the residual of the factorization's own
+# back-substitution (times ROUNDOFF), or FLOOR_RTOL; else the set is factored: the loop's
+# decisions then do not depend on which way a set was solved.
+ROUNDOFF, FLOOR_RTOL = 2.0, 1e-15
 
 
 @dataclass(frozen=True)
@@ -150,6 +154,7 @@ class DirectFriction:
         self._law, self._kept = None, None
         self._configured = False
         self._t_factor, self._t_bs = 0.0, 0.0  # a numeric factorization, a back-substitution
+        self._res_bs = 0.0  # the relative residual of the last back-substitution
 
     def solve(self, s: FrictionSystem) -> FrictionAnswer:
         """Write the set's values and solve: by the kept factorization or a new one."""
@@ -181,8 +186,12 @@ class DirectFriction:
             self._back_substitution(b, x)
         else:
             assert self._kept is not None
-            self._kept.solve(self._A, self._P, rows, b, x)
-            self.stats["updated"] += 1
+            rtol = max(ROUNDOFF * self._res_bs, FLOOR_RTOL)
+            if self._kept.solve(self._A, self._P, rows, b, x, rtol):
+                self.stats["updated"] += 1
+            else:  # the kept factorization is too far from this set: a new one
+                self._factor(v, law)
+                self._back_substitution(b, x)
         nu, m = self._nu, self._m
         out = x.array_r.copy()
         b.destroy()
@@ -230,6 +239,12 @@ class DirectFriction:
         t0 = time.perf_counter()
         self._ksp.solve(b, x)
         self._t_bs = time.perf_counter() - t0
+        assert self._A is not None
+        r = b.duplicate()
+        self._A.mult(x, r)
+        r.aypx(-1.0, b)
+        self._res_bs = float(cast(Any, r.norm())) / max(float(cast(Any, b.norm())), 1e-300)
+        r.destroy()
         reason = cast(int, self._ksp.getConvergedReason())
         if reason < 0:
             raise SolverError(f"the frictional saddle point's LU failed ({reason})")
