@@ -44,8 +44,6 @@ MU = 0.3
 # The press and the push (cm): the cylinder's top face moved down, then sideways.
 PRESS, PUSH = 0.1, 0.02
 SOLVERS = ("mumps", "condensed-gamg")
-# Contact element sizes (h_far = 10 h, slope 0.1): about 20k to 2M DOFs.
-REFINES = (0.25, 0.12, 0.06, 0.035, 0.025, 0.015)
 DIRECT_STOP_S, DIRECT_STOP_GB = 60.0, 2.5
 
 
@@ -185,64 +183,111 @@ def _child(
     return dict(json.loads(lines[-1]))
 
 
-def sweep(refines: list[float]) -> None:
-    """Each size on each path, mu = 0.3 then 0; the JSON, the chart and a table."""
-    rows: list[dict[str, Any]] = []
-    direct_on = True
-    for refine in refines:
-        for solver in SOLVERS:
-            if solver == "mumps" and not direct_on:
-                continue
-            runs = {}
-            for mu in (MU, 0.0):
-                runs[mu] = _child(refine, solver, mu, 600.0)
-            fr, fl = runs[MU], runs[0.0]
-            if fr is None or fl is None:
-                print(f"h {refine} {solver}: failed", flush=True)
-                direct_on = direct_on and solver != "mumps"
-                continue
-            row = {"refine": refine, "solver": solver, "dofs": fr["dofs"], "friction": fr}
-            row |= {"frictionless": fl, "ratio": fr["solve_s"] / fl["solve_s"]}
-            rows.append(row)
-            print(
-                f"{fr['dofs']:>9} {solver:>15}: mu 0.3 {fr['solve_s']:7.2f} s "
-                f"its {fr['iterations']}, mu 0 {fl['solve_s']:7.2f} s its {fl['iterations']}, "
-                f"ratio {row['ratio']:.2f}, Q/muP {fr['Q'] / (MU * fr['P']):.3f}, "
-                f"peak {fr['peak_gb']:.2f} GB",
-                flush=True,
-            )
-            too_big = fr["solve_s"] > DIRECT_STOP_S or fr["peak_gb"] > DIRECT_STOP_GB
-            if solver == "mumps" and too_big:
-                direct_on = False
-            (HERE / "friction_cost.json").write_text(json.dumps(rows, indent=1) + "\n")
+# Each family's sizes (contact element size) and solver paths, the condensed path of the
+# pushed family (GAMG, no geometric levels) up to CONDENSED_GAMG_MAX DOFs.
+PLAN = {
+    "hertz": ((0.12, 0.06, 0.03, 0.02, 0.014, 0.011), ("mumps", "condensed")),
+    "pushed": ((0.25, 0.12, 0.06, 0.035, 0.025), ("mumps", "condensed-gamg")),
+}
+CONDENSED_GAMG_MAX = 500_000
+REPEATS_BELOW = 200_000  # sizes below this many DOFs run three times (medians)
+
+
+def sweep(families: list[str]) -> None:
+    """Each family's sizes on each path, mu = 0.3 and 0 in turn; the JSON, chart, table."""
+    path = HERE / "friction_cost.json"
+    rows: list[dict[str, Any]] = json.loads(path.read_text()) if path.exists() else []
+    rows = [r for r in rows if r["family"] not in families]
+    for family in families:
+        refines, solvers = PLAN[family]
+        for solver in solvers:
+            for refine in refines:
+                row = _measure(family, refine, solver)
+                if row is None:
+                    break
+                rows.append(row)
+                path.write_text(json.dumps(rows, indent=1) + "\n")
+                fr = row["friction"][0]
+                if solver == "mumps" and (
+                    fr["solve_s"] > DIRECT_STOP_S or fr["peak_gb"] > DIRECT_STOP_GB
+                ):
+                    break
+                if solver == "condensed-gamg" and fr["dofs"] > CONDENSED_GAMG_MAX / 2:
+                    break
     chart(rows)
 
 
+def _measure(family: str, refine: float, solver: str) -> dict[str, Any] | None:
+    """mu = 0.3 and mu = 0 alternately (three times below REPEATS_BELOW DOFs)."""
+    fr: list[dict[str, Any]] = []
+    fl: list[dict[str, Any]] = []
+    for k in range(3):
+        a = _child(family, refine, solver, MU, 900.0)
+        b = _child(family, refine, solver, 0.0, 900.0)
+        if a is None or b is None:
+            print(f"{family} h {refine} {solver}: failed or timed out", flush=True)
+            return None
+        fr.append(a)
+        fl.append(b)
+        if a["dofs"] >= REPEATS_BELOW or k == 2:
+            break
+    ratios = [a["solve_s"] / b["solve_s"] for a, b in zip(fr, fl, strict=True)]
+    row = {"family": family, "refine": refine, "solver": solver, "dofs": fr[0]["dofs"]}
+    row |= {"friction": fr, "frictionless": fl, "ratio": float(np.median(ratios))}
+    row["ratios"] = ratios
+    a, b = fr[0], fl[0]
+    print(
+        f"{family:>6} {a['dofs']:>9} {solver:>15}: mu 0.3 "
+        f"{np.median([r['solve_s'] for r in fr]):7.2f} s its {a['iterations']}, mu 0 "
+        f"{np.median([r['solve_s'] for r in fl]):7.2f} s its {b['iterations']}, ratio "
+        f"{row['ratio']:.2f} (of {len(ratios)}), peak {a['peak_gb']:.2f} GB",
+        flush=True,
+    )
+    return row
+
+
 def chart(rows: list[dict[str, Any]]) -> None:
-    """Frictional over frictionless time against the DOFs, one line per path."""
+    """Frictional over frictionless time against the DOFs, one line per family and path."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 3.6))
-    for solver, marker in zip(SOLVERS, "os", strict=True):
-        mine = [r for r in rows if r["solver"] == solver]
-        ax.semilogx([r["dofs"] for r in mine], [r["ratio"] for r in mine], marker=marker,
-                    label=solver)  # fmt: skip
-    ax.axhline(2.0, color="k", lw=0.8, ls="--", label="target 2x")
+    fig, ax = plt.subplots(figsize=(6.4, 3.8))
+    for (family, (_, solvers)), style in zip(PLAN.items(), ("-", "--"), strict=True):
+        for solver, marker in zip(solvers, "os", strict=True):
+            mine = [r for r in rows if r["solver"] == solver and r["family"] == family]
+            if mine:
+                ax.semilogx([r["dofs"] for r in mine], [r["ratio"] for r in mine], style,
+                            marker=marker, label=f"{family}, {solver}")  # fmt: skip
+    ax.axhline(2.0, color="k", lw=0.8, ls=":", label="target 2x")
     ax.set_xlabel("DOFs")
     ax.set_ylabel("time mu = 0.3 / time mu = 0")
-    ax.set_title("Pressed and pushed cylinder: friction's cost (2 load steps)")
-    ax.legend()
+    ax.set_title("Friction's cost (hertz: pressed; pushed: pressed, then pushed)")
+    ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(HERE / "friction_cost.png", dpi=90)
+
+
+def table(rows: list[dict[str, Any]]) -> None:
+    """The README's rows: family, path, DOFs, times, iterations per step, ratio."""
+    for r in rows:
+        a, b = r["friction"][0], r["frictionless"][0]
+        ta = np.median([x["solve_s"] for x in r["friction"]])
+        tb = np.median([x["solve_s"] for x in r["frictionless"]])
+        print(
+            f"| {r['family']} | {r['solver']} | {r['dofs']:,} | {ta:.2f} | {tb:.2f} | "
+            f"{r['ratio']:.2f} ({len(r['ratios'])}) | {a['iterations']} | {b['iterations']} | "
+            f"{a['peak_gb']:.2f} |"
+        )
 
 
 if __name__ == "__main__":
     if sys.argv[1] == "one":
         print(json.dumps(one(sys.argv[2], float(sys.argv[3]), sys.argv[4], float(sys.argv[5]))))
     elif sys.argv[1] == "sweep":
-        sweep([float(a) for a in sys.argv[2:]] or list(REFINES))
+        sweep(sys.argv[2:] or list(PLAN))
     else:
-        chart(json.loads((HERE / "friction_cost.json").read_text()))
+        done = json.loads((HERE / "friction_cost.json").read_text())
+        chart(done)
+        table(done)
