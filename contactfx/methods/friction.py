@@ -11,7 +11,10 @@ mu_n = -lambda_n, mu_t = +lambda_t, so K u + B^T mu = f):
     stick: weighted gap 0, weighted slip increment 0  (B_n, B_t rows on)
     slip:  weighted gap 0, lambda_t = mu s lambda_n   (B_n row on; mu_t + mu s mu_n = 0: C_tn)
 
-C_tn makes the system unsymmetric: it is factored by LU (MUMPS). The next set is
+C_tn makes the system unsymmetric: it is factored by LU (MUMPS) on one fixed pattern whose
+analysis and last factorization serve the later sets (methods/friction_linear.py), or, with
+dual mortar and the condensed solver, the multipliers are eliminated node by node and GMRES
+solves the unsymmetric displacement system (linalg/condensed_friction.py). The next set is
 contact/friction.py's classification of the solution, with the complementarity constants
 c_n = c_t = E_max / h (tractions against E times a strain: no user constant, no units). The
 loop is the one of active_set.py: the normal set is its `active`, and a change of a row's
@@ -19,10 +22,12 @@ stick/slip status or slip direction keeps it going (`Step.changed`, `SetHistory.
 The slip increment is measured from the previous load step (quasi-static).
 
 Supported: nts and mortar (standard and dual basis) with Lagrange multipliers on the direct
-saddle-point path, every model, pairs between bodies and against rigid obstacles (their rows
-along the obstacle's exact tangent; the obstacle's prescribed motion enters the slip).
-Refused in one line (`refuse_friction`): sts, penalty, Schwarz, an iterative or condensed
-solver.
+saddle-point path, dual mortar on the condensed path, every model, pairs between bodies and
+against rigid obstacles (their rows along the obstacle's exact tangent; the obstacle's
+prescribed motion enters the slip). The first step's first set adds the frictionless coarse
+predictor's contact set where the scene can be remeshed. Refused in one line
+(`refuse_friction`): sts, penalty, Schwarz, the fieldsplit solvers, the condensed solver on
+nts or standard mortar.
 With every mu = 0 nothing here runs: the frictionless path is unchanged.
 """
 
