@@ -46,7 +46,7 @@ from ..contact.friction import FrictionResult, Status, classify, ncp
 from ..contact.sparse import CSR
 from ..discretize.coupling import constrained_rows, global_dirichlet_dofs, petsc_constraint
 from ..discretize.setup import ContactSetup, prepare_contact, prescribed_gap_shift
-from ..errors import InputError, SingularSystemError, SolverError
+from ..errors import InputError, MeshError, SingularSystemError, SolverError
 from ..linalg.condensed_friction import FrictionCondensedSolver
 from ..options import Basis, Discretization, Enforcement, Predictor, SolverKind, System
 from ..request import SolveRequest
@@ -295,6 +295,10 @@ def solve_friction(
         )
     except SingularSystemError as err:
         raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
+    except MeshError as err:  # a geometry gmsh cannot mesh coarser: start without the guess
+        if scene.comm.rank == 0:
+            log.info("coarse predictor: %s; starting without it", err)
+        guess = None
     try:
         for k, step_scene in enumerate(scenes):
             sol, state = _solve_step(step_scene, request, timers, aso, state, direct, guess)
@@ -327,6 +331,10 @@ def _solve_step(
         )
     except SingularSystemError as err:
         raise SingularSystemError(f"{err} (friction does not hold a body yet)") from None
+    except MeshError as err:  # a geometry gmsh cannot mesh coarser: start without the guess
+        if scene.comm.rank == 0:
+            log.info("coarse predictor: %s; starting without it", err)
+        guess = None
     try:
         with timers("contact"):
             Bt, shift_t, tangent, free_t, moving = tangent_constraint(
