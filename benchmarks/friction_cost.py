@@ -1,27 +1,34 @@
 """What friction costs: a frictional solve over the frictionless one, both solver paths.
 
-A cylinder (R = 60) pressed on a block and then pushed sideways: the built-in Hertz scene's
-structured grid (contactfx.meshes.hertz_grid_part) mirrored about x = 0 into a full model
-(a push breaks the half model's symmetry), E = 7000, nu = 0.23, dual mortar. The cylinder's
-top face carries the line load P = 100 (named `press`) and a prescribed u_x (named `push`,
-0 in the first step: it also holds the cylinder sideways); the block's bottom is clamped.
-Two load steps: {press = 1}, then {push = 1}. Each run is one process; the time is the
-wall time of `contactfx.solve` (assembly, contact search, every load step), the mesh apart.
+Two families (PLAN), E = 7000, nu = 0.23, dual mortar, mu = 0.3 against mu = 0:
 
-Compared, per mesh and solver path: mu = 0.3 over mu = 0 on the same scene with the same
-two steps (frictionless, each step is its own solve, so the reference is two solves: the
-press alone and the final loads, press and push). Paths: `mumps` (frictionless: LDL^T of the
-saddle point; frictional: LU of the unsymmetric saddle point, its analysis kept) and
-`condensed-gamg` (frictionless: CG; frictional: GMRES; GAMG on the condensed operator: the
-mirrored grid has no geometric levels).
+- `hertz`: the built-in Hertz half model on its structured grid (`--mesh structured
+  --refine H --h-far 10H`), pressed with friction in one step; paths `mumps` and
+  `condensed` (its geometric multigrid).
+- `pushed`: a cylinder (R = 60) on a block, the same grid (contactfx.meshes.hertz_grid_part)
+  mirrored about x = 0 into a full model (a push breaks the half model's symmetry); the
+  cylinder's top face moved down by PRESS (named `press`) and then sideways by PUSH (named
+  `push`; 0 in the first step, which also holds the cylinder sideways), the block's bottom
+  clamped. Two load steps: {press = 1}, then {push = 1}. Paths `mumps` and `condensed-gamg`
+  (GAMG: the mirrored grid has no geometric levels).
 
-    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py sweep            # the table
-    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py one 0.2 condensed-gamg 0.3
+Each run is one process; the time is the wall time of `contactfx.solve` (assembly, search,
+predictor, every load step), the mesh apart. The frictionless reference is the same scene
+with the same steps and solver (without friction each step is its own solve: for `pushed`,
+two solves, the press alone and the final loads). Paths: `mumps` (frictionless: LDL^T of the
+saddle point; frictional: LU of the unsymmetric one, analysis and factorization kept) and
+the condensed ones (frictionless: CG; frictional: GMRES).
 
-(`one REFINE SOLVER MU` prints one run's JSON line; `sweep [REFINE ...]` runs each in a
-child process, writes friction_cost.json and friction_cost.png.) The direct path stops
-after the first size whose frictional run took over 60 s or 2.5 GB (the next, about twice
-the DOFs, would pass 3 minutes or 5 GB).
+    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py sweep [hertz] [pushed]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py table    # README rows, chart
+    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py one pushed 0.06 mumps 0.3
+
+(`one FAMILY REFINE SOLVER MU` prints one run's JSON line; `sweep` runs each in a child
+process and writes friction_cost.json and friction_cost.png; about 26 minutes on the shared
+2-core machine.) The direct path stops after the first size whose frictional run took over
+60 s or 2.5 GB (the next, about twice the DOFs, would pass 3 minutes or 5 GB); the
+condensed-gamg path after the first size over CONDENSED_GAMG_MAX / 2 DOFs (GAMG's setup on
+this mesh costs minutes from 500k).
 """
 
 from __future__ import annotations
