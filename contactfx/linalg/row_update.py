@@ -123,6 +123,9 @@ class KeptFactorization:
             A.mult(x, res)
             res.aypx(-1.0, b)
             now = float(cast(Any, res.norm()))
+            if now > last:  # the step made it worse: undo it (round-off reached)
+                x.axpy(-1.0, y)
+                break
             ok = now <= rtol * b_norm
             if now > STALL * last:  # round-off: more steps do not help
                 break

@@ -35,7 +35,7 @@ KEPT_BYTES = 2**28
 # A solve on the kept factorization is refined to the residual of the factorization's own
 # back-substitution (times ROUNDOFF), or FLOOR_RTOL; else the set is factored: the loop's
 # decisions then do not depend on which way a set was solved.
-ROUNDOFF, FLOOR_RTOL = 2.0, 1e-15
+ROUNDOFF, FLOOR_RTOL = 10.0, 1e-15
 
 
 @dataclass(frozen=True)
