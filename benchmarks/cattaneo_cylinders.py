@@ -5,14 +5,14 @@ nu = 0.3, mu = 0.3: the lower flat face held, the upper one moved down by `press
 flat face, no tilt) and then sideways by `push`, mortar on the direct path. The computed P and
 Q give Cattaneo-Mindlin's line contact (R_eff = R / 2, the pair's E*); the stick half-width
 read from the statuses and the shear's relative L2 error come from
-contactfx.results.friction_references.cattaneo_errors. The table of docs/friction.md:
+contactfx.results.friction_references.cattaneo_errors. The table of docs/friction_verification.md:
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/cattaneo_cylinders.py 0.004 0.03 0.01
     OPENBLAS_NUM_THREADS=1 python benchmarks/cattaneo_cylinders.py 0.0012 0.0037 0.0008
     OPENBLAS_NUM_THREADS=1 python benchmarks/cattaneo_cylinders.py 0.002 0.03 0.01
 
 (arguments: h, press, push; the second about a minute on one loaded core). Rows in the
-bisector frame (docs/friction.md).
+bisector frame (docs/friction_verification.md).
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ relative L2 error (`cattaneo_errors`, the scene's own `[[reference]] type = "cat
 slip law on the slip nodes, step 1's shear (the locked-in shear the mirror removes), the
 interpolation floor (the L2 error of the closed form's own nodal values, interpolated as the
 computed shear is), the solve's wall time and the Newton (active-set) iterations per step.
-The table of docs/friction.md (about four minutes on one core; the machine was shared):
+The table of docs/friction_verification.md (about four minutes on one core; the machine was shared):
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/cattaneo_mirrored.py \
         --factors 4 2 1 0.7 --json benchmarks/cattaneo_mirrored.json
@@ -68,7 +68,7 @@ def run(factor: float, method: str) -> dict[str, Any]:
 
 
 def table(rows: list[dict[str, Any]]) -> str:
-    """The markdown table of docs/friction.md."""
+    """The markdown table of docs/friction_verification.md."""
     head = (
         "| method | size factor | DOFs | $a/h$ | stick half-width $-\\, c$ | shear $L^2$ error "
         "| interpolation floor | slip law | step 1 shear | iterations | time |\n"

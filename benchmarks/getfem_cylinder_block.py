@@ -13,7 +13,7 @@ and the non-symmetric Alart-Curnier law lam = Coulomb_friction_coupled_projectio
 slip, gap, mu, r) (GetFEM's operator, r = E / h) tested with the multiplier's test functions,
 Newton on the whole system with MUMPS. `--frame flat`: n the block's normal, (0, -1);
 `--frame bisector`: the bisector of the block's and the cylinder's normals, as contactfx's
-rows (docs/friction.md). GetFEM's packaged brick
+rows (docs/friction_verification.md). GetFEM's packaged brick
 (`add_integral_contact_between_nonmatching_meshes_brick`) is not usable here: it projects
 only points closer to the master than 5 % of an element (getfem_projected_fem.cc), so the
 cylinder's initial gap leaves all but a few points out of contact.

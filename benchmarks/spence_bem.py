@@ -12,13 +12,14 @@ history, as the slope of the stick cell count over the contact cell count in the
 the loading (the problem is self-similar, so the slope is c/a). Goodman's approximation drops H
 from u_z (the shear no longer moves the surface normally).
 
-This is route (b) of docs/friction.md; route (a) is friction_references.spence_stick_ratio (the
-self-similar reduction to a flat-punch increment). Run:
+This is route (b) of docs/friction_verification.md; route (a) is
+friction_references.spence_stick_ratio (the self-similar reduction to a flat-punch increment). Run:
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/spence_bem.py --json benchmarks/spence_bem.json
 
 (about ten minutes on one loaded core) prints, per (mu, nu), both routes and Goodman's, and
-writes them; `--table benchmarks/spence_bem.json` prints docs/friction.md's table from them.
+writes them; `--table benchmarks/spence_bem.json` prints docs/friction_verification.md's
+table from them.
 """
 
 from __future__ import annotations
@@ -144,7 +145,7 @@ def stick_ratio(history: dict[str, np.ndarray]) -> float:
 
 
 def table(rows: list[dict[str, float]]) -> str:
-    """The docs' markdown table (docs/friction.md) of the recorded rows."""
+    """The docs' markdown table (docs/friction_verification.md) of the recorded rows."""
     out = [
         "| mu | nu | beta | mu / beta | c/a (a) self-similar | c/a (b) BEM | (a) - (b) "
         "| Goodman (a) | Goodman (b) |",

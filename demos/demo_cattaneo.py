@@ -37,7 +37,7 @@ PRESS, PUSH = 0.03, 0.01
 # The element size at the contact: about 25 cells across a (10 in the quick run).
 H = 0.01 if QUICK else 0.004
 # The shear's relative L2 error measured at these sizes: 10.1 % and 3.3 %; the asserts
-# below keep a band above each (docs/friction.md lists the measured errors).
+# below keep a band above each (docs/friction_verification.md lists the measured errors).
 L2_BOUND = 0.12 if QUICK else 0.04
 # -
 

@@ -6,7 +6,7 @@
 # inwards. Spence (1975) showed that the problem is self-similar: as the load grows, $c/a$
 # stays constant, at a value that depends on $\mu$ and on $\nu$: 0.689 for
 # $\mu = \nu = 0.3$ (`spence_stick_ratio`, checked against an independent half-plane
-# boundary-element computation in docs/friction.md).
+# boundary-element computation in docs/friction_verification.md).
 #
 # The scene is `demos/scenes/spence_indenter.toml`: a block ($E = 7000$, $\nu = 0.3$,
 # plane strain, half model) 100 wide and deep, so that the contact sees a half-plane, under a

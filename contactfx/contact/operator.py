@@ -118,7 +118,8 @@ def bisector_normals(passive_normals: np.ndarray, active_normals: np.ndarray) ->
     half the angle between them. Friction needs that interface's frame: along the passive
     tangent, the closing of the initial gap reads as slip, and a pressure along the passive
     normal carries a shear, so mirrored cylinders pressed with friction locked in a shear
-    that the physics (their mirror symmetry) rules out (docs/friction.md, Cattaneo-Mindlin).
+    that the physics (their mirror symmetry) rules out (docs/friction_verification.md,
+    Cattaneo-Mindlin).
     The bisector is the same whichever side is active, and the passive normal on flat faces.
     """
     n = passive_normals - active_normals

@@ -11,19 +11,26 @@ mu_n = -lambda_n, mu_t = +lambda_t, so K u + B^T mu = f):
     stick: weighted gap 0, weighted slip increment 0  (B_n, B_t rows on)
     slip:  weighted gap 0, lambda_t = mu s lambda_n   (B_n row on; mu_t + mu s mu_n = 0: C_tn)
 
-C_tn makes the system unsymmetric: it is factored by LU (MUMPS). The next set is
+C_tn makes the system unsymmetric: it is factored by LU (MUMPS) on one fixed pattern whose
+analysis and last factorization serve the later sets (methods/friction_linear.py), or, with
+dual mortar and the condensed solver, the multipliers are eliminated node by node and GMRES
+solves the unsymmetric displacement system (linalg/condensed_friction.py). The next set is
 contact/friction.py's classification of the solution, with the complementarity constants
-c_n = c_t = E_max / h (tractions against E times a strain: no user constant, no units). The
-loop is the one of active_set.py: the normal set is its `active`, and a change of a row's
-stick/slip status or slip direction keeps it going (`Step.changed`, `SetHistory.visit`'s key).
-The slip increment is measured from the previous load step (quasi-static).
+c_n = c_t = E_max / h (tractions against E times a strain: no user constant, no units), each
+solve a semismooth Newton step shortened where it does not lower the complementarity
+residual (contact/friction.py, damped_length). The loop is the one of active_set.py: the
+normal set is its `active`, and a change of a row's stick/slip status or slip direction keeps
+it going (`Step.changed`, `SetHistory.visit`'s key). The slip increment is measured from the
+previous load step (quasi-static).
 
 Supported: nts and mortar (standard and dual basis) with Lagrange multipliers on the direct
-saddle-point path, every model, pairs between bodies and against rigid obstacles (their rows
-along the obstacle's exact tangent; the obstacle's prescribed motion enters the slip). The
-penalty enforcement's regularized Coulomb law on the same rows: methods/penalty_friction.py.
-Refused in one line (`refuse_friction`): sts (either enforcement), Schwarz, an iterative or
-condensed solver.
+saddle-point path, dual mortar on the condensed path, every model, pairs between bodies and
+against rigid obstacles (their rows along the obstacle's exact tangent; the obstacle's
+prescribed motion enters the slip). The first step's first set adds the frictionless coarse
+predictor's contact set where the scene can be remeshed. The penalty enforcement's
+regularized Coulomb law on the same rows: methods/penalty_friction.py. Refused in one line
+(`refuse_friction`): sts (either enforcement), Schwarz, the fieldsplit solvers, the condensed
+solver on nts or standard mortar.
 With every mu = 0 nothing here runs: the frictionless path is unchanged.
 """
 
@@ -31,7 +38,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from dolfinx import fem
@@ -48,16 +55,19 @@ from ..contact.friction import (
     ncp,
 )
 from ..discretize.setup import ContactSetup, prepare_contact
-from ..errors import InputError, SolverError
-from ..linalg.blocks import diagonal_matrix
-from ..options import Discretization, Enforcement, SolverKind
+from ..errors import InputError, MeshError, SingularSystemError, SolverError
+from ..linalg.condensed_friction import FrictionCondensedSolver
+from ..options import Basis, Discretization, Enforcement, Predictor, SolverKind, System
 from ..request import SolveRequest
 from ..scenes import Scene
 from ..scenes.steps import step_scenes
 from ..timers import Timers
-from .active_set import ActiveSetOptions, Proposal, Step, run_active_set
+from .active_set import ActiveSetOptions, InitialSet, Proposal, Step, run_active_set
+from .friction_linear import CondensedFriction, DirectFriction, FrictionSystem
 from .friction_tangents import FRAME, tangent_constraint
+from .predictor import predict
 from .solution import Solution, finish
+from .solvers import setup_solver
 
 log = logging.getLogger("contactfx")
 
@@ -65,8 +75,8 @@ log = logging.getLogger("contactfx")
 START_BAND = 0.1
 
 SUPPORTED = (
-    "nts or mortar (standard or dual) with multipliers and a direct solver (mumps), "
-    "or the penalty enforcement on nts or mortar"
+    "nts or mortar (standard or dual) with multipliers and a direct solver (mumps), dual "
+    "mortar with the condensed solver, or the penalty enforcement on nts or mortar"
 )
 
 
@@ -95,13 +105,19 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
     if not pairs:
         return
     why = ""
+    multipliers = request.enforcement is Enforcement.MULTIPLIERS
+    dual = request.discretization is Discretization.MORTAR and request.basis is Basis.DUAL
     if request.enforcement is Enforcement.SCHWARZ:
         why = f"the {request.enforcement.value} enforcement"
     elif request.discretization is Discretization.STS:
         why = "sts"  # its kernel has no tangential rows
-    elif request.enforcement is Enforcement.MULTIPLIERS and request.solver.kind not in (
+    elif multipliers and request.solver.kind is SolverKind.CONDENSED and not dual:
+        how = f"{request.discretization.value} ({request.basis.value} basis)"
+        why = f"the {request.solver.name} solver on {how}, which needs dual mortar"
+    elif multipliers and request.solver.kind not in (
         SolverKind.DIRECT,
         SolverKind.AUTO,
+        SolverKind.CONDENSED,
     ):
         why = f"the {request.solver.name} solver"
     if why:
@@ -109,13 +125,6 @@ def refuse_friction(scene: Scene, request: SolveRequest) -> None:
             f"{_pair_label(scene, pairs[0])}: Coulomb friction is not solved with {why}; it "
             f"is solved by {SUPPORTED} (or set mu = 0)"
         )
-
-
-def _vec(comm: MPI.Comm, values: np.ndarray) -> PETSc.Vec:
-    """A distributed vector holding this rank's `values`."""
-    v = PETSc.Vec().createMPI((len(values), PETSc.DETERMINE), comm=comm)  # type: ignore[arg-type]
-    v.array[:] = values
-    return v
 
 
 class FrictionIteration:
@@ -131,8 +140,11 @@ class FrictionIteration:
         Bt: PETSc.Mat,
         shift_t: np.ndarray,
         free_t: np.ndarray,
+        linear: DirectFriction | CondensedFriction,
     ) -> None:
         self.setup, self.Bt, self.shift_t, self.free_t = setup, Bt, shift_t, free_t
+        self.linear = linear
+        self.krylov = 0
         layout = setup.layout
         mus = pair_mu(scene)
         self.mu = np.array([mus[int(k)] for k in layout.pair[layout.mine]])
@@ -158,58 +170,16 @@ class FrictionIteration:
         return rows + 4 * self.epochs.epoch
 
     def solve(self, active: np.ndarray, it: int) -> Step:
-        """One LU solve of the frictional saddle point on `active` and the friction sets."""
+        """One solve of the frictional saddle point on `active` and the friction sets."""
         setup, comm = self.setup, self.setup.comm
-        el = setup.elasticity
-        on = np.asarray(active, dtype=float)
         # A row without a free tangential dof neither sticks nor slips: lambda_t = 0.
         stick = active & self.stick & self.free_t
         slip = active & ~self.stick & self.free_t
-        # Row blocks: the normal rows where in contact, the tangential rows where sticking.
-        Bn_a, Bt_a = setup.B.copy(), self.Bt.copy()
-        Bn_a.diagonalScale(L=_vec(comm, on))
-        Bt_a.diagonalScale(L=_vec(comm, stick.astype(float)))
-        BnT, BtT = setup.B.copy().transpose(), self.Bt.copy().transpose()
-        Cnn = diagonal_matrix(setup.B.getComm(), 1.0 - on, self.offset)
-        Ctn = diagonal_matrix(
-            setup.B.getComm(), np.where(slip, self.mu * self.sign, 0.0), self.offset
-        )
-        Ctt = diagonal_matrix(setup.B.getComm(), 1.0 - stick, self.offset)
-        nest = PETSc.Mat().createNest(
-            [[el.K, BnT, BtT], [Bn_a, Cnn, None], [Bt_a, Ctn, Ctt]],  # type: ignore[list-item]
-            comm=setup.B.getComm(),
-        )
-        rows, _ = nest.getNestISs()
-        A = nest.convert("aij", PETSc.Mat())
-        b = A.createVecRight()
-        parts = (
-            el.f.array_r,
-            np.where(active, -setup.g, 0.0),
-            np.where(stick, self.ut_prev - self.shift_t, 0.0),
-        )
-        for iset, values in zip(rows, parts, strict=True):
-            sub = b.getSubVector(iset)
-            sub.array[:] = values
-            b.restoreSubVector(iset, sub)
-        x = b.duplicate()
-        ksp = PETSc.KSP().create(A.getComm())
-        ksp.setOperators(A)
-        ksp.setType("preonly")
-        ksp.getPC().setType("lu")
-        ksp.getPC().setFactorSolverType("mumps")
-        ksp.solve(b, x)
-        if ksp.getConvergedReason() < 0:  # type: ignore[operator]
-            raise SolverError(
-                f"the frictional saddle point's LU failed ({ksp.getConvergedReason()})"
-            )
-        out = []
-        for iset in rows:
-            sub = x.getSubVector(iset)
-            out.append(sub.array_r.copy())
-            x.restoreSubVector(iset, sub)
-        for obj in (ksp, A, nest, Bn_a, Bt_a, BnT, BtT, Cnn, Ctn, Ctt, b, x):
-            obj.destroy()
-        u, mu_n, mu_t = out
+        coef = np.where(slip, self.mu * self.sign, 0.0)
+        system = FrictionSystem(active, stick, coef, setup.g, self.shift_t - self.ut_prev)
+        answer = self.linear.solve(system)
+        self.krylov += answer.iterations
+        u, mu_n, mu_t = answer.u, answer.mu_n, answer.mu_t
         lam_n, lam_t = np.where(active, -mu_n, 0.0), np.where(active, mu_t, 0.0)
         w = setup.w
         start = self.u.x.petsc_vec.array_r.copy()
@@ -304,7 +274,41 @@ def solve_friction(
     `refuse_friction` has passed. Each load step's slip increment is measured from the step
     before (quasi-static).
     """
-    return in_steps(scene, lambda s, before: _solve_step(s, request, timers, aso, before))
+    # One LU for the whole load history: its pattern and analysis outlive the steps.
+    condensed = request.solver.traits.system is System.CONDENSED
+    direct = None if condensed else DirectFriction()
+    guesses = [_coarse_guess(step_scenes(scene)[0], request, aso, timers)]
+
+    def one(s: Scene, before: StepState | None) -> tuple[Solution, StepState]:
+        guess = guesses.pop() if guesses else None
+        return _solve_step(s, request, timers, aso, before, direct, guess)
+
+    try:
+        return in_steps(scene, one)
+    finally:
+        if direct is not None:
+            direct.destroy()
+
+
+def _coarse_guess(
+    scene: Scene, request: SolveRequest, aso: ActiveSetOptions, timers: Timers
+) -> InitialSet | None:
+    """The frictionless coarse predictor's contact set for the first step's first set.
+
+    A frictional set differs from it by the stick and slip zones: fewer sets to visit. No
+    probes here: the coarse solve pays wherever the scene can be remeshed. None where the
+    frictionless scene is not held (a body held by friction alone) or cannot be meshed
+    coarser.
+    """
+    coarse = request.predictor is Predictor.AUTO and scene.can_remesh
+    try:
+        return predict(
+            scene, replace(request, predictor=Predictor.COARSE) if coarse else request, aso, timers
+        )
+    except (SingularSystemError, MeshError) as err:
+        if scene.comm.rank == 0:
+            log.info("coarse predictor: %s; starting without it", err)
+        return None
 
 
 def in_steps[S](scene: Scene, one: Callable[[Scene, S | None], tuple[Solution, S]]) -> Solution:
@@ -330,6 +334,8 @@ def _solve_step(
     timers: Timers,
     aso: ActiveSetOptions,
     before: StepState | None,
+    direct: DirectFriction | None,
+    guess: InitialSet | None = None,
 ) -> tuple[Solution, StepState]:
     """One load step of `solve_friction`, from the state the step before left."""
     kernel = request.discretization.kernel
@@ -341,10 +347,21 @@ def _solve_step(
             Bt, shift_t, tangent, free_t, moving = tangent_constraint(
                 scene, setup, request.basis, kernel
             )
-        iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t)
-        # The first set: the rows within h / 10 of touching (no predictor on this path; a
+        el = setup.elasticity
+        linear: DirectFriction | CondensedFriction
+        if direct is not None:
+            direct.bind(el.K, setup.B, Bt, el.f)
+            linear = direct
+        else:
+            solver = setup_solver(setup, request.solver, scene, reuse=True, tangent=Bt)
+            assert isinstance(solver, FrictionCondensedSolver)
+            linear = CondensedFriction(solver)
+        iteration = FrictionIteration(scene, setup, Bt, shift_t, free_t, linear)
+        # The first set: the rows within h / 10 of touching, with the coarse predictor's (a
         # curved contact touching at one node would leave the body free to rotate).
         active = setup.initial_active(START_BAND * setup.h)
+        if guess is not None:
+            active = active | np.asarray(guess.active(setup.layout.x[setup.layout.mine]), bool)
         if before is not None:
             if len(before.active) != len(active):
                 raise SolverError("the contact rows changed between load steps")
@@ -357,6 +374,8 @@ def _solve_step(
             step, active, history = run_active_set(setup, iteration, active, aso, timers)
         finally:
             Bt.destroy()
+            if direct is None:
+                linear.destroy()
         sol = finish(
             setup, request.method, scene, iteration.u, step.lam, step.gap, active, history, timers
         )

@@ -109,6 +109,7 @@ def make_solver(
     node_dofs: np.ndarray,
     reuse: bool = True,
     grid: Callable[[], list[PETSc.Mat]] | None = None,
+    tangent: PETSc.Mat | None = None,
 ) -> LinearSolver:
     """The solver `spec` asks for, on K, B (this rank's rows) and f.
 
@@ -117,7 +118,8 @@ def make_solver(
     condensed solver's pivots); `reuse` False: a throwaway solver for one set; `grid()`: the
     prolongations of the scene's coarser grids, if it has them (a condensed spec with
     `Multigrid.GEOMETRIC` then runs a geometric multigrid). An `auto` spec must be resolved
-    first (methods/autosolve.py); here it is its direct path.
+    first (methods/autosolve.py); here it is its direct path. `tangent`: friction's
+    tangential rows (a condensed spec then gives a FrictionCondensedSolver).
     """
     spec = direct_path(spec)
     traits = spec.traits
@@ -129,7 +131,13 @@ def make_solver(
         if reuse and K.getComm().tompi4py().rank == 0:
             how = f"geometric, {len(levels)} coarser levels" if levels else "GAMG (algebraic)"
             log.info("multigrid: %s", how)
-        return CondensedSolver(
+        cls: type[CondensedSolver] = CondensedSolver
+        extra: dict[str, PETSc.Mat] = {}
+        if tangent is not None:
+            from ..linalg.condensed_friction import FrictionCondensedSolver
+
+            cls, extra = FrictionCondensedSolver, {"Bt": tangent}
+        return cls(
             K,
             B,
             f,
@@ -141,6 +149,7 @@ def make_solver(
             reuse=reuse,
             free_products=spec.free_products and not reuses_interpolation(spec.petsc),
             interpolations=levels,
+            **extra,
         )
     nullspace = None
     if traits.rigid_modes:
@@ -171,6 +180,7 @@ def setup_solver(
     *,
     reuse: bool,
     grid: Callable[[], list[PETSc.Mat]] | None = None,
+    tangent: PETSc.Mat | None = None,
 ) -> LinearSolver:
     """The solver of a contact setup's saddle points (reuse: it keeps its setup across sets).
 
@@ -193,4 +203,5 @@ def setup_solver(
         node_dofs=setup.node_dofs(),
         reuse=reuse,
         grid=grid,
+        tangent=tangent,
     )

@@ -235,7 +235,7 @@ class CattaneoCheck:
 
 # A push-out: the active surface's normal may lean this far from radial (round-off of a
 # cylinder), and in full slip the ratio and the slip law must hold to this (round-off of
-# the multipliers: measured 1e-15 and 2e-16, docs/friction.md).
+# the multipliers: measured 1e-15 and 2e-16, docs/friction_verification.md).
 CYLINDER_TOL = 1e-6
 COULOMB_TOL = 1e-6
 
@@ -323,7 +323,7 @@ class PushoutFit:
     length, which a frictionless fit meets) is the reference the error is taken against;
     plane strain (eps_z = 0) is the value above it: stick friction holds the axial strains
     the fit's Poisson effect would slide by and raises the pressure towards it (a bonded fit
-    stays below: shaft and hub share one axial strain, not zero; docs/friction.md).
+    stays below: shaft and hub share one axial strain, not zero; docs/friction_verification.md).
     """
 
     p_mean: float  # sum p_j w_j / sum w_j at step 1
@@ -395,7 +395,7 @@ class PushoutSummary:
 
 # Spence's analysis is the limit a/R -> 0: beyond this a/R the cylinder's tilt across the
 # contact moved the measured stick edge out by more than the done-when's 1.5 cells
-# (docs/friction.md, Spence, "Finite a/R").
+# (docs/friction_verification.md, Spence, "Finite a/R").
 SPENCE_AR_MAX = 0.02
 
 

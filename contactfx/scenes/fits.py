@@ -104,7 +104,7 @@ class PushoutReference:
     contact node slips with |shear| = mu p. `mu` None takes the pair's. With the rings' radii
     (a, b, c; `delta` None: the pair's `interference = D`) the first step, the fit before the
     push, is compared with Lame's open-ended cylinder and its plane-strain value
-    (docs/friction.md, "The push-out of a press fit").
+    (docs/friction_verification.md, "The push-out of a press fit").
     """
 
     pair: int = 0

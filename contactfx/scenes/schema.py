@@ -106,7 +106,7 @@ SECTIONS: dict[str, tuple[Key, ...]] = {
             "number",
             "0",
             "Coulomb friction coefficient (0: frictionless)",
-            "mu < 0; mu > 0 with sts, penalty, schwarz, a condensed solver (docs/friction.md)",
+            "mu < 0; mu > 0 with sts, penalty, schwarz, fieldsplit, condensed but not dual mortar",
         ),
     ),
     "dirichlet": (

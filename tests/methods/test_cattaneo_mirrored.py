@@ -9,7 +9,7 @@ contact, a/h = 100, 9,060 DOFs): the mesh is a mirror image, the approach locks 
 (`cattaneo_errors`) is pinned (a regression lock: refresh by printing `check.shear_l2` after
 an intended change of the mesh or the method). The scene's own size (factor 1, a/h = 200,
 30,668 DOFs) meets the 1.5 % bound with both methods in about half a minute each:
-benchmarks/cattaneo_mirrored.py and its JSON, docs/friction.md.
+benchmarks/cattaneo_mirrored.py and its JSON, docs/friction_verification.md.
 """
 
 from __future__ import annotations

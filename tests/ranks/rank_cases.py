@@ -258,6 +258,11 @@ def held_sideways() -> tuple[Solution, Arrays]:
 CASES["cli-friction-held-sideways"] = Case(
     held_sideways, {"forces": Abs(1e-9 * 10.0), "shear": Abs(1e-9 * 10.0), "status": Exact()}
 )
+# The condensed dual path: GMRES to rtol 1e-9 (the frictionless condensed case's 1e-6).
+CASES["cli-friction-push-condensed"] = Case(
+    friction_push("--basis", "dual", "--solver", "condensed"),
+    {"forces": Abs(1e-6 * 10.0), "shear": Abs(1e-6 * 10.0), "status": Exact()},
+)
 
 
 def pushout() -> tuple[Solution, Arrays]:

@@ -7,7 +7,8 @@ regime), coarsened for speed (size factor 2: a/h up to ~23 over 8 steps growing 
 each): the stick half-width from the statuses within 1.5 contact cells of Spence's at every
 step after the first,
 no active-set cycle (nts, mortar, dual mortar); step 1, a single step from zero, is not Spence's
-(docs/friction.md: measured c/a = 0.33 and 0.24); and the scene-file plumbing and its refusals.
+(docs/friction_verification.md: measured c/a = 0.33 and 0.24); and the scene-file plumbing
+and its refusals.
 """
 
 from __future__ import annotations
