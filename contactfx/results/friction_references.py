@@ -9,7 +9,8 @@
   half-width a, which depends on the friction coefficient and on Poisson's ratio (through the
   coupling constant beta). docs/friction_verification.md derives the formulation;
   benchmarks/spence_bem.py is the second, independent route (the loading history by a
-  half-plane boundary-element method). `half_plane_influence` holds the surface Green's functions both use.
+  half-plane boundary-element method). `half_plane_influence` holds the surface Green's
+  functions both use.
 
 Conventions of the half-plane functions: x along the surface, p > 0 a compressive pressure on the
 half-plane, q its shear along +x; u_z the surface displacement into the solid, u_x along +x;
@@ -267,8 +268,8 @@ def spence_stick_ratio(mu: float, nu: float, n: int = 300, coupled: bool = True)
 
     Spence's self-similar reduction (docs/friction_verification.md): the load increment is a
     flat-punch problem whose stick zone is c/a; c/a is the root of the slip rate's sqrt(x - c)
-    term at the stick edge (a wrong c gives a slip against the shear on one side of the root, or a shear
-    above mu p inside the stick zone on the other). coupled=False is Goodman's approximation
+    term at the stick edge (a wrong c gives a slip against the shear on one side of the root,
+    or a shear above mu p inside the stick zone on the other). coupled=False is Goodman's approximation
     (the shear's effect on the pressure dropped): c/a then depends on mu / beta only.
     """
     # scipy only here: a run with a Cattaneo reference imports this module, and the command
