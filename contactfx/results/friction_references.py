@@ -269,8 +269,9 @@ def spence_stick_ratio(mu: float, nu: float, n: int = 300, coupled: bool = True)
     Spence's self-similar reduction (docs/friction_verification.md): the load increment is a
     flat-punch problem whose stick zone is c/a; c/a is the root of the slip rate's sqrt(x - c)
     term at the stick edge (a wrong c gives a slip against the shear on one side of the root,
-    or a shear above mu p inside the stick zone on the other). coupled=False is Goodman's approximation
-    (the shear's effect on the pressure dropped): c/a then depends on mu / beta only.
+    or a shear above mu p inside the stick zone on the other). coupled=False is Goodman's
+    approximation (the shear's effect on the pressure dropped): c/a then depends on mu / beta
+    only.
     """
     # scipy only here: a run with a Cattaneo reference imports this module, and the command
     # line loads no scipy (tests/cli/test_import_cost.py).
