@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from dolfinx import fem
@@ -295,17 +295,20 @@ def _coarse_guess(
 ) -> InitialSet | None:
     """The frictionless coarse predictor's contact set for the first step's first set.
 
-    A frictional set differs from it by the stick and slip zones: fewer sets to visit. No
-    probes here: the coarse solve pays wherever the scene can be remeshed. None where the
-    frictionless scene is not held (a body held by friction alone) or cannot be meshed
-    coarser.
+    A frictional set differs from it by the stick and slip zones: fewer sets to visit. Used
+    where the frictionless solve would use it (`predictor.use_coarse`: many contact rows, or
+    the condensed path). None where the frictionless scene is not held (a body held by
+    friction alone) or cannot be meshed coarser.
     """
-    coarse = request.predictor is Predictor.AUTO and scene.can_remesh
     try:
-        return predict(
-            scene, replace(request, predictor=Predictor.COARSE) if coarse else request, aso, timers
-        )
+        return predict(scene, request, aso, timers)
     except (SingularSystemError, MeshError) as err:
+        if scene.comm.rank == 0:
+            log.info("coarse predictor: %s; starting without it", err)
+        return None
+    except InputError as err:  # the coarse scene's sizes refused: only a guess is lost
+        if request.predictor is not Predictor.AUTO:
+            raise
         if scene.comm.rank == 0:
             log.info("coarse predictor: %s; starting without it", err)
         return None

@@ -87,15 +87,16 @@ def test_builtin_mu_option_reaches_the_pair() -> None:
         (("--method", "schwarz"), "the schwarz enforcement"),
         (("--solver", "fieldsplit"), "the fieldsplit solver"),
         (
-            ("--method", "mortar", "--basis", "dual", "--solver", "condensed"),
-            "the condensed solver",
+            ("--method", "nts", "--solver", "condensed"),
+            "the condensed solver on nts (standard basis), which needs dual mortar",
         ),
     ],
 )
 def test_friction_refused_by_enforcement_or_solver_is_one_line(
     args: tuple[str, ...], refused: str
 ) -> None:
-    """Schwarz, an iterative or the condensed solver with friction: one line, exit 2,
+    """Schwarz, an iterative solver, or the condensed solver on anything but dual mortar with
+    friction: one line, exit 2,
     naming the pair and what does solve it."""
     proc = cli("solve", "blocks", "--mu", "0.2", "--size1", "1", "--size2", "1", *args)
     assert proc.returncode == 2, proc.stderr
