@@ -11,14 +11,18 @@ Newton) iterations per load step:
   iterations, as recorded in benchmarks/getfem_cylinder_block.json and
   getfem_cylinder_block_bisector.json (one core, this machine, an earlier session; made by
   benchmarks/getfem_cylinder_block.py, see benchmarks/cylinder_block_compare.py).
+- `getfem_live` (with `--getfem-msh MSH`, the scene's mesh written by
+  `cylinder_block_compare.py --write-mesh MSH`): GetFEM run here, now, one process per run
+  (its Newton solves' wall time), alternated with contactfx's three methods, `--repeat` times.
 - `mu0`: tests/scenes/cattaneo_mirrored.toml at `--size-factor` (pressed, then pushed: two
   load steps) frictional (mu = 0.3) against the same scene, steps and method with mu = 0,
   the two solves alternated so both see the same load on a shared machine.
 
+    OPENBLAS_NUM_THREADS=1 python benchmarks/cylinder_block_compare.py --write-mesh /tmp/cb1.msh
     OPENBLAS_NUM_THREADS=1 python benchmarks/friction_overhead.py --repeat 5 \
-        --size-factor 2 --json benchmarks/friction_overhead.json
+        --size-factor 2 --getfem-msh /tmp/cb1.msh --json benchmarks/friction_overhead.json
 
-(about three minutes on one core.)
+(about five minutes on one core; without `--getfem-msh`, three.)
 """
 
 from __future__ import annotations
@@ -26,7 +30,10 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import platform
+import subprocess
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -42,6 +49,7 @@ BLOCK = ROOT / "tests" / "scenes" / "cylinder_block.toml"
 MIRRORED = ROOT / "tests" / "scenes" / "cattaneo_mirrored.toml"
 GETFEM = [ROOT / "benchmarks" / f for f in ("getfem_cylinder_block.json",)]
 GETFEM += [ROOT / "benchmarks" / "getfem_cylinder_block_bisector.json"]
+GETFEM_PYTHON = "/usr/bin/python3"  # Debian's python3-getfem
 METHODS = {"mortar": {}, "dual": {"basis": "dual"}, "nts": {}}
 
 
@@ -87,6 +95,44 @@ def against_getfem(repeat: int) -> list[dict[str, Any]]:
     return rows
 
 
+def getfem_now(msh: Path) -> dict[str, Any]:
+    """One GetFEM run of both steps on `msh` now (Debian's python3-getfem, flat frame)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "gf.json"
+        script = ROOT / "benchmarks" / "getfem_cylinder_block.py"
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+        cmd = [GETFEM_PYTHON, str(script), str(msh), "--json", str(out)]
+        subprocess.run(cmd, check=True, env=env, capture_output=True)
+        gf = json.loads(out.read_text())
+    return {"wall_s": gf["wall_s_median"], "iterations": [s["iterations"] for s in gf["steps"]]}
+
+
+def against_getfem_live(msh: Path, repeat: int) -> list[dict[str, Any]]:
+    """The cylinder on the block, GetFEM run here and now, alternated with each method."""
+    scene = load_scene_file(BLOCK)
+    for method in METHODS:
+        timed(scene, method)  # warm-up
+    gf: list[dict[str, Any]] = []
+    ours: dict[str, list[dict[str, Any]]] = {m: [] for m in METHODS}
+    for _ in range(repeat):
+        gf.append(getfem_now(msh))
+        for method in METHODS:
+            ours[method].append(timed(scene, method))
+    theirs = float(np.median([g["wall_s"] for g in gf]))
+    return [
+        {
+            "method": method,
+            "getfem_frame": "flat",
+            **series(runs),
+            "getfem_wall_s": theirs,
+            "getfem_wall_s_runs": [g["wall_s"] for g in gf],
+            "getfem_iterations": gf[0]["iterations"],
+            "ratio": series(runs)["wall_s"] / theirs,
+        }
+        for method, runs in ours.items()
+    ]
+
+
 def against_mu0(size_factor: float, repeat: int) -> list[dict[str, Any]]:
     """The mirrored cylinders, frictional against mu = 0, runs alternated."""
     rough = load_scene_file(MIRRORED, size_factor=size_factor)
@@ -120,12 +166,23 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--size-factor", type=float, default=2.0)
     ap.add_argument("--json", type=Path)
+    ap.add_argument(
+        "--getfem-msh",
+        type=Path,
+        help="run GetFEM on this mesh of the scene now, alternated with contactfx",
+    )
     args = ap.parse_args()
-    out = {
-        "machine": platform.node(),
-        "getfem": against_getfem(args.repeat),
-        "mu0": against_mu0(args.size_factor, args.repeat),
-    }
+    out: dict[str, Any] = {"machine": platform.node()}
+    if args.getfem_msh:
+        out["getfem_live"] = against_getfem_live(args.getfem_msh, args.repeat)
+    out["getfem"] = against_getfem(args.repeat)
+    out["mu0"] = against_mu0(args.size_factor, args.repeat)
+    for r in out.get("getfem_live", []):
+        print(
+            f"cylinder_block {r['method']:6s} {r['dofs']} DOFs: {r['wall_s']:.2f} s "
+            f"{r['iterations']} it, GetFEM now {r['getfem_wall_s']:.2f} s "
+            f"{r['getfem_iterations']} it: {r['ratio']:.2f}x"
+        )
     for r in out["getfem"]:
         print(
             f"cylinder_block {r['method']:6s} {r['dofs']} DOFs: {r['wall_s']:.2f} s "
