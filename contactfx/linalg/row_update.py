@@ -32,16 +32,19 @@ class KeptFactorization:
 
     def __init__(self, F: PETSc.Mat) -> None:
         self._F = F
-        self._columns: dict[int, np.ndarray] = {}  # global row -> this rank's part of Z e_row
+        # Z's kept columns as the rows of one array (global row -> its index), so that a
+        # set's columns are one gather rather than a stack of |R| arrays per solve.
+        self._index: dict[int, int] = {}
+        self._Zt = np.zeros((0, 0))
         self.columns_solved = 0
 
     def has(self, row: int) -> bool:
         """Whether Z's column of global row `row` is kept."""
-        return row in self._columns
+        return row in self._index
 
     def _z(self, rows_all: np.ndarray, n_loc: int, comm: PETSc.Comm) -> np.ndarray:
         """This rank's rows of Z = P^-1 E_R (R = `rows_all`, every rank's, in order)."""
-        new = [int(g) for g in rows_all if int(g) not in self._columns]
+        new = [int(g) for g in rows_all if int(g) not in self._index]
         if new:
             r0, r1 = self._F.getOwnershipRange()
             E = PETSc.Mat().createDense(
@@ -55,14 +58,15 @@ class KeptFactorization:
             Z = E.duplicate()
             self._F.matSolve(E, Z)
             block = np.asarray(Z.getDenseArray()).reshape(n_loc, len(new))
-            for k, g in enumerate(new):
-                self._columns[g] = block[:, k].copy()
+            start = len(self._index)
+            self._Zt = np.concatenate([self._Zt.reshape(start, n_loc), block.T])
+            self._index.update((g, start + k) for k, g in enumerate(new))
             self.columns_solved += len(new)
             E.destroy()
             Z.destroy()
         if not len(rows_all):
             return np.zeros((n_loc, 0))
-        return np.column_stack([self._columns[int(g)] for g in rows_all])
+        return self._Zt[[self._index[int(g)] for g in rows_all]].T
 
     def solve(
         self,
