@@ -123,8 +123,10 @@ def _surface_nodes(sol: Solution, gblock: np.ndarray, S: fem.FunctionSpace) -> n
 
 
 class _ContactFields:
-    """Q1 fields on the contact surfaces: the frame normal N, the multipliers p and s (the
-    shear, 0 without friction), the gap terms."""
+    """Q1 fields on the contact surfaces: frame normal N, multipliers p and s, gap terms.
+
+    s is the shear (0 without friction).
+    """
 
     def __init__(self, sol: Solution) -> None:
         msh = sol.scene.mesh
@@ -166,7 +168,8 @@ class _ContactFields:
         ends = surf.segments[seg]
         dofs_p = _surface_nodes(sol, pv.passive.gblock, self.S)
         for f, v in ((self.p, p_nodes), (self.s, s_nodes)):
-            self._set(f, dofs_p, np.where(found, (1 - xi) * v[ends[:, 0]] + xi * v[ends[:, 1]], 0.0))
+            at = (1 - xi) * v[ends[:, 0]] + xi * v[ends[:, 1]]
+            self._set(f, dofs_p, np.where(found, at, 0.0))
         normal_p = nodal_normals(ps)
         for c in range(2):
             self._set(self.N[c], dofs_p, normal_p[:, c])
