@@ -174,10 +174,7 @@ class GoalRecord:
         return max(self.shear.values()) if self.shear else None
 
     def to_json(self) -> dict[str, Any]:
-        """The JSON fields `goal`, `goal_estimate`, `goal_parts`, `goal_refined_dofs`.
-
-        With friction also `shear_estimate` and `shear_parts` (not bounded).
-        """
+        """The JSON's `goal`, `goal_estimate`, `goal_parts`, ...; `shear_*` with friction."""
         extra: dict[str, Any] = {}
         if self.shear:
             extra = {"shear_estimate": self.shear_estimate, "shear_parts": dict(self.shear)}
