@@ -1,7 +1,8 @@
 """The contact pressure along a pair's surface: its L2 norms and its peak's growth.
 
 The pressure goal (adapt/goal.py) compares two solutions' pressures in L2
-(`pressure_difference`, exact for piecewise-linear curves) and judges whether the pressure
+(`pressure_difference`, exact for piecewise-linear curves; with friction the shear too,
+`shear_parts`) and judges whether the pressure
 is singular from its peak (`window_peak`) over successive refinements (`singular_growth`).
 """
 
@@ -11,7 +12,8 @@ import itertools
 
 import numpy as np
 
-from ..methods.solution import PairView
+from ..methods.solution import PairView, Solution
+from ..scenes import Model
 
 # A pair's pressure is singular when its peak grows like h^-lambda, lambda at least this, over
 # two successive refinements of the contact cells: a rigid flat punch's 1/sqrt edge has
@@ -116,3 +118,20 @@ def singular_growth(peaks: list[tuple[float, float]]) -> list[float] | None:
     if len(exponents) < 2 or min(exponents) < SINGULAR_EXPONENT:
         return None
     return exponents
+
+
+def shear_parts(sol: Solution, ref: Solution, q: float) -> dict[str, float]:
+    """Per frictional pair: the shear's relative L2 difference / (1 - q), as the pressure's."""
+    if sol.friction is None or ref.friction is None:
+        return {}
+    out = {}
+    for pv, pr in zip(sol.pairs, ref.pairs, strict=True):
+        if not np.any(sol.friction.mu[pv.rows] > 0):
+            continue
+        d, n = pressure_difference(
+            pressure_curve(pv, sol.friction.shear),
+            pressure_curve(pr, ref.friction.shear),
+            radial=sol.scene.model is Model.AXISYMMETRIC,
+        )
+        out[pv.label] = d / n / (1.0 - q) if n > 0 else 0.0
+    return out

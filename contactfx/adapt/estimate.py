@@ -8,7 +8,7 @@ Young's modulus, so that it has the units of the energy a(u, u)):
             + sum_{interior e in dK} h_e / 2 |[sigma(u_h) n]|^2_e / E  traction jumps
             + sum_{boundary e in dK} h_e |M (sigma(u_h) n - t)|^2_e / E  Neumann residual
             + sum_{contact e in dK} h_e (sigma_nn + p_h)^2_e / E       normal stress vs. multiplier
-            + sum_{contact e in dK} h_e sigma_nt^2_e / E                tangential stress (= 0)
+            + sum_{contact e in dK} h_e (sigma_nt + s_h)^2_e / E        shear vs. multiplier
             + int_{contact e} p_h g_h^+                                complementarity
             + int_{contact e} E g_h^-^2 / h_e                          gap (penetration)
 
@@ -16,7 +16,13 @@ M masks the components a Dirichlet condition prescribes (rollers leave the other
 traction-free); sigma_nn, sigma_nt are each body's own traction on the contact frame (the
 passive normal nu the multipliers act along, as results/interface.py resolves it), p_h the
 piecewise-linear interpolant of the multipliers on the active surface and, on the passive
-surface, at the projection of each passive node. docs/adapt.md has the references and the
+surface, at the projection of each passive node. With friction s_h is the shear lambda_t
+interpolated the same way (0 without friction: the frictionless estimator's sigma_nt = 0),
+and sigma_nt is read along T = (-N_y, N_x), N the contact normal of that surface: the
+traction the multipliers put on either body is -p_h N - s_h T (contact/friction.py's t is T
+on the active surface and -T on the passive one, where the shear acts oppositely). The
+estimate is that of the solution handed in: a stepped solve's last step, whose multipliers
+and displacement it reads together. docs/adapt.md has the references and the
 measured effectivity. The jumps across process boundaries, which DOLFINx's dS does not
 reach on the scenes' unghosted meshes, come from results/facet_jumps.py.
 """
@@ -117,12 +123,16 @@ def _surface_nodes(sol: Solution, gblock: np.ndarray, S: fem.FunctionSpace) -> n
 
 
 class _ContactFields:
-    """Q1 fields on the contact surfaces: the frame normal N, the multiplier p, the gap terms."""
+    """Q1 fields on the contact surfaces: frame normal N, multipliers p and s, gap terms.
+
+    s is the shear (0 without friction).
+    """
 
     def __init__(self, sol: Solution) -> None:
         msh = sol.scene.mesh
         self.S = fem.functionspace(msh, ("Lagrange", 1))
         self.p = fem.Function(self.S)
+        self.s = fem.Function(self.S)  # the shear lambda_t (contact/friction.py)
         self.g = fem.Function(self.S)  # the multiplier rows' gaps at the active nodes
         self.pen = fem.Function(self.S)  # (g^-)^2 at the active nodes
         self.N = [fem.Function(self.S), fem.Function(self.S)]
@@ -137,11 +147,14 @@ class _ContactFields:
         pv = sol.pairs[k]
         surf = pv.active.surface
         p_nodes = pv.nodal(sol.pressure)
+        fr = sol.friction
+        s_nodes = pv.nodal(fr.shear) if fr is not None else np.zeros_like(p_nodes)
         normal = nodal_normals(surf)
         normal[pv.nodes] = pv.frame[0]
         gap = sol.gap[pv.rows]
         dofs = _surface_nodes(sol, pv.active.gblock, self.S)
         self._set(self.p, dofs, p_nodes)
+        self._set(self.s, dofs, s_nodes)
         for c in range(2):
             self._set(self.N[c], dofs, normal[:, c])
         rows = dofs[pv.nodes]
@@ -153,9 +166,10 @@ class _ContactFields:
         ps = pv.passive.surface
         seg, xi, found = project(ps.x, surf)
         ends = surf.segments[seg]
-        p_pass = np.where(found, (1 - xi) * p_nodes[ends[:, 0]] + xi * p_nodes[ends[:, 1]], 0.0)
         dofs_p = _surface_nodes(sol, pv.passive.gblock, self.S)
-        self._set(self.p, dofs_p, p_pass)
+        for f, v in ((self.p, p_nodes), (self.s, s_nodes)):
+            at = (1 - xi) * v[ends[:, 0]] + xi * v[ends[:, 1]]
+            self._set(f, dofs_p, np.where(found, at, 0.0))
         normal_p = nodal_normals(ps)
         for c in range(2):
             self._set(self.N[c], dofs_p, normal_p[:, c])
@@ -284,9 +298,10 @@ def estimate(sol: Solution) -> Estimate:
     forms["neumann"] = neumann
     dsc = ds(tuple(contact_tags)) if contact_tags else ds(_CONTACT_TAG0)
     tnn = ufl.dot(tn, N)
-    tt = tn - tnn * N
+    # The shear's direction (docstring): the multipliers' traction is -p N - s T.
+    tnt = ufl.dot(tn, ufl.as_vector([-N[1], N[0]]))
     forms["normal"] = he * (tnn + cf.p) ** 2 / E * m * w * dsc
-    forms["tangential"] = he * ufl.dot(tt, tt) / E * m * w * dsc
+    forms["tangential"] = he * (tnt + cf.s) ** 2 / E * m * w * dsc
     # The interpolants' product, not the nodal one: p_h g_h^+ vanishes at every node of a
     # converged set but not in the cell across the zone's edge, where p_h falls from its
     # last active node and g_h rises to its first inactive one.

@@ -37,7 +37,7 @@ default goal stops on the energy instead.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
 
@@ -57,6 +57,7 @@ from .curves import (
     peak_exponent,
     pressure_curve,
     pressure_difference,
+    shear_parts,
     singular_growth,
 )
 from .estimate import estimate
@@ -127,11 +128,15 @@ class GoalEstimate:
     seconds: float  # remesh + refined solve + comparison
     reference: Solution  # the refined solution (a better answer than the level's own)
     halvings: int = 1  # k: the refined mesh's near cells are 2^-k of the level's
+    # The pressure goal with friction: the shear's relative L2 difference, extrapolated the
+    # same way, per pair. Reported, not bounded (FRICTION_MEANING).
+    shear: dict[str, float] = field(default_factory=dict)
 
     def record(self) -> GoalRecord:
         """The estimate without the refined solution."""
+        g = self
         return GoalRecord(
-            self.goal, self.relative, dict(self.parts), self.dofs, self.seconds, self.halvings
+            g.goal, g.relative, dict(g.parts), g.dofs, g.seconds, g.halvings, dict(g.shear)
         )
 
 
@@ -141,6 +146,14 @@ GOAL_MEANING = {
     Goal.FORCE: "the relative error of each pair's contact force (worst pair)",
     Goal.RESIDUAL: "the relative residual estimate of the energy-norm error (uncalibrated)",
 }
+
+# What adapt bounds with friction (the log, adapt.json's `friction`; docs/adapt.md).
+FRICTION_MEANING = (
+    "with friction the goal is that of the last load step's solution (the residual "
+    "indicators read its normal and shear multipliers); the pressure goal bounds the "
+    "pressure; the shear is not bounded: its two-level estimate (shear_estimate) is "
+    "reported only"
+)
 
 
 @dataclass(frozen=True)
@@ -153,10 +166,20 @@ class GoalRecord:
     dofs: int  # DOFs of the refined solve (0: none, the residual estimate calibrated)
     seconds: float
     halvings: int = 1  # how often the refined mesh halved the contact cells
+    shear: dict[str, float] = field(default_factory=dict)  # per pair; reported, not bounded
+
+    @property
+    def shear_estimate(self) -> float | None:
+        """The worst pair's shear estimate (None without friction)."""
+        return max(self.shear.values()) if self.shear else None
 
     def to_json(self) -> dict[str, Any]:
-        """The JSON fields `goal`, `goal_estimate`, `goal_parts`, `goal_refined_dofs`."""
+        """The JSON's `goal`, `goal_estimate`, `goal_parts`, ...; `shear_*` with friction."""
+        extra: dict[str, Any] = {}
+        if self.shear:
+            extra = {"shear_estimate": self.shear_estimate, "shear_parts": dict(self.shear)}
         return {
+            **extra,
             "goal": self.goal.value,
             "goal_estimate": self.relative,
             "goal_parts": dict(self.parts),
@@ -339,6 +362,7 @@ def goal_estimate(
     ref = _refined(sol, field, solver, options or {})
     q = 2.0 ** (-r * k)
     parts: dict[str, float] = {}
+    shear: dict[str, float] = {}
     if goal is Goal.ENERGY:
         e = sol.scene.comm.bcast(energy_error(sol, ref), root=0)
         parts["difference"] = e["relative"]
@@ -358,13 +382,14 @@ def goal_estimate(
             )
             parts[pv.label] = d / n / (1.0 - q) if n > 0 else 0.0
         relative = max(parts.values(), default=0.0)
+        shear = shear_parts(sol, ref, q)
     else:
         for k, pv in enumerate(sol.pairs):
             fine = _force(ref, k)
             parts[pv.label] = abs(_force(sol, k) - fine) / max(fine, 1e-300) / (1.0 - q)
         relative = max(parts.values(), default=0.0)
     seconds = time.perf_counter() - t0
-    return GoalEstimate(goal, float(relative), parts, r, ref.dofs, seconds, ref, k)
+    return GoalEstimate(goal, float(relative), parts, r, ref.dofs, seconds, ref, k, shear)
 
 
 def _force(sol: Solution, k: int) -> float:

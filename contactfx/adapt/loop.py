@@ -23,7 +23,7 @@ from ..request import SolveRequest
 from ..scenes import Scene
 from ..timers import Timers
 from .estimate import estimate
-from .goal import Goal
+from .goal import FRICTION_MEANING, Goal
 from .records import AdaptLevel, AdaptOptions, AdaptResult
 from .sizing import Plan, plan_mesh
 
@@ -198,6 +198,8 @@ def adapt(
     for k in range(opts.max_levels):
         previous = levels[-1].solution if levels else None
         level = solve_level(scene, k, mesh_time, request, paper_interface, previous)
+        if k == 0 and level.solution.friction is not None:
+            say(f"friction: {FRICTION_MEANING}")
         level = strategy.assess(level, say)
         levels.append(level)
         say(level_line(level))
@@ -279,11 +281,17 @@ def level_line(level: AdaptLevel) -> str:
         )
     elif run.patch is not None:
         ref = f", patch max {run.patch.max:.2e}"
+    elif level.exact_error is not None:  # Cattaneo-Mindlin: Hertz's pressure
+        ref = f", pressure L2 {100 * level.exact_error:.3f} % against Hertz"
     pressure = f", pressure {100 * e.pressure:.3g} %" if e.pressure else ""
     if level.goal is not None:
         g = level.goal
         eff = level.exact_error
         eff_s = f", effectivity {g.relative / eff:.2f}" if eff else ""
+        if g.shear_estimate is not None:
+            true = level.exact_shear_error
+            eff_s += f"; shear estimate {100 * g.shear_estimate:.3g} % (not bounded"
+            eff_s += f", true {100 * true:.3g} %)" if true else ")"
         return (
             f"level {level.index}: {run.dofs} DOFs, {g.goal.value} estimate "
             f"{100 * g.relative:.3g} %{ref}{eff_s} (residual {100 * e.total:.3g} %), "

@@ -10,7 +10,7 @@ from ..methods.solution import Solution
 from ..request import SolveRequest
 from ..results.records import RunSummary
 from .estimate import Estimate
-from .goal import GOAL_MEANING, Goal, GoalRecord
+from .goal import FRICTION_MEANING, GOAL_MEANING, Goal, GoalRecord
 from .sizing import SizingRule
 
 # --tol's default: the goal's relative error; the residual estimate's is looser (it is an
@@ -197,14 +197,29 @@ class AdaptLevel:
             if exact is not None:
                 out["exact_error"] = exact
                 out["effectivity"] = self.goal.relative / exact if exact > 0 else None
+            shear, exact_shear = self.goal.shear_estimate, self.exact_shear_error
+            if shear is not None and exact_shear is not None:
+                out["exact_shear_error"] = exact_shear
+                out["shear_effectivity"] = shear / exact_shear if exact_shear > 0 else None
         return out
 
     @property
     def exact_error(self) -> float | None:
-        """The goal's exact relative error where the scene has one (pressure on Hertz)."""
-        if self.goal is None or self.goal.goal is not Goal.PRESSURE or not self.summary.hertz:
+        """The goal's exact relative error where the scene has one (the pressure goal).
+
+        Against Hertz, or Cattaneo-Mindlin (whose pressure is Hertz's under the pair's force).
+        """
+        if self.goal is None or self.goal.goal is not Goal.PRESSURE:
             return None
-        return max(h.l2_error for h in self.summary.hertz)
+        if self.summary.hertz:
+            return max(h.l2_error for h in self.summary.hertz)
+        errors = [c.pressure_l2 for c in self.summary.cattaneo if c.pressure_l2 is not None]
+        return max(errors) if errors else None
+
+    @property
+    def exact_shear_error(self) -> float | None:
+        """The shear's exact relative L2 error on a Cattaneo-Mindlin scene (worst pair)."""
+        return max((c.shear_l2 for c in self.summary.cattaneo), default=None)
 
 
 @dataclass
@@ -221,6 +236,10 @@ class AdaptResult:
     goal_note: str = ""
     uniform: list[AdaptLevel] = field(default_factory=list)
 
+    @property
+    def _frictional(self) -> bool:
+        return any(lv.solution.friction is not None for lv in self.levels)
+
     def to_json(self, scene: str, request: SolveRequest, opts: AdaptOptions) -> dict[str, Any]:
         """adapt.json: the settings, every level (estimate a number), why the loop stopped.
 
@@ -233,6 +252,7 @@ class AdaptResult:
             "goal": self.goal.value,
             "goal_meaning": GOAL_MEANING[self.goal],
             "goal_note": self.goal_note,
+            **({"friction": FRICTION_MEANING} if self._frictional else {}),
             "stop": self.stop,
             "levels": [lv.to_json() for lv in self.levels],
             **({"uniform": [lv.to_json() for lv in self.uniform]} if self.uniform else {}),

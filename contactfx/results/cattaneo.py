@@ -69,6 +69,7 @@ def cattaneo_check(
         slip_law=err.slip_law,
         shear_ratio=_shear_ratio(sol, ref, mu),
         approach_shear=None if approach is None else _shear_ratio(approach, ref, mu),
+        pressure_l2=err.pressure_l2,
     )
 
 

@@ -79,6 +79,7 @@ class CattaneoErrors:
     c: float  # stick half-width read from the statuses (edges halfway to the slip neighbours)
     c_exact: float
     slip_law: float  # max over slip nodes of ||q_h| - mu p_h| / (mu p0)
+    pressure_l2: float = 0.0  # ||p_h - p|| / ||p||: the pressure against Hertz's, the same way
 
 
 def cattaneo_errors(
@@ -103,6 +104,9 @@ def cattaneo_errors(
     exact = ref.shear(pts)
     computed = np.interp(pts, x, q, left=0.0, right=0.0)
     l2 = np.sqrt(wts @ (computed - exact) ** 2) / np.sqrt(wts @ exact**2)
+    hertz = ref.pressure(pts)
+    p_h = np.interp(pts, x, p, left=0.0, right=0.0)
+    p_l2 = np.sqrt(wts @ (p_h - hertz) ** 2) / np.sqrt(wts @ hertz**2)
     c = 0.0
     idx = np.flatnonzero(st)
     if idx.size:
@@ -113,7 +117,9 @@ def cattaneo_errors(
     slip = ~st & (p > 0)
     excess = np.abs(np.abs(q[slip]) - ref.mu * p[slip])
     slip_law = float(excess.max(initial=0.0) / (ref.mu * ref.p0))
-    return CattaneoErrors(shear_l2=float(l2), c=float(c), c_exact=ref.c, slip_law=slip_law)
+    return CattaneoErrors(
+        shear_l2=float(l2), c=float(c), c_exact=ref.c, slip_law=slip_law, pressure_l2=float(p_l2)
+    )
 
 
 def _ellipse(x: np.ndarray, half: float) -> np.ndarray:

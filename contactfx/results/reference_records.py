@@ -174,6 +174,8 @@ class CattaneoCheck:
     slip_law: float  # max over slip nodes of ||shear| - mu p| / (mu p0)
     shear_ratio: float  # this step's shear L2 over mu p's (well defined where Q ~ 0)
     approach_shear: float | None = None  # step 1's shear_ratio (None: one step)
+    # Relative L2 error of the pressure against Hertz's under P (Cattaneo-Mindlin's pressure).
+    pressure_l2: float | None = None
 
     @property
     def c_error_cells(self) -> float:
@@ -225,6 +227,7 @@ class CattaneoCheck:
             "h": self.h,
             "c_error_cells": self.c_error_cells,
             "shear_l2": self.shear_l2,
+            "pressure_l2": self.pressure_l2,
             "slip_law": self.slip_law,
             "shear_ratio": self.shear_ratio,
             "approach_shear": self.approach_shear,

@@ -105,6 +105,23 @@ def test_cattaneo_errors_of_sampled_solutions():
     np.testing.assert_allclose(off.slip_law, 0.01 * p[~ref.stick(x)].max() / ref.p0, rtol=1e-9)
 
 
+def test_cattaneo_pressure_error_against_hertz():
+    """The pressure's L2 error against Hertz's (adapt's truth on a Cattaneo scene): the nodal
+    samples' interpolation error (the sqrt edge, ~h^1.5) falls below 0.5 % at 320 cells and
+    8x below 40 cells (measured 2.57 % and 0.165 %); a pressure 2 % too large reads 2 % up
+    to it."""
+    ref = cattaneo_mindlin(1.0, 0.4, 0.5, 1.0, 1.0)
+    errors = []
+    for n in (40, 320):
+        x = np.linspace(-1.5 * ref.a, 1.5 * ref.a, n + 1)
+        e = cattaneo_errors(ref, x, ref.shear(x), ref.pressure(x), ref.stick(x))
+        errors.append(e.pressure_l2)
+    assert errors[1] < 0.005 and errors[1] < errors[0] / 8
+    x = np.linspace(-1.5 * ref.a, 1.5 * ref.a, 321)
+    off = cattaneo_errors(ref, x, ref.shear(x), 1.02 * ref.pressure(x), ref.stick(x))
+    assert abs(off.pressure_l2 - 0.02) <= 1.02 * errors[1] + 1e-12
+
+
 def test_cattaneo_bad_input():
     with pytest.raises(ValueError, match="need 0 <= Q <= mu P"):
         cattaneo_mindlin(1.0, 0.6, 0.5, 1.0, 1.0)
