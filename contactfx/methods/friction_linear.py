@@ -229,7 +229,11 @@ class DirectFriction:
             ksp.setUp()
         self._law = law.copy()
         self._kept = KeptFactorization(ksp.getPC().getFactorMatrix())
-        self._t_factor = time.perf_counter() - t0
+        # Every rank must take the same branch of `_refactor` (a factorization is collective):
+        # the slowest rank's time decides.
+        self._t_factor = (
+            self._P.getComm().tompi4py().allreduce(time.perf_counter() - t0, op=MPI.MAX)
+        )
         self.stats["factorizations"] += 1
         self.stats["factor"] += self._t_factor
 
@@ -238,7 +242,9 @@ class DirectFriction:
         assert self._ksp is not None
         t0 = time.perf_counter()
         self._ksp.solve(b, x)
-        self._t_bs = time.perf_counter() - t0
+        self._t_bs = (
+            b.getComm().tompi4py().allreduce(time.perf_counter() - t0, op=MPI.MAX)
+        )  # as above
         assert self._A is not None
         r = b.duplicate()
         self._A.mult(x, r)
