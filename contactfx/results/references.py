@@ -315,8 +315,16 @@ def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
         nn_p, nt_p = resolve(sig, nu, nu, tau)
         exact = {"nn_active": nn_a, "nn_passive": nn_p, "nt_active": nt_a, "nt_passive": nt_p}
         sides = ("active",) if pv.obstacle is not None else ("active", "passive")
+        shear = {}
+        if "shear" in itf:
+            # The frictional multiplier: the traction on the active body (sigma nu, nu out of
+            # it) is -shear along t = (-nu_y, nu_x) (results/interface.py's convention).
+            traction = np.einsum("kij,kj->ki", sig, nu)
+            exact_shear = -(traction[:, 0] * -nu[:, 1] + traction[:, 1] * nu[:, 0])
+            shear["shear"] = _max_error(itf["shear"], exact_shear, scale)
         pairs.append(
             {
+                **shear,
                 "pressure": _max_error(itf["pressure"], -nn_p, scale),
                 **{
                     f"sigma_{kind}_{side}": _max_error(

@@ -10,11 +10,13 @@ the mirrored answer, and what is not supported is refused in one line.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from conftest import ROOT
 
-from contactfx import ContactPair, SolveRequest, scene_from_gmsh, solve
+from contactfx import ContactPair, SolveRequest, UniformStress, run_scene, scene_from_gmsh, solve
 from contactfx.contact.friction import Status
 from contactfx.errors import InputError, SingularSystemError
 from contactfx.methods.solution import Solution
@@ -415,3 +417,27 @@ def test_cattaneo_mindlin_stick_half_width_on_mirrored_cylinders() -> None:
     stick = x[sol.friction.status == Status.STICK]
     assert abs(stick.min() + stick.max()) < h
     assert err.shear_l2 == pytest.approx(0.03258, rel=1e-3)
+
+
+@pytest.mark.parametrize("basis", ["standard", "dual"])
+@pytest.mark.parametrize(("tau", "delta"), [(2.0, 0.0), (MU * P, 0.01), (-MU * P, -0.01)])
+def test_patch_test_through_the_uniform_stress_reference(
+    basis: str, tau: float, delta: float
+) -> None:
+    """The frictional patch test as a scene checks it: `uniform_stress` with the shear
+    component reads the bodies' stress, the interface's sigma_nn and sigma_nt, the pressure
+    and the multipliers' shear exact (1e-8 of the largest stress) in stick and in slip; the
+    same solution against the shear of the other sign reads the shear 2 |tau| off."""
+    scene = patch(tau, delta)
+    exact = UniformStress(((0.0, tau), (tau, -P)))
+    _, run = run_scene(
+        replace(scene, references=(exact,)), SolveRequest.parse("mortar", basis=basis)
+    )
+    assert run.patch is not None and run.patch.max < 1e-8, run.patch
+    assert run.patch.pairs[0]["shear"] < 1e-8
+    wrong = UniformStress(((0.0, -tau), (-tau, -P)))
+    _, run = run_scene(
+        replace(scene, references=(wrong,)), SolveRequest.parse("mortar", basis=basis)
+    )
+    assert run.patch is not None
+    assert run.patch.pairs[0]["shear"] == pytest.approx(2 * abs(tau) / P, rel=1e-8)
