@@ -19,7 +19,7 @@ def max_cell_aspect(msh: mesh.Mesh) -> float:
     if len(cells) == 0:
         return 1.0
     # The edges of a DOLFINx quadrilateral: 0-1, 1-3, 3-2, 2-0; squared lengths, one edge
-    # at a time (`auto` asks this of 10M-DOF meshes: a third of the (cells, 4, 2) version).
+    # at a time (`auto` asks this of its largest meshes: no (cells, 4, 2) temporary).
     sq = []
     for i, j in ((1, 0), (3, 1), (2, 3), (0, 2)):
         v = x[cells[:, i]] - x[cells[:, j]]

@@ -98,19 +98,14 @@ def moved(op: ContactOperator, pairs: list[PairData]) -> ContactOperator:
 
 
 def node_free_rows(
-    op: ContactOperator,
-    node_dofs: np.ndarray,
-    pairs: list[PairData],
-    dirichlet: np.ndarray,
-    rtol: float = 1e-10,
+    op: ContactOperator, node_dofs: np.ndarray, pairs: list[PairData], dirichlet: np.ndarray
 ) -> np.ndarray:
     """False on the obstacle rows whose own node cannot move along them (prescribed).
 
     Such a row still touches the neighbours' dofs (STS, mortar), but with a rigid side
     that has no dofs the rows outnumber the free normal motions they constrain: the
     multipliers would not be unique (a singular saddle point). Body pairs keep theirs: the
-    passive body's dofs take up the slack. `rtol`: how small the row's free own entries may be,
-    relative to the row's largest (by default: round-off).
+    passive body's dofs take up the slack.
     """
     keep = np.ones(op.B.shape[0], dtype=bool)
     fixed = column_mask(dirichlet, op.B.shape[1])
@@ -127,5 +122,5 @@ def node_free_rows(
             at = (sub.indices == dof[r]) & ~fixed[sub.indices]  # the row's own dof, free
             np.maximum.at(own, r[at], np.abs(sub.data[at]))
         # Relative to the row, as constrained_rows: "prescribed" is up to round-off.
-        keep[rows] = own > rtol * whole
+        keep[rows] = own > 1e-10 * whole
     return keep

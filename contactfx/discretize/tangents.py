@@ -67,8 +67,8 @@ def tangent_rows(
 
 # A tangential row whose own node moves along it by less than this fraction of the row's
 # own entries is held: a node on a symmetry line or the axis, whose row in the bisector
-# frame is tilted from the line by half a segment's angle (2 % on the shrink fit's 41-node
-# quarter), not by a real freedom (docs/friction.md, "How it is solved").
+# frame is tilted from the line by half a segment's angle (a few per cent on a coarse arc),
+# not by a real freedom (docs/friction.md, "How it is solved").
 HELD_FRACTION = 0.1
 
 

@@ -95,6 +95,9 @@ def node_blocks(
     g_rows: PivotRows = {}
     nodes: list[tuple[int, np.ndarray, np.ndarray, float]] = []
     touched: list[tuple[np.ndarray, np.ndarray, float]] = []
+    # A row this rank cannot eliminate is said on every rank (raised by one alone, the others
+    # would wait in the collectives below).
+    prescribed = False
     for j in np.flatnonzero(active):
         cn, vn = Bn.row(j)
         ct, vt = Bt.row(j)
@@ -108,10 +111,8 @@ def node_blocks(
         else:
             mine = np.isin(cn, own) & (vn != 0.0)
             if not mine.any():
-                raise SolverError(
-                    "the condensed solver cannot eliminate a contact row whose active node is "
-                    "fully prescribed: use --solver mumps"
-                )
+                prescribed = True
+                continue
             k = np.flatnonzero(mine)[int(np.argmax(np.abs(vn[mine])))]
             piv = np.array([cn[k]], dtype=np.int64)
             cols, rows = _dense([(cn, vn), (ct, vt)])
@@ -131,6 +132,11 @@ def node_blocks(
         others[at] = False
         scale = float(np.abs(LC).max())
         touched.append((cols[others], np.abs(np.vstack([C, G])[:, others]).max(axis=0), scale))
+    if comm.allreduce(prescribed, op=MPI.LOR):
+        raise SolverError(
+            "the condensed solver cannot eliminate a contact row whose active node is "
+            "fully prescribed: use --solver mumps"
+        )
     piv_all = np.concatenate(comm.allgather(np.concatenate(dofs) if dofs else np.zeros(0, int)))
     coupled = any(
         np.any(vals[np.isin(cols, piv_all)] > DIAGONAL_TOL * scale) for cols, vals, scale in touched

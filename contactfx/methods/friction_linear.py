@@ -27,9 +27,9 @@ from ..linalg.petsc_options import PrefixedOptions
 from ..linalg.row_update import KeptFactorization
 from .solvers import with_ordering, with_sequential_analysis
 
-# A column of the changed rows' block solve relative to one back-substitution (about 0.4
-# at 166k DOFs: benchmarks/README.md, friction_cost.py), and the most memory the kept
-# columns (a dense vector each) may take.
+# A column of the changed rows' block solve relative to one back-substitution (measured:
+# benchmarks/README.md, friction_cost.py), and the most memory the kept columns (a dense
+# vector each) may take.
 COLUMN_COST = 0.4
 KEPT_BYTES = 2**28
 # A solve on the kept factorization is refined to the residual of the factorization's own

@@ -316,9 +316,11 @@ def uniform_stress_errors(sol: Solution, ref: UniformStress) -> PatchErrors:
         exact = {"nn_active": nn_a, "nn_passive": nn_p, "nt_active": nt_a, "nt_passive": nt_p}
         sides = ("active",) if pv.obstacle is not None else ("active", "passive")
         shear = {}
-        if "shear" in itf:
+        fr = sol.friction
+        if "shear" in itf and fr is not None and np.any(fr.mu[pv.rows] > 0):
             # The frictional multiplier: the traction on the active body (sigma nu, nu out of
-            # it) is -shear along t = (-nu_y, nu_x) (results/interface.py's convention).
+            # it) is -shear along t = (-nu_y, nu_x) (results/interface.py's convention). A
+            # frictionless pair carries none, whatever the uniform stress's shear.
             traction = np.einsum("kij,kj->ki", sig, nu)
             exact_shear = -(traction[:, 0] * -nu[:, 1] + traction[:, 1] * nu[:, 0])
             shear["shear"] = _max_error(itf["shear"], exact_shear, scale)

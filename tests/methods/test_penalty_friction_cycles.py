@@ -105,9 +105,9 @@ def test_the_first_try_converges_as_the_multipliers() -> None:
 
 def test_searched_steps_and_tresca_end_the_heated_block() -> None:
     """The heated block between frictional walls (mu = 0.2) with the penalty on nts rows: the
-    plain iteration meets a set again, the searched steps and then the Tresca-Coulomb fixed
-    point take over, and it ends on the multipliers' statuses with Coulomb's law at every
-    node (the plain iteration cycled here)."""
+    plain iteration meets a set again, the searched steps (and, where none lowers |R|, the
+    Tresca-Coulomb fixed point) take over, and it ends on the multipliers' statuses with
+    Coulomb's law at every node (the plain iteration cycled here)."""
     scene = load_scene_file(ROOT / "tests" / "scenes" / "heated_block.toml")
     scene = replace(
         scene,
@@ -115,8 +115,9 @@ def test_searched_steps_and_tresca_end_the_heated_block() -> None:
         obstacles=tuple(replace(o, mu=0.2) for o in scene.obstacles),
     )
     sol = solve(scene, SolveRequest.parse("nts", enforcement="penalty"))
+    # The plain iteration's rows all flip together here (the walls' shear moves them back by
+    # more than the expansion): not a tie of round-off, so a searched step is always taken.
     assert any(r["step_length"] < 1.0 for r in sol.history)
-    assert any(r["tresca"] for r in sol.history)
     coulomb(sol, 0.2)
     ref = solve(scene, "nts")
     assert sol.friction is not None and ref.friction is not None
