@@ -44,12 +44,31 @@ def grid_interpolations(
     fixed = _owned_fixed(bcs, n_owned)
     mats = []
     rows_of = grid_of_block[:n_owned]  # fine rows: the owned blocks' grid nodes
+    owner = _owners(rows_of, levels[0].n_fine if levels else 0, comm)
     for k, level in enumerate(levels):
-        lo, hi = split_nodes(level.n_coarse, comm.rank, comm.size)
+        # Each coarser node stays on the rank of the finer node it is, numbered in rank
+        # blocks: the products and transfers then stay on their rank (a split of the grid's
+        # own numbering sent most of the fine rows' columns to the other rank).
+        owner = owner[level.fine_of]
+        order = np.argsort(owner, kind="stable")  # the new numbering's coarse nodes
+        number = np.empty_like(order)
+        number[order] = np.arange(len(order))
+        lo, hi = np.searchsorted(owner[order], [comm.rank, comm.rank + 1])
         count, cols, vals = _level_rows(level, rows_of)
-        mats.append(node_prolongation(comm, count, cols, vals, hi - lo, fixed if k == 0 else None))
-        rows_of = np.arange(lo, hi)
+        mats.append(
+            node_prolongation(comm, count, number[cols], vals, hi - lo, fixed if k == 0 else None)
+        )
+        rows_of = order[lo:hi]
     return mats
+
+
+def _owners(rows_of: np.ndarray, n: int, comm: MPI.Comm) -> np.ndarray:
+    """(n,) the rank owning each grid node, from every rank's owned nodes `rows_of`."""
+    owner = np.zeros(n, dtype=np.int32)
+    owner[rows_of] = comm.rank
+    if comm.size > 1:
+        comm.Allreduce(MPI.IN_PLACE, owner, op=MPI.MAX)
+    return owner
 
 
 def _owned_fixed(bcs: list[fem.DirichletBC], n_owned: int) -> np.ndarray:

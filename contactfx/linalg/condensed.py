@@ -5,8 +5,9 @@ it, with the rigid modes of all bodies (zero on the pivots) as near-nullspace. L
 differ from it by a few pivots, a low-rank change: CG keeps that multigrid and applies the
 new operator matrix-free, from the last displacement, until the pivots have moved too far.
 Given the prolongations of coarser grids (a structured grid's own, or a remeshed scene's),
-PCMG on them with Galerkin coarse operators replaces GAMG; its setup is cheap, so every set
-rebuilds it.
+PCMG on them with Galerkin coarse operators replaces GAMG, kept across sets by the same rule
+(its Galerkin products and smoother factorizations cost several CG iterations from a
+million DOFs: docs/scale.md, "The multigrid kept across sets").
 The loop's solves stop at a loose tolerance (only signs decide the set): there the loop's
 `stationary` test reads the loose answer inside the CG run (a convergence test), and on a
 stationary set the same run goes on to the final tolerance, so the answer does not depend on
@@ -247,8 +248,8 @@ class CondensedSolver:
         in more than max(REBUILD_FRACTION of the set, REBUILD_CHANGES) places.
         """
         prev = self._built_for
-        if not self.reuse or prev is None or self._interp:
-            return False  # a geometric multigrid's setup costs a few CG iterations: rebuilt
+        if not self.reuse or prev is None:
+            return False
         changed = self._mpi.allreduce(int(np.setxor1d(prev, piv).size))
         n_piv = self._mpi.allreduce(len(piv))
         return changed <= max(REBUILD_FRACTION * n_piv, REBUILD_CHANGES)

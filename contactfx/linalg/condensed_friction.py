@@ -77,7 +77,9 @@ class _Cycle:
 class FrictionCondensedSolver(CondensedSolver):
     """The condensed solver with tangential rows `Bt` beside B's normal ones (same layout).
 
-    Each set builds its multigrid afresh (the statuses change the pivots and W).
+    A set keeps the multigrid of an earlier one while its pivots have moved in few places
+    (`CondensedSolver._keeps_multigrid`: each change costs GMRES about one iteration, a
+    new setup several); W is applied matrix-free and never enters the multigrid.
     """
 
     def __init__(self, *args: Any, Bt: PETSc.Mat, **kwargs: Any) -> None:
@@ -136,9 +138,11 @@ class FrictionCondensedSolver(CondensedSolver):
         )
         A.setUp()
         ksp = self._outer
+        reuse = self._keeps_multigrid(nb.dofs)
         try:
             with self._options.inserted():
-                self._preconditioner(nb)
+                if not reuse:
+                    self._preconditioner(nb)
             ksp.setOperators(A)
             ksp.setInitialGuessNonzero(True)
             ksp.setUp()
@@ -156,7 +160,7 @@ class FrictionCondensedSolver(CondensedSolver):
         t2 = time.perf_counter()
         for obj in (EC, EG, d, t, r, b, v, A):
             obj.destroy()
-        self.stats["factorizations"] += 1
+        self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
         return FrictionSolve(self._u.array.copy(), mu_n, mu_t, its, t1 - t0, t2 - t1)
 
@@ -175,6 +179,7 @@ class FrictionCondensedSolver(CondensedSolver):
         if self._A is not None:
             self._A.destroy()
         self._A = S
+        self._built_for = piv.copy()
 
     def _recover(
         self, EC: PETSc.Mat, v: PETSc.Vec, t: PETSc.Vec, r: PETSc.Vec, nb: NodeBlocks

@@ -31,6 +31,7 @@ class Level(NamedTuple):
     vals: np.ndarray
     n_fine: int
     n_coarse: int
+    fine_of: np.ndarray  # (n_coarse,) the finer node each coarser node is
 
 
 def grid_patches(lines: GridLines) -> tuple[list[Patch], int]:
@@ -79,7 +80,12 @@ def coarsen(patches: list[Patch], n_fine: int) -> tuple[Level, list[Patch]]:
                 cols.append(cids[np.ix_(ki + a, kj + b)][m])
                 vals.append(w[m])
     level = Level(
-        np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), n_fine, int(coarse.sum())
+        np.concatenate(rows),
+        np.concatenate(cols),
+        np.concatenate(vals),
+        n_fine,
+        int(coarse.sum()),
+        np.flatnonzero(coarse),
     )
     return level, out
 

@@ -229,7 +229,7 @@ class FrictionIteration:
         damped = f", step {alpha:g}" if alpha < 1.0 else ""
         text = (
             f"{n_stick} stick, {n_slip} slip, {n_changed} changed{damped}, "
-            f"complementarity {resid:.2e}, "
+            f"complementarity {resid:.2e}, {answer.iterations} linear its, "
         )
         return Step(
             lam_n, gap, new_active, float(resid), record, text, True, n_changed + (alpha < 1.0)
