@@ -1,10 +1,11 @@
 """The large default command's phases, with and without the graph model of MUMPS' memory.
 
 `python benchmarks/floor_phases.py [--ranks 2] [--repeats 1] [--out benchmarks/floor_phases.json]
-H:AVAILABLE_MB [H:AVAILABLE_MB ...]` runs, per size, `mpirun -n R python -m contactfx solve
-hertz --mesh structured --refine H --h-far 10H --method mortar --basis dual
---available-memory AVAILABLE_MB` (the default solver `auto`; AVAILABLE_MB below MUMPS' need,
-so that `auto` takes the condensed path as the 10.46M default command does on a 24 GB
+[--variants before,after] H:AVAILABLE_MB [H:AVAILABLE_MB ...]` runs, per size, `mpirun -n R
+python -m contactfx solve hertz --mesh structured --refine H --h-far 10H --method mortar
+--basis dual --available-memory AVAILABLE_MB` (the default solver `auto`; AVAILABLE_MB 0
+leaves the flag out, the command exactly as a user types it; else below MUMPS' need, so
+that `auto` takes the condensed path as the 10.46M default command does on a 24 GB
 machine) twice in fresh processes, alternating: `before` with the model switched off (the
 environment variable CONTACTFX_NO_MUMPS_MODEL=1 read here, in `_child`: `auto` then runs the
 analysis as it did: the fine one, or from 1.6M DOFs the coarse check) and `after` (the
@@ -61,8 +62,7 @@ def run_one(h: float, available: float, variant: str, ranks: int) -> dict[str, o
             "mortar",
             "--basis",
             "dual",
-            "--available-memory",
-            str(available),
+            *(["--available-memory", str(available)] if available > 0 else []),
             "--json",
             str(out),
             "-q",
@@ -131,13 +131,16 @@ def main() -> None:
     ap.add_argument("--ranks", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--out", default=str(HERE / "floor_phases.json"))
+    ap.add_argument(
+        "--variants", default="before,after", help="comma list: before (model off), after"
+    )
     args = ap.parse_args()
     rows = []
     for spec in args.sizes:
         h, _, avail = spec.partition(":")
         for k in range(args.repeats):
             order = ("before", "after") if k % 2 == 0 else ("after", "before")
-            for variant in order:
+            for variant in (v for v in order if v in args.variants.split(",")):
                 row = run_one(float(h), float(avail), variant, args.ranks)
                 print(json.dumps(row), flush=True)
                 rows.append(row)

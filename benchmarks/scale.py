@@ -37,6 +37,10 @@ PARALLEL = 2e6
 LARGEST = 10e6
 METHODS = ("nts", "mortar")
 START, END = "<!-- scale:start -->", "<!-- scale:end -->"
+# The floor the chart draws: one assembled multigrid solve of 2D elasticity, setup and
+# solve each at about 1M DOFs per second and core (deal.II step-37/50 and AMGCL's published
+# timings; benchmarks/README.md, "The floor").
+FLOOR_DOF_PER_S_PER_CORE = 1.0e6
 
 
 def case(
@@ -245,6 +249,15 @@ def chart(data: list[dict[str, Any]]) -> str:
                         alpha=1.0 if ranks == 1 else 0.5,
                         label=f"{method}, {solver}, {ranks} rank{'s' if ranks > 1 else ''}",
                     )
+    x_floor = [min(d["dofs"] for d in data), max(d["dofs"] for d in data)]
+    for ranks, alpha in ((1, 1.0), (2, 0.5)):
+        ax.plot(
+            x_floor,
+            [2.0 * n / (FLOOR_DOF_PER_S_PER_CORE * ranks) for n in x_floor],
+            "k:",
+            alpha=alpha,
+            label=f"floor: setup + solve at 1M DOF/s per core, {ranks} core{'s' * (ranks > 1)}",
+        )
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("dofs")
