@@ -67,7 +67,8 @@ class _Checkpoint:
             return 0
         self.ask = None
         try:
-            self.stopped = not ask(ksp.getSolution(), its)
+            # buildSolution: GMRES forms its iterate only on request (CG's is its vector).
+            self.stopped = not ask(ksp.buildSolution(), its)
         except BaseException as err:  # raised again after KSPSolve, on every rank alike
             self.error = err
             return int(PETSc.KSP.ConvergedReason.DIVERGED_BREAKDOWN)

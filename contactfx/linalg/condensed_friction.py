@@ -13,6 +13,7 @@ condensed solver does.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -40,6 +41,7 @@ class FrictionSolve:
     iterations: int
     setup: float
     solve: float
+    final: bool = True  # solved to the final tolerance (else the loop's loose answer)
 
 
 class FrictionOperator:
@@ -95,6 +97,7 @@ class FrictionCondensedSolver(CondensedSolver):
         pc = outer.getPC()
         pc.setType(PETSc.PC.Type.PYTHON)
         pc.setPythonContext(_Cycle(self._ksp))
+        outer.addConvergenceTest(cast(Any, self._check.test), prepend=True)
         self._outer = outer
 
     def destroy(self) -> None:
@@ -108,11 +111,14 @@ class FrictionCondensedSolver(CondensedSolver):
         active: np.ndarray,
         stick: np.ndarray,
         coef: np.ndarray,
+        stationary: Callable[[FrictionSolve], bool] | None = None,
     ) -> FrictionSolve:
-        """Solve on a frictional set (owned rows) to the final tolerance.
+        """Solve on a frictional set (owned rows), to the final tolerance or the loop's.
 
         `g` = (g_n, g_t): B_n u = -g_n on `active`, B_t u = -g_t on `stick`; `coef`: a
-        slipping row's mu_t = coef mu_n.
+        slipping row's mu_t = coef mu_n. With `stationary` the loose answer is asked inside
+        the GMRES run (as the frictionless loop's is inside CG's): where it says True the
+        run goes on to the final tolerance, else it stops there (`final` False).
         """
         t0 = time.perf_counter()
         nb = node_blocks(self._rows, self._t_rows, active, stick, coef, g, self._mpi, self._r0)
@@ -137,20 +143,37 @@ class FrictionCondensedSolver(CondensedSolver):
             cast(Any, self._K.getSizes()), FrictionOperator(self._K, EC, EG, d), comm=self._comm
         )
         A.setUp()
-        ksp = self._outer
+        ksp, check = self._outer, self._check
         reuse = self._keeps_multigrid(nb.dofs)
+        check.stopped, check.error = False, None
         try:
             with self._options.inserted():
                 if not reuse:
                     self._preconditioner(nb)
             ksp.setOperators(A)
             ksp.setInitialGuessNonzero(True)
+            target = self._relative_to_b(A, v, b, self._loose_rtol)
+            if stationary is not None and target > self._rtol:
+
+                def ask(w: PETSc.Vec, its: int) -> bool:
+                    mu_n, mu_t = self._recover(EC, w, t, r, nb)
+                    loose = FrictionSolve(self._u.array.copy(), mu_n, mu_t, its, 0.0, 0.0, False)
+                    return stationary(loose)
+
+                check.at, check.ask = target * float(cast(Any, b.norm())), ask
+            ksp.setTolerances(rtol=self._rtol)  # the run's own end; the checkpoint may stop it
             ksp.setUp()
             t1 = time.perf_counter()
             ksp.solve(b, v)
         except PETSc.Error as err:
-            raise SolverError(petsc_error_message(err, "frictional condensed solve")) from None
+            raise check.error or SolverError(
+                petsc_error_message(err, "frictional condensed solve")
+            ) from None
+        finally:
+            check.ask = None
         reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
+        if check.error is not None:
+            raise check.error
         if reason <= 0 or not np.isfinite(v.norm()):
             raise SolverError(
                 f"frictional condensed solve (gmres) did not converge: PETSc reason {reason} "
@@ -162,7 +185,9 @@ class FrictionCondensedSolver(CondensedSolver):
             obj.destroy()
         self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
-        return FrictionSolve(self._u.array.copy(), mu_n, mu_t, its, t1 - t0, t2 - t1)
+        return FrictionSolve(
+            self._u.array.copy(), mu_n, mu_t, its, t1 - t0, t2 - t1, not check.stopped
+        )
 
     def _preconditioner(self, nb: NodeBlocks) -> None:
         """One multigrid cycle on T^T K T + P (symmetric positive definite), set up."""

@@ -13,7 +13,7 @@ multipliers node by node (linalg/condensed_friction.py).
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -22,7 +22,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from ..errors import SolverError
-from ..linalg.condensed_friction import FrictionCondensedSolver
+from ..linalg.condensed_friction import FrictionCondensedSolver, FrictionSolve
 from ..linalg.petsc_options import PrefixedOptions
 from ..linalg.row_update import KeptFactorization
 from .solvers import with_ordering, with_sequential_analysis
@@ -57,6 +57,7 @@ class FrictionAnswer:
     mu_n: np.ndarray
     mu_t: np.ndarray
     iterations: int = 1  # Krylov iterations (1: a direct solve)
+    final: bool = True  # solved to the final tolerance (a condensed loose answer: False)
 
 
 def _csr(A: PETSc.Mat) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -270,10 +271,23 @@ class CondensedFriction:
         self._solver = solver
         self.stats = solver.stats
 
-    def solve(self, s: FrictionSystem) -> FrictionAnswer:
-        """Solve the set to the final tolerance (the loop judges every answer)."""
-        r = self._solver.solve_sets((s.g_n, s.g_t), s.active, s.stick, -s.slip_coef)
-        return FrictionAnswer(r.u, r.mu_n, r.mu_t, r.iterations)
+    def solve(
+        self, s: FrictionSystem, stationary: Callable[[FrictionAnswer], bool] | None = None
+    ) -> FrictionAnswer:
+        """Solve the set to the loop's loose tolerance, or on to the final one.
+
+        The run goes on where the loose answer is `stationary` (asked inside the Krylov run);
+        without `stationary` it solves to the final tolerance.
+        """
+
+        def ask(r: FrictionSolve) -> bool:
+            assert stationary is not None
+            return stationary(FrictionAnswer(r.u, r.mu_n, r.mu_t, r.iterations, False))
+
+        r = self._solver.solve_sets(
+            (s.g_n, s.g_t), s.active, s.stick, -s.slip_coef, None if stationary is None else ask
+        )
+        return FrictionAnswer(r.u, r.mu_n, r.mu_t, r.iterations, r.final)
 
     def destroy(self) -> None:
         """Free the solver."""

@@ -75,3 +75,28 @@ def test_vanishing_mu_on_condensed_gives_the_frictionless_condensed_solve() -> N
     np.testing.assert_array_equal(tiny.active, frictionless.active)
     np.testing.assert_allclose(tiny.pressure, frictionless.pressure, rtol=0, atol=AGREE)
     assert np.abs(tiny.friction.shear).max() < 1e-9 * P
+
+
+def test_condensed_sets_are_solved_loosely_until_stationary(monkeypatch) -> None:
+    """Each load step's last set is solved to the final tolerance, the sets before it only
+    to the loop's loose one (their answers only decide the next set); the answers above
+    equal the LU's all the same."""
+    from contactfx.linalg.condensed_friction import FrictionCondensedSolver
+
+    runs: list[tuple[bool, int]] = []
+    solve_sets = FrictionCondensedSolver.solve_sets
+
+    def spy(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        r = solve_sets(self, *args, **kwargs)
+        runs.append((r.final, r.iterations))
+        return r
+
+    monkeypatch.setattr(FrictionCondensedSolver, "solve_sets", spy)
+    sol = solve(SCENES["pushed-stick-then-slip"](), "mortar", basis="dual", solver="condensed")
+    iterations = [len(s.history) for s in steps_of(sol)]
+    assert len(runs) == sum(iterations)
+    ends = np.cumsum(iterations) - 1
+    finals = np.array([f for f, _ in runs])
+    assert finals[ends].all()  # every step ends on a final answer
+    loose = np.delete(finals, ends)
+    assert loose.size > 0 and not loose.any()  # and solved every set before it loosely
