@@ -19,7 +19,7 @@ two solves, the press alone and the final loads). Paths: `mumps` (frictionless: 
 saddle point; frictional: LU of the unsymmetric one, analysis and factorization kept) and
 the condensed ones (frictionless: CG; frictional: GMRES).
 
-    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py sweep [hertz] [pushed]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py sweep [hertz] [pushed:condensed-gamg]
     OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py table    # README rows, chart
     OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py one pushed 0.06 mumps 0.3
 
@@ -201,26 +201,34 @@ REPEATS_BELOW = 200_000  # sizes below this many DOFs run three times (medians)
 
 
 def sweep(families: list[str]) -> None:
-    """Each family's sizes on each path, mu = 0.3 and 0 in turn; the JSON, chart, table."""
+    """Each family's sizes on each path, mu = 0.3 and 0 in turn; the JSON, chart, table.
+
+    A family given as FAMILY:SOLVER reruns that path only (the other rows are kept).
+    """
     path = HERE / "friction_cost.json"
     rows: list[dict[str, Any]] = json.loads(path.read_text()) if path.exists() else []
-    rows = [r for r in rows if r["family"] not in families]
-    for family in families:
-        refines, solvers = PLAN[family]
-        for solver in solvers:
-            for refine in refines:
-                row = _measure(family, refine, solver)
-                if row is None:
-                    break
-                rows.append(row)
-                path.write_text(json.dumps(rows, indent=1) + "\n")
-                fr = row["friction"][0]
-                if solver == "mumps" and (
-                    fr["solve_s"] > DIRECT_STOP_S or fr["peak_gb"] > DIRECT_STOP_GB
-                ):
-                    break
-                if solver == "condensed-gamg" and fr["dofs"] > CONDENSED_GAMG_MAX / 2:
-                    break
+    chosen = [
+        (f.partition(":")[0], solver)
+        for f in families
+        for solver in PLAN[f.partition(":")[0]][1]
+        if f.partition(":")[2] in ("", solver)
+    ]
+    rows = [r for r in rows if (r["family"], r["solver"]) not in chosen]
+    for family, solver in chosen:
+        refines = PLAN[family][0]
+        for refine in refines:
+            row = _measure(family, refine, solver)
+            if row is None:
+                break
+            rows.append(row)
+            path.write_text(json.dumps(rows, indent=1) + "\n")
+            fr = row["friction"][0]
+            if solver == "mumps" and (
+                fr["solve_s"] > DIRECT_STOP_S or fr["peak_gb"] > DIRECT_STOP_GB
+            ):
+                break
+            if solver == "condensed-gamg" and fr["dofs"] > CONDENSED_GAMG_MAX / 2:
+                break
     chart(rows)
 
 

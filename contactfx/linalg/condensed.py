@@ -7,7 +7,7 @@ new operator matrix-free, from the last displacement, until the pivots have move
 Given the prolongations of coarser grids (a structured grid's own, or a remeshed scene's),
 PCMG on them with Galerkin coarse operators replaces GAMG, kept across sets by the same rule
 (its Galerkin products and smoother factorizations cost several CG iterations from a
-million DOFs: docs/scale.md, "The multigrid kept across sets").
+million DOFs: docs/condensed.md, "One multigrid per loop").
 The loop's solves stop at a loose tolerance (only signs decide the set): there the loop's
 `stationary` test reads the loose answer inside the CG run (a convergence test), and on a
 stationary set the same run goes on to the final tolerance, so the answer does not depend on
