@@ -74,33 +74,155 @@ def condensed_matrix(
     """T^T K T + P = K + C, C = E^T K + K E + E^T K E (E = T - I: this rank's `prows`).
 
     E is nonzero on the pivot rows only, so C touches the pivots' neighbourhoods: it is
-    summed here from the pivots' rows of K as coordinates (`coupling`) and added to K in
-    one pass, into a new matrix (K itself is kept; the union pattern is allocated once).
-    PETSc's products E^T K and their transposes cost passes over all rows, which grew
-    faster than the DOFs (docs/scale.md, "The condensed matrix").
+    summed here from the pivots' rows of K as coordinates (`coupling`), sent to the rows'
+    owners and inserted into a copy of K's local rows (`add_entries`, the union pattern); the
+    pivot rows and columns are decoupled there (`decouple`), and the diagonal and
+    off-diagonal blocks are handed to PETSc as they are (`split_blocks`). PETSc's products
+    E^T K cost passes over all rows that grew faster than the DOFs, and its MatAXPY with a
+    different pattern rebuilds the matrix entry by entry: several times slower at millions
+    of DOFs (benchmarks/README.md, "Building the condensed matrix").
     """
-    comm = K.getComm()
-    i, j, v = coupling(K, prows, r0, comm.tompi4py())
-    A = PETSc.Mat().create(comm)
-    A.setSizes(cast(Any, K.getSizes()))
-    A.setType(PETSc.Mat.Type.AIJ)
-    A.setPreallocationCOO(cast(Any, i.astype(PETSc.IntType)), cast(Any, j.astype(PETSc.IntType)))
-    A.setValuesCOO(cast(Any, v.astype(PETSc.ScalarType)), cast(Any, PETSc.InsertMode.ADD_VALUES))
-    A.assemble()
-    A.axpy(1.0, K, structure=cast(Any, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN))
-    # Round-off leaves ~1e-16 on the pivot rows and columns: zero them, with K_pp on the
-    # diagonal (the decoupled v_p = 0).
-    ip: Any = piv.astype(PETSc.IntType)
-    A.zeroRowsColumns(ip, diag=1.0)
-    diag = A.getDiagonal()
-    diag.setValues(ip, cast(Any, k_diag.getValues(ip)))
-    diag.assemble()
-    A.setDiagonal(diag)
-    diag.destroy()
+    mpi = K.getComm().tompi4py()
+    i, j, v = coupling(K, prows, r0, mpi)
+    # Zero entries on the pivots' rows and columns of K: every row a pivot touches is then
+    # one of the rows handed over (the pivots of `piv` without an E row included).
+    zi, zj = _pivot_pattern(K, piv)
+    i, j = np.concatenate([i, zi, zj]), np.concatenate([j, zj, zi])
+    v = np.concatenate([v, np.zeros(2 * len(zi))])
+    i, j, v = _to_owners(i, j, v, K.getOwnershipRanges(), mpi)
+    ptr, cols, vals = (np.asarray(a) for a in K.getValuesCSR())
+    n_global = K.getSize()[1]
+    ptr, cols, vals = add_entries(ptr, cols, vals, i - r0, j, v, n_global)
+    every = np.concatenate(mpi.allgather(np.asarray(piv, dtype=np.int64)))
+    ip: Any = np.asarray(piv, dtype=PETSc.IntType)
+    decouple(ptr, cols, vals, np.unique(i - r0), r0, every, ip - r0, k_diag.getValues(ip))
+    c0, c1 = K.getOwnershipRangeColumn()
+    A = PETSc.Mat().createAIJWithArrays(
+        cast(Any, K.getSizes()), cast(Any, split_blocks(ptr, cols, vals, c0, c1)), comm=K.getComm()
+    )
     A.setBlockSize(2)
     # Symmetric positive definite: what a Cholesky factorization (MUMPS SYM=1) needs to know.
     A.setOption(cast(PETSc.Mat.Option, PETSc.Mat.Option.SPD), True)
     return A
+
+
+Csr = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def _pivot_pattern(K: PETSc.Mat, piv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(p, c) for each pivot p of this rank and each column c of K's row p."""
+    rows = [K.getRow(int(p))[0] for p in piv]
+    if not rows:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    lengths = [len(r) for r in rows]
+    return np.repeat(np.asarray(piv, np.int64), lengths), np.concatenate(rows).astype(np.int64)
+
+
+def _to_owners(
+    i: np.ndarray, j: np.ndarray, v: np.ndarray, ranges: np.ndarray, comm: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each (row, column, value) sent to the rank owning its row; this rank's received."""
+    owner = np.searchsorted(ranges, i, side="right") - 1
+    order = np.argsort(owner, kind="stable")
+    cuts = np.searchsorted(owner[order], np.arange(comm.size + 1))
+    parts = [
+        (i[order[a:b]], j[order[a:b]], v[order[a:b]]) for a, b in zip(cuts, cuts[1:], strict=False)
+    ]
+    got = comm.alltoall(parts)
+    return tuple(np.concatenate([g[k] for g in got]) for k in range(3))  # type: ignore[return-value]
+
+
+def add_entries(
+    ptr: np.ndarray,
+    cols: np.ndarray,
+    vals: np.ndarray,
+    rows: np.ndarray,
+    new_cols: np.ndarray,
+    new_vals: np.ndarray,
+    n_cols: int,
+) -> Csr:
+    """The CSR rows (ptr, cols, vals) plus the coordinates (rows, new_cols, new_vals).
+
+    Columns sorted in each row (as given and as returned); repeated coordinates are summed;
+    the pattern is the union. Coordinates already in the pattern are added into the values;
+    the others are inserted in one pass over the arrays (`np.insert`), so the cost is a copy
+    of the arrays however few rows the coordinates touch.
+    """
+    if len(rows) == 0:
+        return ptr.copy(), cols.copy(), vals.copy()
+    keys, where = np.unique(
+        rows.astype(np.int64) * n_cols + new_cols.astype(np.int64), return_inverse=True
+    )
+    sums = np.bincount(where.ravel(), weights=new_vals, minlength=len(keys))
+    key_rows = keys // n_cols
+    # The touched rows' entries as keys (ascending: rows ascending, columns sorted).
+    touched = np.unique(key_rows)
+    lengths = (ptr[touched + 1] - ptr[touched]).astype(np.int64)
+    at = _segments(ptr[touched].astype(np.int64), lengths)
+    old_keys = np.repeat(touched, lengths) * n_cols + cols[at]
+    pos = np.searchsorted(old_keys, keys)
+    found = pos < len(old_keys)
+    found[found] = old_keys[pos[found]] == keys[found]
+    new = ~found
+    # An absent key goes before the first larger column of its row (or at the row's end).
+    row_start = np.searchsorted(old_keys, key_rows[new] * n_cols)
+    put = ptr[key_rows[new]] + (pos[new] - row_start)
+    out_cols = np.insert(cols, put, (keys[new] % n_cols).astype(cols.dtype))
+    out_vals = np.insert(vals, put, sums[new])
+    old_at = at[pos[found]]
+    out_vals[old_at + np.searchsorted(put, old_at, side="right")] += sums[found]
+    counts = np.bincount(key_rows[new], minlength=len(ptr) - 1)
+    out_ptr = ptr + np.concatenate([[0], np.cumsum(counts)]).astype(ptr.dtype)
+    return out_ptr, out_cols, out_vals
+
+
+def _segments(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """The positions start, start + 1, ..., start + length - 1 of each segment, in order."""
+    offsets = np.cumsum(lengths) - lengths
+    return np.repeat(starts - offsets, lengths) + np.arange(int(lengths.sum()))
+
+
+def decouple(
+    ptr: np.ndarray,
+    cols: np.ndarray,
+    vals: np.ndarray,
+    rows: np.ndarray,
+    r0: int,
+    pivots: np.ndarray,
+    mine: np.ndarray,
+    diag: np.ndarray,
+) -> None:
+    """Zero the pivots' rows and columns in place; diag on the diagonal of the local rows
+    `mine` (this rank's pivots, each with its diagonal in the pattern).
+
+    Only the local `rows` (and `mine`) are looked at: they must hold every entry of a
+    pivot's row or column (all of C's rows do, with the pivots' own rows of K).
+    """
+    rows = np.union1d(rows, mine).astype(np.int64)
+    lengths = (ptr[rows + 1] - ptr[rows]).astype(np.int64)
+    at = _segments(ptr[rows].astype(np.int64), lengths)
+    row_of = np.repeat(rows, lengths)
+    own = np.isin(row_of, mine)
+    vals[at[own | np.isin(cols[at], pivots)]] = 0.0
+    on_diag = own & (cols[at] == row_of + r0)
+    order = np.argsort(mine)
+    vals[at[on_diag]] = diag[order][np.searchsorted(mine[order], row_of[on_diag])]
+
+
+def split_blocks(
+    ptr: np.ndarray, cols: np.ndarray, vals: np.ndarray, c0: int, c1: int
+) -> tuple[Csr, Csr]:
+    """The diagonal block (columns c0 <= c < c1, made local) and the rest (global columns)."""
+    it = PETSc.IntType
+    off = np.flatnonzero((cols < c0) | (cols >= c1))
+    off_rows = np.searchsorted(ptr, off, side="right") - 1
+    n_off = np.concatenate([[0], np.cumsum(np.bincount(off_rows, minlength=len(ptr) - 1))])
+    diag = (
+        (ptr - n_off).astype(it),
+        np.subtract(np.delete(cols, off), c0, dtype=it),
+        np.delete(vals, off),
+    )
+    return diag, (n_off.astype(it), cols[off].astype(it), vals[off])
 
 
 def coupling(
