@@ -36,7 +36,24 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from contactfx.linalg import elimination
 from contactfx.linalg.elimination import PivotRows, condensed_matrix, coupling
+
+PARTS = ["coupling", "_to_owners", "add_entries", "decouple", "assemble_blocks"]
+SPENT: dict[str, list[float]] = {}
+
+
+def _timing(name: str) -> None:
+    """Replace elimination.<name> by a wrapper adding its seconds to SPENT[name][-1]."""
+    f = getattr(elimination, name)
+
+    def wrapped(*args: Any, **kwargs: Any) -> Any:
+        t = time.perf_counter()
+        out = f(*args, **kwargs)
+        SPENT[name][-1] += time.perf_counter() - t
+        return out
+
+    setattr(elimination, name, wrapped)
 
 
 def axpy_matrix(
@@ -117,7 +134,9 @@ def grid_matrix(dofs: float, comm: MPI.Comm) -> tuple[PETSc.Mat, PivotRows, np.n
     return K, prows, (2 * mine).astype(np.int64), n
 
 
-def hertz_problem(refine: float, h_far: float, comm: MPI.Comm) -> tuple[PETSc.Mat, PivotRows, np.ndarray, int]:
+def hertz_problem(
+    refine: float, h_far: float, comm: MPI.Comm
+) -> tuple[PETSc.Mat, PivotRows, np.ndarray, int]:
     """The structured Hertz scene's K and the pivots of the zone x < a (dual mortar)."""
     from contactfx.contact import Kernel
     from contactfx.discretize.setup import prepare_contact
@@ -204,10 +223,15 @@ def main() -> None:
     new: list[float] = []
     csr: list[float] = []
     ok, err = True, 0.0
+    for name in PARTS:
+        _timing(name)
+        SPENT[name] = []
     full = comm.allreduce(K.getInfo()["nz_used"], op=MPI.MAX) < 3e7
     for _ in range(args.repeat):
         t_csr, _ = timed(lambda: K.getValuesCSR(), comm)  # type: ignore[arg-type,return-value]
         t_old, A = timed(lambda: axpy_matrix(K, prows, r0, piv, diag), comm)
+        for name in PARTS:
+            SPENT[name].append(0.0)
         t_new, B, ok, err = compared(
             A, lambda: condensed_matrix(K, prows, r0, piv, diag), scale, full, comm
         )
@@ -227,6 +251,9 @@ def main() -> None:
         "merge_s": round(float(np.median(new)), 3),
         "ratio": round(float(np.median(old)) / float(np.median(new)), 2),
         "get_values_csr_s": round(float(np.median(csr)), 3),
+        "merge_parts_s": {  # this rank's medians (the merge's total is the slowest rank's)
+            k: round(float(np.median(v)), 3) for k, v in SPENT.items()
+        },
         "axpy_all": [round(x, 3) for x in old],
         "merge_all": [round(x, 3) for x in new],
         "same_pattern": ok,

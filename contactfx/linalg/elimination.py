@@ -14,6 +14,7 @@ what it needs explicitly (B's local CSR rows, E's pivot rows).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import pairwise
 from typing import Any, cast
 
 import numpy as np
@@ -75,9 +76,10 @@ def condensed_matrix(
 
     E is nonzero on the pivot rows only, so C touches the pivots' neighbourhoods: it is
     summed here from the pivots' rows of K as coordinates (`coupling`), sent to the rows'
-    owners and inserted into a copy of K's local rows (`add_entries`, the union pattern); the
-    pivot rows and columns are decoupled there (`decouple`), and the diagonal and
-    off-diagonal blocks are handed to PETSc as they are (`split_blocks`). PETSc's products
+    owners and added to K's rows there (`add_entries`, the union pattern), where the pivot
+    rows and columns are decoupled (`decouple`); K's local rows (one copy) get these rows
+    in place, as the diagonal and off-diagonal blocks PETSc takes as they are
+    (`assemble_blocks`, MatCreateMPIAIJWithSplitArrays). PETSc's products
     E^T K cost passes over all rows that grew faster than the DOFs, and its MatAXPY with a
     different pattern rebuilds the matrix entry by entry: several times slower at millions
     of DOFs (benchmarks/README.md, "Building the condensed matrix").
@@ -91,15 +93,18 @@ def condensed_matrix(
     v = np.concatenate([v, np.zeros(2 * len(zi))])
     i, j, v = _to_owners(i, j, v, K.getOwnershipRanges(), mpi)
     ptr, cols, vals = (np.asarray(a) for a in K.getValuesCSR())
-    n_global = K.getSize()[1]
-    ptr, cols, vals = add_entries(ptr, cols, vals, i - r0, j, v, n_global)
-    every = np.concatenate(mpi.allgather(np.asarray(piv, dtype=np.int64)))
+    # The few rows C touches: summed with K's there and decoupled, as a small CSR.
+    rows = np.unique(i - r0)
+    sub = _rows_of(ptr, cols, vals, rows)
+    sub = add_entries(*sub, np.searchsorted(rows, i - r0), j, v, K.getSize()[1])
     ip: Any = np.asarray(piv, dtype=PETSc.IntType)
-    decouple(ptr, cols, vals, np.unique(i - r0), r0, every, ip - r0, k_diag.getValues(ip))
+    every = np.concatenate(mpi.allgather(np.asarray(piv, dtype=np.int64)))
+    decouple(*sub, rows + r0, every, ip, k_diag.getValues(ip))
     c0, c1 = K.getOwnershipRangeColumn()
-    A = PETSc.Mat().createAIJWithArrays(
-        cast(Any, K.getSizes()), cast(Any, split_blocks(ptr, cols, vals, c0, c1)), comm=K.getComm()
-    )
+    blocks = assemble_blocks(ptr, cols, vals, rows, sub, c0, c1)  # in cols' and vals' memory
+    del ptr, cols, vals
+    sizes: Any = K.getSizes()
+    A = PETSc.Mat().createAIJWithArrays(sizes, cast(Any, blocks), comm=K.getComm())
     A.setBlockSize(2)
     # Symmetric positive definite: what a Cholesky factorization (MUMPS SYM=1) needs to know.
     A.setOption(cast(PETSc.Mat.Option, PETSc.Mat.Option.SPD), True)
@@ -125,9 +130,7 @@ def _to_owners(
     owner = np.searchsorted(ranges, i, side="right") - 1
     order = np.argsort(owner, kind="stable")
     cuts = np.searchsorted(owner[order], np.arange(comm.size + 1))
-    parts = [
-        (i[order[a:b]], j[order[a:b]], v[order[a:b]]) for a, b in zip(cuts, cuts[1:], strict=False)
-    ]
+    parts = [(i[order[a:b]], j[order[a:b]], v[order[a:b]]) for a, b in pairwise(cuts)]
     got = comm.alltoall(parts)
     return tuple(np.concatenate([g[k] for g in got]) for k in range(3))  # type: ignore[return-value]
 
@@ -182,47 +185,147 @@ def _segments(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     return np.repeat(starts - offsets, lengths) + np.arange(int(lengths.sum()))
 
 
+def _rows_of(ptr: np.ndarray, cols: np.ndarray, vals: np.ndarray, rows: np.ndarray) -> Csr:
+    """The CSR rows `rows` (sorted) of (ptr, cols, vals), copied."""
+    lengths = (ptr[rows + 1] - ptr[rows]).astype(np.int64)
+    at = _segments(ptr[rows].astype(np.int64), lengths)
+    sub_ptr = np.concatenate([[0], np.cumsum(lengths)]).astype(ptr.dtype)
+    return sub_ptr, cols[at], vals[at]
+
+
 def decouple(
     ptr: np.ndarray,
     cols: np.ndarray,
     vals: np.ndarray,
-    rows: np.ndarray,
-    r0: int,
+    row_ids: np.ndarray,
     pivots: np.ndarray,
-    mine: np.ndarray,
+    own: np.ndarray,
     diag: np.ndarray,
 ) -> None:
-    """Zero the pivots' rows and columns in place; diag on the diagonal of the local rows
-    `mine` (this rank's pivots, each with its diagonal in the pattern).
+    """Zero the pivots' rows and columns in place, diag on the diagonal of the rows `own`.
 
-    Only the local `rows` (and `mine`) are looked at: they must hold every entry of a
-    pivot's row or column (all of C's rows do, with the pivots' own rows of K).
+    row_ids: the global row of each CSR row; own: pivots among them, each with its diagonal
+    in the pattern (diag: their values); pivots: every rank's. The rows given must hold
+    every entry of these rows and columns (what C touches does, with the pivots' own rows).
     """
-    rows = np.union1d(rows, mine).astype(np.int64)
-    lengths = (ptr[rows + 1] - ptr[rows]).astype(np.int64)
-    at = _segments(ptr[rows].astype(np.int64), lengths)
-    row_of = np.repeat(rows, lengths)
-    own = np.isin(row_of, mine)
-    vals[at[own | np.isin(cols[at], pivots)]] = 0.0
-    on_diag = own & (cols[at] == row_of + r0)
-    order = np.argsort(mine)
-    vals[at[on_diag]] = diag[order][np.searchsorted(mine[order], row_of[on_diag])]
+    lengths = np.diff(ptr).astype(np.int64)
+    row_of = np.repeat(np.asarray(row_ids, np.int64), lengths)
+    mine = np.isin(row_of, own)
+    vals[mine | np.isin(cols, pivots)] = 0.0
+    on_diag = np.flatnonzero(mine & (cols == row_of))
+    order = np.argsort(own)
+    sorted_own = np.asarray(own)[order]
+    vals[on_diag] = np.asarray(diag)[order][np.searchsorted(sorted_own, row_of[on_diag])]
 
 
-def split_blocks(
-    ptr: np.ndarray, cols: np.ndarray, vals: np.ndarray, c0: int, c1: int
+def assemble_blocks(
+    ptr: np.ndarray,
+    cols: np.ndarray,
+    vals: np.ndarray,
+    rows: np.ndarray,
+    sub: Csr,
+    c0: int,
+    c1: int,
 ) -> tuple[Csr, Csr]:
-    """The diagonal block (columns c0 <= c < c1, made local) and the rest (global columns)."""
+    """The local CSR rows, rows `rows` replaced by `sub`'s, as diagonal and off-diagonal blocks.
+
+    The diagonal block has the columns c0 <= c < c1 (made local), the other the rest (global
+    columns), both PetscInt; `rows` is sorted. cols and vals (PetscInt, PetscScalar) are
+    consumed: the diagonal block is built in their memory (resized, the runs of entries
+    between the replaced rows and the off-diagonal ones moved in place), which maps no new
+    pages but the growth: on fresh pages the faults cost as much as the copy
+    (benchmarks/README.md, "Building the condensed matrix").
+    """
     it = PETSc.IntType
+    n, nnz = len(ptr) - 1, len(cols)
+    rows = np.asarray(rows, np.int64)
+    sp_, sc, sv = sub
+    sub_len = np.diff(sp_).astype(np.int64)
+    # Off-diagonal entries: K's outside the replaced rows, and the replacements'.
     off = np.flatnonzero((cols < c0) | (cols >= c1))
-    off_rows = np.searchsorted(ptr, off, side="right") - 1
-    n_off = np.concatenate([[0], np.cumsum(np.bincount(off_rows, minlength=len(ptr) - 1))])
-    diag = (
-        (ptr - n_off).astype(it),
-        np.subtract(np.delete(cols, off), c0, dtype=it),
-        np.delete(vals, off),
-    )
-    return diag, (n_off.astype(it), cols[off].astype(it), vals[off])
+    off_row = np.searchsorted(ptr, off, side="right") - 1
+    keep = ~_member(off_row, rows)
+    off, off_row = off[keep], off_row[keep]
+    sub_row = np.repeat(rows, sub_len)
+    sub_off = (sc < c0) | (sc >= c1)
+    o_row = np.concatenate([off_row, sub_row[sub_off]])
+    order = np.argsort(o_row, kind="stable")  # each row from one source, columns sorted
+    o_cols = np.concatenate([cols[off], sc[sub_off]])[order].astype(it)
+    o_vals = np.concatenate([vals[off], sv[sub_off]])[order]
+    o_count = np.bincount(o_row, minlength=n)
+    counts = np.diff(ptr).astype(np.int64)
+    counts[rows] = sub_len
+    d_ptr = np.concatenate([[0], np.cumsum(counts - o_count)])
+    # The runs of K's entries kept: between the replaced rows and the off-diagonal entries.
+    starts = np.concatenate([ptr[rows].astype(np.int64), off])
+    ends = np.concatenate([ptr[rows + 1].astype(np.int64), off + 1])
+    order = np.argsort(starts, kind="stable")
+    run_a = np.concatenate([[0], ends[order]])
+    run_b = np.concatenate([starts[order], [nnz]])
+    nonempty = run_b > run_a
+    run_a, run_b = run_a[nonempty], run_b[nonempty]
+    run_row = np.searchsorted(ptr, run_a, side="right") - 1
+    before = np.searchsorted(off, run_a) - np.searchsorted(off, ptr[run_row])
+    shift = d_ptr[run_row] - ptr[run_row] - before
+    size = int(d_ptr[-1])
+    d_cols = _resized(cols, max(size, nnz))
+    d_vals = _resized(vals, max(size, nnz))
+    for arr in (d_cols, d_vals):
+        _move_runs(arr, run_a, run_b, shift)
+    d_cols, d_vals = _resized(d_cols, size), _resized(d_vals, size)
+    d_cols -= c0
+    at = _segments(d_ptr[rows], sub_len - np.bincount(sub_row[sub_off], minlength=n)[rows])
+    d_cols[at] = sc[~sub_off] - c0
+    d_vals[at] = sv[~sub_off]
+    o_ptr = np.concatenate([[0], np.cumsum(o_count)])
+    return (d_ptr.astype(it), d_cols, d_vals), (o_ptr.astype(it), o_cols, o_vals)
+
+
+# Entries moved at a time, through one buffer (numpy would allocate a new one for each
+# overlapping move: new pages, whose faults cost as much as the copy).
+_CHUNK = 1 << 18
+
+
+def _resized(a: np.ndarray, size: int) -> np.ndarray:
+    """The array with `size` entries, in place where numpy can (realloc), else copied."""
+    try:
+        a.resize(size, refcheck=False)
+        return a
+    except ValueError:  # a view or not its own memory
+        out = np.empty(size, dtype=a.dtype)
+        m = min(size, len(a))
+        out[:m] = a[:m]
+        return out
+
+
+def _move_runs(a: np.ndarray, run_a: np.ndarray, run_b: np.ndarray, shift: np.ndarray) -> None:
+    """a[x + s] = a[x] for each run [x0, x1) and its shift s, in place.
+
+    The destinations keep the runs' order and do not overlap: runs moving right are moved
+    from the last, the ones moving left from the first, each in chunks from its leading
+    end (through a buffer), so no source is overwritten before it is read.
+    """
+    right = np.flatnonzero(shift > 0)[::-1]
+    left = np.flatnonzero(shift < 0)
+    buf = np.empty(min(_CHUNK, len(a)), dtype=a.dtype)
+    for k in right.tolist():
+        x0, x1, d = int(run_a[k]), int(run_b[k]), int(shift[k])
+        for y in range(x1, x0, -_CHUNK):
+            x = max(x0, y - _CHUNK)
+            buf[: y - x] = a[x:y]
+            a[x + d : y + d] = buf[: y - x]
+    for k in left.tolist():
+        x0, x1, d = int(run_a[k]), int(run_b[k]), int(shift[k])
+        for x in range(x0, x1, _CHUNK):
+            y = min(x1, x + _CHUNK)
+            buf[: y - x] = a[x:y]
+            a[x + d : y + d] = buf[: y - x]
+
+
+def _member(x: np.ndarray, sorted_set: np.ndarray) -> np.ndarray:
+    """Which entries of x are in sorted_set (sorted, unique)."""
+    at = np.minimum(np.searchsorted(sorted_set, x), max(len(sorted_set) - 1, 0))
+    return sorted_set[at] == x if len(sorted_set) else np.zeros(len(x), dtype=bool)
 
 
 def coupling(

@@ -1,5 +1,6 @@
 """The CSR kernels that build the condensed matrix (contactfx/linalg/elimination.py),
-against scipy.sparse: the sum with coordinates, the pivots decoupled, the two blocks."""
+against scipy.sparse: the sum with coordinates, the pivots decoupled, the two blocks with
+rows replaced."""
 
 from __future__ import annotations
 
@@ -11,7 +12,13 @@ import scipy.sparse as sp
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from contactfx.linalg.elimination import add_entries, condensed_matrix, decouple, split_blocks
+from contactfx.linalg import elimination
+from contactfx.linalg.elimination import (
+    add_entries,
+    assemble_blocks,
+    condensed_matrix,
+    decouple,
+)
 
 
 def _random_csr(
@@ -75,43 +82,62 @@ def test_add_entries_is_the_sum(seed: int, n_new: int) -> None:
 @pytest.mark.parametrize("seed", range(4))
 def test_decouple_zeroes_pivot_rows_and_columns(seed: int) -> None:
     """The pivots' rows and columns zero, their own diagonal given; the rest unchanged
-    (a square slab of rows r0.. of a symmetric matrix, pivots elsewhere too)."""
+    (some rows of a symmetric matrix: the ones holding a pivot's column; pivots elsewhere
+    too)."""
     rng = np.random.default_rng(seed)
-    m, r0, n = 80, 20, 30
+    m = 80
     a = _random_csr(rng, m, m, 0.1)
     a = (a + a.T).tocsr()
     a.sort_indices()
-    local = a[r0 : r0 + n].tocsr()
     pivots = np.sort(rng.choice(m, 12, replace=False))
-    mine = pivots[(pivots >= r0) & (pivots < r0 + n)] - r0
-    diag = rng.uniform(1.0, 2.0, len(mine))
+    dense = a.toarray()
+    rows = np.flatnonzero((dense[:, pivots] != 0).any(axis=1))  # what the caller hands over
+    local = a[rows].tocsr()
+    own = rng.permutation(pivots[np.isin(pivots, rows[::2])])  # this rank's, in any order
+    diag = rng.uniform(1.0, 2.0, len(own))
     ptr, cols, vals = _arrays(local)
-    # The rows holding a pivot's row or column (what the caller hands over).
-    dense = local.toarray()
-    rows = np.flatnonzero((dense[:, pivots] != 0).any(axis=1))
-    decouple(ptr, cols, vals, rows, r0, pivots, mine, diag)
+    decouple(ptr, cols, vals, rows, pivots, own, diag)
     want = dense.copy()
     want[:, pivots] = 0.0
-    want[mine, :] = 0.0
-    want[mine, mine + r0] = diag
-    assert np.array_equal(_dense(ptr, cols, vals, m), want)
-    assert len(mine) > 0
+    want[own, :] = 0.0
+    want[own, own] = diag
+    assert np.array_equal(_dense(ptr, cols, vals, m), want[rows])
+    assert len(own) > 0
 
 
+@pytest.mark.parametrize("seed", range(3))
 @pytest.mark.parametrize(("c0", "c1"), [(0, 75), (20, 50), (0, 30), (40, 75)])
-def test_split_blocks_rebuild_the_rows(c0: int, c1: int) -> None:
-    """Diagonal block (columns made local) and off-diagonal block (global columns) put
-    back together are the rows given."""
-    rng = np.random.default_rng(c0 + c1)
-    a = _random_csr(rng, 40, 75, 0.15)
-    (dp, dj, dv), (op, oj, ov) = split_blocks(*_arrays(a), c0, c1)
+@pytest.mark.parametrize("n_rows", [0, 1, 9, 30])
+@pytest.mark.parametrize("views", [False, True])
+def test_assemble_blocks_rebuild_the_rows(
+    seed: int, c0: int, c1: int, n_rows: int, views: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The diagonal block (columns made local) and the off-diagonal block (global columns)
+    put back together are the rows given, with the rows `rows` replaced by `sub`'s
+    (longer, shorter, empty, both blocks): the runs moved in place both ways, in chunks of
+    3 entries (overlapping moves), or copied where the arrays are views."""
+    monkeypatch.setattr(elimination, "_CHUNK", 3)
+    rng = np.random.default_rng(seed + 10 * c0 + c1)
+    n, m = 40, 75
+    a = _random_csr(rng, n, m, 0.15, diagonal=False)
+    rows = np.sort(rng.choice(n, n_rows, replace=False))
+    sub = _random_csr(rng, n_rows, m, 0.3, diagonal=False)
+    ptr, cols, vals = _arrays(a)
+    if views:
+        cols, vals = np.concatenate([cols, cols])[: len(cols)], np.tile(vals, 2)[: len(vals)]
+    (dp, dj, dv), (op, oj, ov) = assemble_blocks(ptr, cols, vals, rows, _arrays(sub), c0, c1)
     for x in (dp, dj, op, oj):
         assert x.dtype == PETSc.IntType
+    for p, j in ((dp, dj), (op, oj)):
+        assert all(np.all(np.diff(j[p[r] : p[r + 1]]) > 0) for r in range(n))
+    want = a.toarray()
+    want[rows] = sub.toarray()
     diag = _dense(dp, dj, dv, c1 - c0)
-    off = _dense(op, oj, ov, 75)
+    off = _dense(op, oj, ov, m)
     assert not off[:, c0:c1].any()
     off[:, c0:c1] = diag
-    assert np.array_equal(off, a.toarray())
+    assert np.array_equal(off, want)
+    assert len(dj) + len(oj) == (want != 0).sum()
 
 
 def test_condensed_matrix_outlives_its_python_object() -> None:
