@@ -281,8 +281,7 @@ def assemble_blocks(
     return (d_ptr.astype(it), d_cols, d_vals), (o_ptr.astype(it), o_cols, o_vals)
 
 
-# Entries moved at a time, through one buffer (numpy would allocate a new one for each
-# overlapping move: new pages, whose faults cost as much as the copy).
+# Entries moved at a time through one buffer (numpy's own, one per move: new pages).
 _CHUNK = 1 << 18
 
 
