@@ -19,7 +19,7 @@ two solves, the press alone and the final loads). Paths: `mumps` (frictionless: 
 saddle point; frictional: LU of the unsymmetric one, analysis and factorization kept) and
 the condensed ones (frictionless: CG; frictional: GMRES).
 
-    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py sweep [hertz] [pushed:condensed-gamg]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py sweep [hertz[:PATH]] [pushed] [--all3]
     OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py table    # README rows, chart
     OPENBLAS_NUM_THREADS=1 python benchmarks/friction_cost.py one pushed 0.06 mumps 0.3
 
@@ -34,6 +34,7 @@ this mesh costs minutes from 500k).
 from __future__ import annotations
 
 import json
+import os
 import resource
 import subprocess
 import sys
@@ -198,6 +199,8 @@ PLAN = {
 }
 CONDENSED_GAMG_MAX = 500_000
 REPEATS_BELOW = 200_000  # sizes below this many DOFs run three times (medians)
+# `sweep ... --all3`: every size three times (the environment variable, read by _measure).
+ALL_THREE = "FRICTION_COST_ALL3"
 
 
 def sweep(families: list[str]) -> None:
@@ -244,7 +247,7 @@ def _measure(family: str, refine: float, solver: str) -> dict[str, Any] | None:
             return None
         fr.append(a)
         fl.append(b)
-        if a["dofs"] >= REPEATS_BELOW or k == 2:
+        if (a["dofs"] >= REPEATS_BELOW and not os.environ.get(ALL_THREE)) or k == 2:
             break
     ratios = [a["solve_s"] / b["solve_s"] for a, b in zip(fr, fl, strict=True)]
     row = {"family": family, "refine": refine, "solver": solver, "dofs": fr[0]["dofs"]}
@@ -301,7 +304,9 @@ if __name__ == "__main__":
     if sys.argv[1] == "one":
         print(json.dumps(one(sys.argv[2], float(sys.argv[3]), sys.argv[4], float(sys.argv[5]))))
     elif sys.argv[1] == "sweep":
-        sweep(sys.argv[2:] or list(PLAN))
+        if "--all3" in sys.argv:
+            os.environ[ALL_THREE] = "1"
+        sweep([a for a in sys.argv[2:] if a != "--all3"] or list(PLAN))
     else:
         done = json.loads((HERE / "friction_cost.json").read_text())
         chart(done)
