@@ -71,7 +71,14 @@ def refine_for(dofs: float, mesh: str = "structured", ratio: float = H_RATIO) ->
             return 125.6 / h**2 + 324.0 / h
         return 2 * len(hertz_grid(60.0, 60.0, 60.0, h, 2.0, ratio * h, 0.1)[0])
 
-    lo, hi = 1e-3, 2.0
+    # A bracket from the 2D count ~ 1 / h^2 (bisecting from 1e-3 built grids of 10^8 nodes
+    # on the way to 10M DOFs with h_far = h, and ran out of memory).
+    guess = 0.2 * (count(0.2) / dofs) ** 0.5
+    lo, hi = guess / 1.5, guess * 1.5
+    while count(lo) < dofs:
+        lo /= 1.5
+    while count(hi) > dofs:
+        hi *= 1.5
     for _ in range(30):
         mid = (lo * hi) ** 0.5
         lo, hi = (mid, hi) if count(mid) > dofs else (lo, mid)

@@ -282,7 +282,7 @@ def chart(data: list[dict[str, Any]]) -> str:
     bx.set_ylim(bottom=0)
     bx.set_xlabel("dofs")
     bx.set_ylabel("CG iterations, one fresh solve to 1e-9")
-    bx.set_title("condensed: CG + GAMG iterations")
+    bx.set_title("condensed: CG iterations (geometric multigrid)")
     bx.grid(True, which="both", alpha=0.3)
     bx.legend(fontsize=7)
     fig.tight_layout()
@@ -314,6 +314,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="three small cases")
     ap.add_argument("--replot", action="store_true", help="redo table and chart from scale.json")
+    ap.add_argument(
+        "--resume", action="store_true", help="keep scale.json's cases, run the plan's others"
+    )
     args = ap.parse_args()
     path = HERE / ("scale_quick.json" if args.quick else "scale.json")
     if args.replot:
@@ -330,7 +333,16 @@ def main() -> None:
         "quick": args.quick,
     }
     runs: list[dict[str, Any]] = []
+    if args.resume:
+        saved = json.loads(path.read_text())
+        meta, runs = saved["meta"], saved["runs"]
+        meta["resumed"] = time.strftime("%Y-%m-%d %H:%M")
+    done = {
+        (r["target"], r["solver"], r["ranks"], r["ratio_far"], r["with_reference"]) for r in runs
+    }
     for dofs, solver, ranks, ratio, reference, methods in plan(args.quick):
+        if (dofs, solver, ranks, ratio, reference) in done:
+            continue
         runs += case(dofs, solver, ranks, ratio, reference, methods)
         path.write_text(json.dumps({"meta": meta, "runs": runs}, indent=1))
     meta.update(minutes=(time.perf_counter() - t0) / 60, load_after=os.getloadavg()[0])
