@@ -1,5 +1,5 @@
 """Coulomb friction on scenes whose active set cycled or carried a spurious shear
-(methods/friction.py, docs/friction.md "How it is solved").
+(methods/friction_iteration.py, docs/friction.md "How it is solved").
 
 With mu = 0.2 on their pairs: the heated block between rigid walls (its walls' slip turns
 against the slip direction each set assumes: the undamped update cycled), the quarter shrink
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-import contactfx.methods.friction as friction_method
+import contactfx.methods.friction_iteration as friction_method
 from contactfx import load_scene_file, solve
 from contactfx.contact.friction import Status
 from contactfx.errors import ActiveSetError
