@@ -101,7 +101,7 @@ class PushoutReference:
     At each load step the pair's axial force (total over the turn) against mu times its
     normal force N = sum_j w_j lambda_n,j (the contact pressure integrated over the revolved
     interface, total over the turn as well): their ratio reaches 1 in full slip, where every
-    contact node slips with |shear| = mu p. `mu` None takes the pair's. With the rings' radii
+    contact node slips with `|shear| = mu p`. `mu` None takes the pair's. With the rings' radii
     (a, b, c; `delta` None: the pair's `interference = D`) the first step, the fit before the
     push, is compared with Lame's open-ended cylinder and its plane-strain value
     (docs/friction_verification.md, "The push-out of a press fit").
