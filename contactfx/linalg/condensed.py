@@ -210,14 +210,7 @@ class CondensedSolver:
             raise check.error or SolverError(petsc_error_message(err, "condensed solve")) from None
         finally:
             check.ask = None
-        reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
-        if check.error is not None:
-            raise check.error
-        if reason <= 0 or not np.isfinite(v.norm()):
-            raise SolverError(
-                f"condensed solve ({ksp.getType()}) did not converge: PETSc "
-                f"reason {reason} ({reason_name(reason)}) after {its} iterations"
-            )
+        its = self._iterations(ksp, v, "condensed solve")
         final = target <= self._rtol and not check.stopped
         u, mu = self._answer(E, v, t, r, pv, len(active))
         t2 = time.perf_counter()
@@ -227,7 +220,20 @@ class CondensedSolver:
             A.destroy()
         self.stats["reused" if reuse else "factorizations"] += 1
         self.stats["setup_time"] += t1 - t0
+        reason = cast(int, ksp.getConvergedReason())
         return SaddleResult(u, mu, its, reason, not reuse, -1, 0, t1 - t0, t2 - t1, final=final)
+
+    def _iterations(self, ksp: PETSc.KSP, v: PETSc.Vec, what: str) -> int:
+        """The run's iterations; the checkpoint's error, or SolverError where it diverged."""
+        reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
+        if self._check.error is not None:
+            raise self._check.error
+        if reason <= 0 or not np.isfinite(v.norm()):
+            raise SolverError(
+                f"{what} ({ksp.getType()}) did not converge: PETSc "
+                f"reason {reason} ({reason_name(reason)}) after {its} iterations"
+            )
+        return its
 
     def _answer(
         self, E: PETSc.Mat, v: PETSc.Vec, t: PETSc.Vec, r: PETSc.Vec, pv: Pivots, n: int

@@ -22,9 +22,16 @@ from petsc4py import PETSc
 
 from ..errors import SolverError
 from .condensed import CondensedSolver, _geometric_levels
-from .elimination import LocalRows, condensed_matrix, elimination_matrix, t_mult, t_mult_transpose
+from .elimination import (
+    CondensedOperator,
+    LocalRows,
+    condensed_matrix,
+    elimination_matrix,
+    t_mult,
+    t_mult_transpose,
+)
 from .node_blocks import NodeBlocks, node_blocks
-from .petsc_options import petsc_error_message, reason_name
+from .petsc_options import petsc_error_message
 
 # GMRES keeps every direction of a solve: the preconditioned operator differs from the
 # identity by the slipping nodes' rank, and a restart would lose what CG's recurrence keeps.
@@ -42,27 +49,6 @@ class FrictionSolve:
     setup: float
     solve: float
     final: bool = True  # solved to the final tolerance (else the loop's loose answer)
-
-
-class FrictionOperator:
-    """y = (W^T K T + P) x matrix-free, T = I + E_C, W = I + E_G (a petsc4py Python matrix)."""
-
-    def __init__(self, K: PETSc.Mat, EC: PETSc.Mat, EG: PETSc.Mat, d: PETSc.Vec) -> None:
-        self._K, self._EC, self._EG, self._d = K, EC, EG, d
-        self._w1, self._w2 = K.createVecRight(), K.createVecLeft()
-
-    def mult(self, mat: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
-        """The product with x (the pivots' own diagonal added: they are decoupled)."""
-        t_mult(self._EC, x, self._w1)
-        self._K.mult(self._w1, self._w2)
-        t_mult_transpose(self._EG, self._w2, y)
-        self._w1.pointwiseMult(self._d, x)
-        y.axpy(1.0, self._w1)
-
-    def destroy(self, mat: PETSc.Mat) -> None:
-        """Free the work vectors with the shell matrix."""
-        self._w1.destroy()
-        self._w2.destroy()
 
 
 class _Cycle:
@@ -140,7 +126,7 @@ class FrictionCondensedSolver(CondensedSolver):
         v.setValues(ip, cast(Any, np.zeros(len(nb.dofs))))
         v.assemble()
         A = PETSc.Mat().createPython(
-            cast(Any, self._K.getSizes()), FrictionOperator(self._K, EC, EG, d), comm=self._comm
+            cast(Any, self._K.getSizes()), CondensedOperator(self._K, EC, d, EG), comm=self._comm
         )
         A.setUp()
         ksp, check = self._outer, self._check
@@ -171,14 +157,7 @@ class FrictionCondensedSolver(CondensedSolver):
             ) from None
         finally:
             check.ask = None
-        reason, its = cast(int, ksp.getConvergedReason()), ksp.getIterationNumber()
-        if check.error is not None:
-            raise check.error
-        if reason <= 0 or not np.isfinite(v.norm()):
-            raise SolverError(
-                f"frictional condensed solve (gmres) did not converge: PETSc reason {reason} "
-                f"({reason_name(reason)}) after {its} iterations"
-            )
+        its = self._iterations(ksp, v, "frictional condensed solve")
         mu_n, mu_t = self._recover(EC, v, t, r, nb)
         t2 = time.perf_counter()
         for obj in (EC, EG, d, t, r, b, v, A):

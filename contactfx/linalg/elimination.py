@@ -81,18 +81,18 @@ def condensed_matrix(
     in place, as the diagonal and off-diagonal blocks PETSc takes as they are
     (`assemble_blocks`, MatCreateMPIAIJWithSplitArrays). PETSc's products E^T K cost passes
     over all rows that grew faster than the DOFs, and its MatAXPY with a different pattern
-    rebuilds the matrix entry by entry: 1.2-2.8 times this way's time at 2.6M-10.4M DOFs
-    (benchmarks/README.md, "Building the condensed matrix").
+    rebuilds the matrix entry by entry (the two ways timed: benchmarks/README.md, "Building
+    the condensed matrix").
     """
     mpi = K.getComm().tompi4py()
     i, j, v = coupling(K, prows, r0, mpi)
+    ptr, cols, vals = (np.asarray(a) for a in K.getValuesCSR())
     # Zero entries on the pivots' rows and columns of K: every row a pivot touches is then
     # one of the rows handed over (the pivots of `piv` without an E row included).
-    zi, zj = _pivot_pattern(K, piv)
+    zi, zj = _pivot_pattern(ptr, cols, np.asarray(piv, np.int64), r0)
     i, j = np.concatenate([i, zi, zj]), np.concatenate([j, zj, zi])
     v = np.concatenate([v, np.zeros(2 * len(zi))])
     i, j, v = _to_owners(i, j, v, K.getOwnershipRanges(), mpi)
-    ptr, cols, vals = (np.asarray(a) for a in K.getValuesCSR())
     # The few rows C touches: summed with K's there and decoupled, as a small CSR.
     rows = np.unique(i - r0)
     sub = _rows_of(ptr, cols, vals, rows)
@@ -114,13 +114,14 @@ def condensed_matrix(
 Csr = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def _pivot_pattern(K: PETSc.Mat, piv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(p, c) for each pivot p of this rank and each column c of K's row p."""
-    rows = [K.getRow(int(p))[0] for p in piv]
-    if not rows:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    lengths = [len(r) for r in rows]
-    return np.repeat(np.asarray(piv, np.int64), lengths), np.concatenate(rows).astype(np.int64)
+def _pivot_pattern(
+    ptr: np.ndarray, cols: np.ndarray, piv: np.ndarray, r0: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """(p, c) for each pivot p of this rank and each column c of its row in K's local CSR."""
+    local = piv - r0
+    lengths = (ptr[local + 1] - ptr[local]).astype(np.int64)
+    at = _segments(ptr[local].astype(np.int64), lengths)
+    return np.repeat(piv, lengths), cols[at].astype(np.int64)
 
 
 def _to_owners(
@@ -379,17 +380,22 @@ def t_mult_transpose(E: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
 
 
 class CondensedOperator:
-    """y = (T^T K T + P) x applied matrix-free, T = I + E (a petsc4py Python matrix context)."""
+    """y = (W^T K T + P) x applied matrix-free (a petsc4py Python matrix context).
 
-    def __init__(self, K: PETSc.Mat, E: PETSc.Mat, d: PETSc.Vec) -> None:
-        self._K, self._E, self._d = K, E, d
+    T = I + E, W = I + G (G None: W = T); friction's slipping rows make W differ from T.
+    """
+
+    def __init__(
+        self, K: PETSc.Mat, E: PETSc.Mat, d: PETSc.Vec, G: PETSc.Mat | None = None
+    ) -> None:
+        self._K, self._E, self._G, self._d = K, E, E if G is None else G, d
         self._w1, self._w2 = K.createVecRight(), K.createVecLeft()
 
     def mult(self, mat: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> None:
         """The product with x (the pivots' own diagonal added: they are decoupled)."""
         t_mult(self._E, x, self._w1)
         self._K.mult(self._w1, self._w2)
-        t_mult_transpose(self._E, self._w2, y)
+        t_mult_transpose(self._G, self._w2, y)
         self._w1.pointwiseMult(self._d, x)
         y.axpy(1.0, self._w1)
 
