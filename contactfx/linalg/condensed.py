@@ -29,6 +29,7 @@ from ..errors import SolverError
 from .elimination import (
     CondensedOperator,
     LocalRows,
+    PivotRows,
     condensed_matrix,
     elimination_matrix,
     t_mult,
@@ -272,17 +273,25 @@ class CondensedSolver:
             assert self._A is not None
             ksp.setOperators(A, self._A)
             return A
-        piv = pv.dofs
-        A = condensed_matrix(self._K, pv.e_rows, self._r0, piv, self._diag)
+        A = self._multigrid(pv.e_rows, pv.dofs)
+        if not self._tested:  # before PETSc's default test, once (after the type is set)
+            ksp.addConvergenceTest(cast(Any, self._check.test), prepend=True)
+            self._tested = True
+        return A
+
+    def _multigrid(self, prows: PivotRows, piv: np.ndarray) -> PETSc.Mat:
+        """T^T K T + P of these pivot rows as the inner KSP's operator (not yet set up).
+
+        The multigrid's levels are given and the matrix kept: the multigrid is built from it.
+        """
+        ksp = self._ksp
+        A = condensed_matrix(self._K, prows, self._r0, piv, self._diag)
         if self._modes:
             A.setNearNullSpace(self._near_nullspace(piv))
         if self._interp:  # before the operators: a rebuild resets the PC
             _geometric_levels(ksp.getPC(), self._interp, piv)
         ksp.setOperators(A)
         ksp.setFromOptions()
-        if not self._tested:  # before PETSc's default test, once (after the type is set)
-            ksp.addConvergenceTest(cast(Any, self._check.test), prepend=True)
-            self._tested = True
         if self._A is not None:
             self._A.destroy()
         self._A = A

@@ -21,11 +21,10 @@ import numpy as np
 from petsc4py import PETSc
 
 from ..errors import SolverError
-from .condensed import CondensedSolver, _geometric_levels
+from .condensed import CondensedSolver
 from .elimination import (
     CondensedOperator,
     LocalRows,
-    condensed_matrix,
     elimination_matrix,
     t_mult,
     t_mult_transpose,
@@ -170,20 +169,9 @@ class FrictionCondensedSolver(CondensedSolver):
 
     def _preconditioner(self, nb: NodeBlocks) -> None:
         """One multigrid cycle on T^T K T + P (symmetric positive definite), set up."""
-        ksp, piv = self._ksp, nb.dofs
-        S = condensed_matrix(self._K, nb.c_rows, self._r0, piv, self._diag)
-        if self._modes:
-            S.setNearNullSpace(self._near_nullspace(piv))
-        if self._interp:  # before the operators: a rebuild resets the PC
-            _geometric_levels(ksp.getPC(), self._interp, piv)
-        ksp.setOperators(S)
-        ksp.setFromOptions()
-        ksp.setType(PETSc.KSP.Type.PREONLY)
-        ksp.setUp()
-        if self._A is not None:
-            self._A.destroy()
-        self._A = S
-        self._built_for = piv.copy()
+        self._multigrid(nb.c_rows, nb.dofs)
+        self._ksp.setType(PETSc.KSP.Type.PREONLY)
+        self._ksp.setUp()
 
     def _recover(
         self, EC: PETSc.Mat, v: PETSc.Vec, t: PETSc.Vec, r: PETSc.Vec, nb: NodeBlocks
